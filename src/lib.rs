@@ -1,0 +1,15 @@
+//! # autobal: design passive auto-balancers by virtual experiment
+//!
+//! autobal answers the question engineers ask when they put an auto-balancer
+//! (balls, rollers or pendulums running in a race on a rotor) into a washing
+//! machine, centrifuge, optical drive or grinder: how many weights, of what
+//! radius, balance the rotor fastest and best over every unbalance it meets?
+//!
+//! ## Data flow
+//! - [`design`]: the analytic theory (capacity, optimal radius, transient measures)
+//!   — pure functions, microseconds.
+//!
+//! The library never prints: the `study` binary is a thin layer that parses
+//! arguments, calls the library and formats the results.
+
+pub mod design;

@@ -1,0 +1,5 @@
+//! autobal's integration tests, linked into one binary to keep builds fast.
+
+mod cli_design;
+mod design_capacity;
+mod design_transient;
