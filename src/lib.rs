@@ -13,3 +13,4 @@
 //! arguments, calls the library and formats the results.
 
 pub mod design;
+pub mod integrate;
