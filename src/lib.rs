@@ -12,5 +12,10 @@
 //! The library never prints: the `study` binary is a thin layer that parses
 //! arguments, calls the library and formats the results.
 
+// Index loops mirror the equations' subscripts (A[r][c], w_i); iterator
+// chains over several parallel arrays would hide them.
+#![allow(clippy::needless_range_loop)]
+
 pub mod design;
 pub mod integrate;
+pub mod model;

@@ -4,3 +4,4 @@ mod cli_design;
 mod design_capacity;
 mod design_transient;
 mod integrate;
+mod model_conservation;

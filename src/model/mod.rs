@@ -1,0 +1,20 @@
+//! What is simulated: rotors carrying auto-balancers, their cargoes, the
+//! speed law and optional effects, assembled into an ODE system.
+//!
+//! - [`scene::Scene`]: a plain, serialisable description of one simulation.
+//! - [`rotor`]: rotor models (one file each) behind the [`rotor::Rotor`] trait.
+//! - [`balancer`]: ball, roller and pendulum kinds (one file each).
+//! - [`effect`]: optional effects such as gravity (one file each).
+//! - [`system::RotorSystem`]: the assembled equations (O(n) per call).
+//! - [`start`]: initial states (locked steady state, rest, step, run-up).
+//! - [`invariants`]: energy and angular momentum, for validation.
+
+pub mod balancer;
+pub mod cargo;
+pub mod effect;
+pub mod invariants;
+pub mod rotor;
+pub mod scene;
+pub mod speed;
+pub mod start;
+pub mod system;

@@ -1,0 +1,102 @@
+//! The plane rotor of seed 004: mass M with eccentricity e on anisotropic
+//! viscoelastic supports (k_x, k_y, b_x, b_y); one balancer plane at the
+//! shaft centre. Coordinates x, y of the shaft centre from static equilibrium.
+
+use super::{DofVec, MAX_DOF, Rotor};
+use serde::{Deserialize, Serialize};
+
+/// Parameters of the plane rotor (any consistent units, SI in study files).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneRotor {
+    /// Rotor mass M (kg).
+    pub mass: f64,
+    /// Eccentricity e of the rotor's centre of mass (m).
+    pub eccentricity: f64,
+    /// Direction ψ₀ of the unbalance relative to the rotor at φ = 0 (rad).
+    #[serde(default)]
+    pub unbalance_angle: f64,
+    /// Polar moment of inertia J_C about the rotor's centre of mass (kg·m²);
+    /// J_P = J_C + M e² enters at variable speed only.
+    #[serde(default = "default_inertia")]
+    pub inertia: f64,
+    /// Support stiffness along X (N/m).
+    pub kx: f64,
+    /// Support stiffness along Y (N/m).
+    pub ky: f64,
+    /// Support damping along X (N·s/m).
+    pub bx: f64,
+    /// Support damping along Y (N·s/m).
+    pub by: f64,
+}
+
+fn default_inertia() -> f64 {
+    1.0
+}
+
+impl PlaneRotor {
+    /// An isotropic rotor (k_x = k_y = k, b_x = b_y = b).
+    pub fn isotropic(mass: f64, eccentricity: f64, k: f64, b: f64) -> Self {
+        PlaneRotor {
+            mass,
+            eccentricity,
+            unbalance_angle: 0.0,
+            inertia: 1.0,
+            kx: k,
+            ky: k,
+            bx: b,
+            by: b,
+        }
+    }
+}
+
+impl Rotor for PlaneRotor {
+    fn name(&self) -> &'static str {
+        "plane"
+    }
+
+    fn dof(&self) -> usize {
+        2
+    }
+
+    fn planes(&self) -> usize {
+        1
+    }
+
+    fn plane_map(&self, _plane: usize) -> [DofVec; 2] {
+        [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]
+    }
+
+    fn mass_matrix(&self) -> [DofVec; MAX_DOF] {
+        let mut m = [[0.0; MAX_DOF]; MAX_DOF];
+        m[0][0] = self.mass;
+        m[1][1] = self.mass;
+        m
+    }
+
+    fn spin_inertia(&self) -> f64 {
+        self.inertia + self.mass * self.eccentricity * self.eccentricity
+    }
+
+    fn forces(&self, q: &[f64], qd: &[f64], _spin_rate: f64, f: &mut DofVec) {
+        f[0] -= self.kx * q[0] + self.bx * qd[0];
+        f[1] -= self.ky * q[1] + self.by * qd[1];
+    }
+
+    fn spin_coupling(&self, phi: f64) -> DofVec {
+        let me = self.mass * self.eccentricity;
+        let (s, c) = (phi + self.unbalance_angle).sin_cos();
+        [-me * s, me * c, 0.0, 0.0]
+    }
+
+    fn unbalance_forces(&self, phi: f64, spin_rate: f64, f: &mut DofVec) {
+        let me = self.mass * self.eccentricity * spin_rate * spin_rate;
+        let (s, c) = (phi + self.unbalance_angle).sin_cos();
+        f[0] += me * c;
+        f[1] += me * s;
+    }
+
+    fn static_unbalance(&self) -> (f64, f64) {
+        (self.mass * self.eccentricity, self.unbalance_angle)
+    }
+}

@@ -1,0 +1,138 @@
+//! Initial states of a run.
+//!
+//! The default, `locked_steady`, starts the rotor in the forced steady state
+//! it would have with the cargoes locked at their initial positions and
+//! releases the cargoes with zero relative speed: settling time then measures
+//! the balancer, not the decay of the start-up whirl through the support
+//! damping (which is what starting from rest at full speed measures).
+
+use super::system::RotorSystem;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// How the rotor and cargoes start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum StartMode {
+    /// Rotor in the forced steady state with the cargoes locked; cargoes released at t = 0.
+    #[default]
+    LockedSteady,
+    /// Rotor at rest (no vibration) at full speed: shows the start-up whirl.
+    Rest,
+    /// The system balanced for another unbalance; the unbalance has just jumped
+    /// (cargo angles balanced for the old direction, rotor quiet).
+    Step,
+    /// Variable speed from rest (use with a motor or ramp speed law).
+    Runup,
+}
+
+/// Initial state for `mode` with cargo angles `psi0` relative to the rotor.
+///
+/// The cargoes always start with zero speed relative to the rotor; the spin
+/// starts at the speed law's initial rate.
+pub fn initial_state(system: &RotorSystem, mode: StartMode, psi0: &[f64]) -> Vec<f64> {
+    let lay = system.layout();
+    let nq = lay.nq();
+    let mut y = vec![0.0; lay.dim()];
+    for (j, &psi) in psi0.iter().enumerate() {
+        y[lay.psi(j)] = psi;
+    }
+    let rate = system.speed().initial_rate();
+    if lay.spin_free {
+        y[nq + lay.phi()] = rate;
+    }
+    if mode == StartMode::LockedSteady {
+        let [x, xd, yy, yd] = locked_response(system, psi0, rate);
+        y[0] = x;
+        y[1] = yy;
+        y[nq] = xd;
+        y[nq + 1] = yd;
+    }
+    y
+}
+
+/// Forced steady state (x, ẋ, y, ẏ) at t = 0 of the plane rotor spinning at ω
+/// with the cargoes locked at `psi0`: each axis answers the rotating total
+/// unbalance U e^{i(ωt+θ)} as M_Σ ẍ + b ẋ + k x = ω² U cos(ωt + θ).
+pub fn locked_response(system: &RotorSystem, psi0: &[f64], omega: f64) -> [f64; 4] {
+    let (ux, uy) = total_unbalance(system, psi0);
+    let rotor = system.rotor();
+    let m_total = rotor.mass_matrix()[0][0] + system.cargo().iter().map(|c| c.mass).sum::<f64>();
+    // Support stiffness and damping along each axis, read off the rotor's forces.
+    let axis = |i: usize| {
+        let mut f = [0.0; super::rotor::MAX_DOF];
+        let mut q = [0.0; super::rotor::MAX_DOF];
+        q[i] = 1.0;
+        rotor.forces(&q, &[0.0; super::rotor::MAX_DOF], omega, &mut f);
+        let k = -f[i];
+        let mut f = [0.0; super::rotor::MAX_DOF];
+        rotor.forces(&[0.0; super::rotor::MAX_DOF], &q, omega, &mut f);
+        (k, -f[i])
+    };
+    let w2 = omega * omega;
+    // x = Re[ω² U e^{iωt} / D], D = k − M_Σ ω² + i b ω, with U = ux + i uy.
+    let response = |k: f64, b: f64, ure: f64, uim: f64| {
+        let (dre, dim) = (k - m_total * w2, b * omega);
+        let den = dre * dre + dim * dim;
+        let re = w2 * (ure * dre + uim * dim) / den;
+        let im = w2 * (uim * dre - ure * dim) / den;
+        (re, -omega * im)
+    };
+    let (kx, bx) = axis(0);
+    let (ky, by) = axis(1);
+    let (x, xd) = response(kx, bx, ux, uy);
+    // y is driven by sin: −i U.
+    let (y, yd) = response(ky, by, uy, -ux);
+    [x, xd, y, yd]
+}
+
+/// Total unbalance (kg·m) of rotor and cargoes at φ = 0 as (U_x, U_y).
+pub fn total_unbalance(system: &RotorSystem, psi: &[f64]) -> (f64, f64) {
+    let (me, angle) = system.rotor().static_unbalance();
+    let (mut ux, mut uy) = (me * angle.cos(), me * angle.sin());
+    for (c, &p) in system.cargo().iter().zip(psi) {
+        ux += c.unbalance() * p.cos();
+        uy += c.unbalance() * p.sin();
+    }
+    (ux, uy)
+}
+
+/// Angles of n equal cargoes, each of unbalance `cargo_unbalance` (m l), that
+/// cancel an unbalance of magnitude `unbalance` at angle `direction`: a fan
+/// symmetric about the opposite direction with equal spacing δ solving
+/// sin(nδ/2)/sin(δ/2) = unbalance/cargo_unbalance. `None` when it cannot be
+/// balanced (more than the cargoes' total, or one cargo of another size).
+pub fn balanced_fan(
+    n: usize,
+    cargo_unbalance: f64,
+    unbalance: f64,
+    direction: f64,
+) -> Option<Vec<f64>> {
+    let ratio = unbalance / cargo_unbalance;
+    let nf = n as f64;
+    if n == 0 || !(0.0..=nf).contains(&ratio) {
+        return None;
+    }
+    if n == 1 {
+        return ((ratio - 1.0).abs() < 1e-12).then(|| vec![direction + PI]);
+    }
+    let sum = |delta: f64| {
+        if delta < 1e-12 {
+            nf
+        } else {
+            (nf * delta / 2.0).sin() / (delta / 2.0).sin()
+        }
+    };
+    // sum decreases from n at δ = 0 to 0 at δ = 2π/n: bisection is exact enough.
+    let (mut lo, mut hi) = (0.0, 2.0 * PI / nf);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if sum(mid) > ratio { lo = mid } else { hi = mid }
+    }
+    let delta = 0.5 * (lo + hi);
+    Some(
+        (0..n)
+            .map(|j| direction + PI + (j as f64 - (nf - 1.0) / 2.0) * delta)
+            .collect(),
+    )
+}

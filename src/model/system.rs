@@ -1,0 +1,323 @@
+//! The assembled equations of motion of a rotor with auto-balancers in the
+//! inertial frame (seed 004, eqs 3, 15–20), as an [`OdeSystem`].
+//!
+//! State layout: q = [rotor coordinates (k), φ (only when the speed is free),
+//! ψ_1..ψ_n], then q̇ in the same order. Cargo angles are integrated relative
+//! to the rotor, ψ_j = φ_j − φ: inertial angles grow to thousands of radians
+//! and would ruin relative error control.
+//!
+//! The mass matrix is an arrowhead: every cargo row couples only to the small
+//! head block (rotor coordinates and φ). Each right-hand side eliminates the
+//! cargo rows (a Schur complement onto the head block), solves the head block
+//! of size ≤ 5 by Gaussian elimination and back-substitutes: O(n) work and no
+//! heap allocation per call.
+
+use super::cargo::Cargo;
+use super::effect::{Effect, EffectContext, Forces};
+use super::rotor::{DofVec, MAX_DOF, Rotor};
+use super::speed::SpeedLaw;
+use crate::integrate::OdeSystem;
+
+/// Largest head block: rotor coordinates plus the spin angle.
+const MAX_HEAD: usize = MAX_DOF + 1;
+
+/// Where each coordinate lives in the state vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Layout {
+    /// Number of rotor coordinates k.
+    pub rotor_dof: usize,
+    /// True when φ is a state variable (variable speed).
+    pub spin_free: bool,
+    /// Number of cargoes n.
+    pub cargoes: usize,
+}
+
+impl Layout {
+    /// Number of generalised coordinates.
+    pub fn nq(&self) -> usize {
+        self.head() + self.cargoes
+    }
+    /// Size of the head block (rotor coordinates plus φ when free).
+    pub fn head(&self) -> usize {
+        self.rotor_dof + usize::from(self.spin_free)
+    }
+    /// State dimension 2·nq.
+    pub fn dim(&self) -> usize {
+        2 * self.nq()
+    }
+    /// Index of φ in q (meaningful only when the spin is free).
+    pub fn phi(&self) -> usize {
+        self.rotor_dof
+    }
+    /// Index of ψ_j in q.
+    pub fn psi(&self, j: usize) -> usize {
+        self.head() + j
+    }
+}
+
+/// Rotor, cargoes, speed law and enabled effects, ready to integrate.
+#[derive(Debug)]
+pub struct RotorSystem {
+    rotor: Box<dyn Rotor>,
+    cargo: Vec<Cargo>,
+    /// κ m l² per cargo (cached: used twice per cargo per call).
+    inertia: Vec<f64>,
+    plane_maps: Vec<[DofVec; 2]>,
+    speed: SpeedLaw,
+    effects: Vec<Box<dyn Effect>>,
+    layout: Layout,
+    /// Rotor mass matrix plus Σ m Gᵀ G of the cargoes (constant).
+    head_mass: [DofVec; MAX_DOF],
+    /// J_P plus the rolling inertia of balls and rollers.
+    spin_inertia: f64,
+}
+
+impl RotorSystem {
+    /// Assemble the system; `effects` are the already-built enabled effects.
+    pub fn new(
+        rotor: Box<dyn Rotor>,
+        cargo: Vec<Cargo>,
+        speed: SpeedLaw,
+        effects: Vec<Box<dyn Effect>>,
+    ) -> Self {
+        let k = rotor.dof();
+        let plane_maps: Vec<_> = (0..rotor.planes()).map(|p| rotor.plane_map(p)).collect();
+        let mut head_mass = rotor.mass_matrix();
+        for c in &cargo {
+            let [gu, gv] = plane_maps[c.plane];
+            for a in 0..k {
+                for b in 0..k {
+                    head_mass[a][b] += c.mass * (gu[a] * gu[b] + gv[a] * gv[b]);
+                }
+            }
+        }
+        let spin_inertia =
+            rotor.spin_inertia() + cargo.iter().map(|c| c.rolling_inertia).sum::<f64>();
+        let layout = Layout {
+            rotor_dof: k,
+            spin_free: !speed.is_prescribed(),
+            cargoes: cargo.len(),
+        };
+        RotorSystem {
+            inertia: cargo.iter().map(Cargo::inertia).collect(),
+            rotor,
+            cargo,
+            plane_maps,
+            speed,
+            effects,
+            layout,
+            head_mass,
+            spin_inertia,
+        }
+    }
+
+    /// Where each coordinate lives in the state.
+    pub fn layout(&self) -> Layout {
+        self.layout
+    }
+
+    /// The rotor model.
+    pub fn rotor(&self) -> &dyn Rotor {
+        self.rotor.as_ref()
+    }
+
+    /// The cargoes.
+    pub fn cargo(&self) -> &[Cargo] {
+        &self.cargo
+    }
+
+    /// The speed law.
+    pub fn speed(&self) -> &SpeedLaw {
+        &self.speed
+    }
+
+    /// Names of the enabled effects.
+    pub fn effect_names(&self) -> Vec<&'static str> {
+        self.effects.iter().map(|e| e.name()).collect()
+    }
+
+    /// Spin angle and rate at time t in state y.
+    pub fn spin(&self, t: f64, y: &[f64]) -> (f64, f64) {
+        if self.layout.spin_free {
+            let nq = self.layout.nq();
+            (y[self.layout.phi()], y[nq + self.layout.phi()])
+        } else {
+            let (phi, rate, _) = self.speed.prescribed(t);
+            (phi, rate)
+        }
+    }
+}
+
+impl OdeSystem for RotorSystem {
+    fn dim(&self) -> usize {
+        self.layout.dim()
+    }
+
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let lay = self.layout;
+        let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
+        let (q, qd) = y.split_at(nq);
+        dydt[..nq].copy_from_slice(qd);
+        let (phi, spin_rate, spin_accel) = if lay.spin_free {
+            (q[lay.phi()], qd[lay.phi()], 0.0)
+        } else {
+            self.speed.prescribed(t)
+        };
+        let psi = &q[head..];
+        let psi_rate = &qd[head..];
+
+        // Generalised forces: rotor g[..k], spin g[k]; cargo forces live in
+        // the acceleration slots of dydt until they are replaced by ψ̈.
+        let mut g: [f64; MAX_HEAD] = [0.0; MAX_HEAD];
+        let mut rotor_f: DofVec = [0.0; MAX_DOF];
+        self.rotor
+            .forces(&q[..k], &qd[..k], spin_rate, &mut rotor_f);
+        self.rotor.unbalance_forces(phi, spin_rate, &mut rotor_f);
+        let mut spin_f = self.speed.torque(spin_rate);
+        let cargo_f = &mut dydt[nq + head..];
+        for (j, c) in self.cargo.iter().enumerate() {
+            let drag = c.drag * c.track_radius * c.track_radius * psi_rate[j];
+            cargo_f[j] = -drag;
+            spin_f += drag;
+        }
+        if !self.effects.is_empty() {
+            let ctx = EffectContext {
+                t,
+                phi,
+                spin_rate,
+                spin_free: lay.spin_free,
+                cargo: &self.cargo,
+                psi,
+                psi_rate,
+                rotor_unbalance: self.rotor.static_unbalance(),
+            };
+            let mut forces = Forces {
+                rotor: &mut rotor_f,
+                spin: &mut spin_f,
+                cargo: cargo_f,
+            };
+            for effect in &self.effects {
+                effect.apply(&ctx, &mut forces);
+            }
+        }
+        g[..k].copy_from_slice(&rotor_f[..k]);
+
+        // Head block before elimination.
+        let coupling = self.rotor.spin_coupling(phi);
+        let mut a = [[0.0; MAX_HEAD]; MAX_HEAD];
+        for r in 0..k {
+            a[r][..k].copy_from_slice(&self.head_mass[r][..k]);
+        }
+        // Column of φ̈ in the rotor rows (rotor unbalance plus every cargo's).
+        let mut spin_col: DofVec = coupling;
+        let mut spin_diag = self.spin_inertia;
+
+        // Eliminate the cargo rows. Cargo row j reads
+        //   I_j ψ̈_j + c_j·z = Q_j,  c_j = (w_j, I_j − J_j),
+        // and contributes e_j·ψ̈_j to the head rows, e_j = (w_j, −J_j), with
+        // w_j = m l (−sin φ_j G_u + cos φ_j G_v) and J_j the rolling coupling.
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = (phi + psi[j]).sin_cos();
+            let ml = c.mass * c.track_radius;
+            let [gu, gv] = &self.plane_maps[c.plane];
+            let rate = spin_rate + psi_rate[j];
+            let mut w: DofVec = [0.0; MAX_DOF];
+            for i in 0..k {
+                w[i] = ml * (co * gv[i] - s * gu[i]);
+                g[i] += ml * rate * rate * (co * gu[i] + s * gv[i]);
+                spin_col[i] += w[i];
+            }
+            let inertia = self.inertia[j];
+            let jc = c.rolling_coupling;
+            spin_diag -= jc;
+            let mut qj = cargo_f[j];
+            if !lay.spin_free {
+                qj -= (inertia - jc) * spin_accel;
+                cargo_f[j] = qj;
+            }
+            let inv = 1.0 / inertia;
+            for r in 0..k {
+                let er = w[r] * inv;
+                for col in 0..k {
+                    a[r][col] -= er * w[col];
+                }
+                g[r] -= er * qj;
+            }
+            if lay.spin_free {
+                for r in 0..k {
+                    // e_r · c_φ and e_φ · c_r terms.
+                    a[r][k] -= w[r] * inv * (inertia - jc);
+                    a[k][r] += jc * inv * w[r];
+                }
+                a[k][k] += jc * inv * (inertia - jc);
+                g[k] += jc * inv * qj;
+            }
+        }
+        if lay.spin_free {
+            for r in 0..k {
+                a[r][k] += spin_col[r];
+                a[k][r] += coupling[r];
+            }
+            a[k][k] += spin_diag;
+            g[k] += spin_f;
+        } else {
+            for r in 0..k {
+                g[r] -= spin_col[r] * spin_accel;
+            }
+        }
+
+        let z = solve_small(&mut a, &mut g, head);
+
+        // Back-substitute the cargo accelerations.
+        let mut z_rotor: DofVec = [0.0; MAX_DOF];
+        z_rotor[..k].copy_from_slice(&z[..k]);
+        let z_spin = if lay.spin_free { z[k] } else { 0.0 };
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = (phi + psi[j]).sin_cos();
+            let ml = c.mass * c.track_radius;
+            let [gu, gv] = &self.plane_maps[c.plane];
+            let mut wz = 0.0;
+            for i in 0..k {
+                wz += ml * (co * gv[i] - s * gu[i]) * z_rotor[i];
+            }
+            let spin_term = (self.inertia[j] - c.rolling_coupling) * z_spin;
+            cargo_f[j] = (cargo_f[j] - wz - spin_term) / self.inertia[j];
+        }
+        dydt[nq..nq + head].copy_from_slice(&z[..head]);
+    }
+}
+
+/// Solve the dense system a·z = g of size `size` ≤ 5 by Gaussian elimination
+/// with partial pivoting (a library call would cost more than the solve).
+fn solve_small(
+    a: &mut [[f64; MAX_HEAD]; MAX_HEAD],
+    g: &mut [f64; MAX_HEAD],
+    size: usize,
+) -> [f64; MAX_HEAD] {
+    for col in 0..size {
+        let pivot = (col..size)
+            .max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))
+            .unwrap_or(col);
+        a.swap(col, pivot);
+        g.swap(col, pivot);
+        let inv = 1.0 / a[col][col];
+        for row in col + 1..size {
+            let f = a[row][col] * inv;
+            if f != 0.0 {
+                for c in col..size {
+                    a[row][c] -= f * a[col][c];
+                }
+                g[row] -= f * g[col];
+            }
+        }
+    }
+    let mut z = [0.0; MAX_HEAD];
+    for row in (0..size).rev() {
+        let mut sum = g[row];
+        for c in row + 1..size {
+            sum -= a[row][c] * z[c];
+        }
+        z[row] = sum / a[row][row];
+    }
+    z
+}
