@@ -18,4 +18,7 @@
 
 pub mod design;
 pub mod integrate;
+pub mod metrics;
 pub mod model;
+pub mod scene_file;
+pub mod simulation;

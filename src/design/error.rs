@@ -40,6 +40,9 @@ pub enum DesignError {
     /// A shape name that is neither `ball` nor `roller`.
     #[error("unknown weight shape '{0}': expected 'ball' or 'roller'")]
     UnknownShape(String),
+    /// A named ρ rule that does not exist.
+    #[error("rho = \"{0}\": expected a number, \"optimal\" or \"half_race\"")]
+    UnknownRhoRule(String),
     /// The numerical optimiser failed (should not happen on the valid domain).
     #[error("optimisation of ρ for n = {n} failed: {reason}")]
     Optimizer {

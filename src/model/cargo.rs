@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 /// that centre; balls and rollers additionally couple with the rotor's
 /// angular acceleration through rolling without slip (seed 004, eqs 15, 17).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Cargo {
     /// Mass m (kg).
     pub mass: f64,
@@ -20,8 +21,10 @@ pub struct Cargo {
     pub kappa: f64,
     /// Rolling coupling J_C (l/r)(l/r + 1) with the rotor's angular
     /// acceleration (kg·m²); zero for pendulums.
+    #[serde(default)]
     pub rolling_coupling: f64,
     /// Extra rotor inertia J_C (l/r + 1)² from rolling (kg·m²); zero for pendulums.
+    #[serde(default)]
     pub rolling_inertia: f64,
     /// Index of the balancer plane the cargo runs in.
     #[serde(default)]

@@ -17,26 +17,17 @@ use serde::{Deserialize, Serialize};
 pub struct Scene {
     /// The rotor and its supports.
     pub rotor: PlaneRotor,
-    /// The auto-balancer.
-    pub balancer: BalancerSpec,
+    /// The auto-balancer as a design (give this or `cargo`).
+    #[serde(default)]
+    pub balancer: Option<DesignSpec>,
+    /// The auto-balancer as explicit cargoes (give this or `balancer`).
+    #[serde(default)]
+    pub cargo: Vec<Cargo>,
     /// How the spin evolves.
     pub speed: SpeedLaw,
     /// Optional effects (gravity …).
     #[serde(default)]
     pub effects: Effects,
-}
-
-/// The balancer: a design (kind, n, geometry) or explicit cargoes.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum BalancerSpec {
-    /// n identical weights of one kind built from a geometry.
-    Design(DesignSpec),
-    /// Explicit cargoes (any masses, radii, κ).
-    Custom {
-        /// The cargoes.
-        cargo: Vec<Cargo>,
-    },
 }
 
 /// n identical weights of one kind.
@@ -65,35 +56,28 @@ fn steel() -> f64 {
     7850.0
 }
 
-/// How the radius ratio is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// How the radius ratio is chosen: a number, or the name of a rule
+/// (`"optimal"`: the capacity optimum of Table 1; `"half_race"`: the weights
+/// fill exactly half the race).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum RhoChoice {
     /// A given ρ.
     Value(f64),
-    /// A named rule.
-    Rule(RhoRule),
-}
-
-/// Named rules for ρ.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RhoRule {
-    /// The capacity optimum of Table 1 (seed 000).
-    Optimal,
-    /// The weights fill exactly half the race.
-    HalfRace,
+    /// A named rule, checked when the spec is resolved.
+    Rule(String),
 }
 
 impl DesignSpec {
     /// The radius ratio this spec resolves to.
     pub fn resolved_rho(&self) -> Result<f64, DesignError> {
-        match self.rho {
-            RhoChoice::Value(rho) => Ok(rho),
-            RhoChoice::Rule(RhoRule::Optimal) => {
+        match &self.rho {
+            RhoChoice::Value(rho) => Ok(*rho),
+            RhoChoice::Rule(rule) if rule == "optimal" => {
                 Ok(optimal_rho(self.kind.model().shape(), self.n)?.rho)
             }
-            RhoChoice::Rule(RhoRule::HalfRace) => rho_half_race(self.n),
+            RhoChoice::Rule(rule) if rule == "half_race" => rho_half_race(self.n),
+            RhoChoice::Rule(rule) => Err(DesignError::UnknownRhoRule(rule.clone())),
         }
     }
 
@@ -201,8 +185,22 @@ impl Scene {
                 ));
             }
         }
-        match &self.balancer {
-            BalancerSpec::Design(d) => {
+        match (&self.balancer, self.cargo.is_empty()) {
+            (None, true) => {
+                return Err(SceneError::Invalid {
+                    field: "balancer".into(),
+                    value: "missing".into(),
+                    reason: "give a [balancer] design or a [[cargo]] list".into(),
+                });
+            }
+            (Some(_), false) => {
+                return Err(SceneError::Invalid {
+                    field: "balancer".into(),
+                    value: "both [balancer] and [[cargo]]".into(),
+                    reason: "give one of them, not both".into(),
+                });
+            }
+            (Some(d), true) => {
                 if d.n == 0 {
                     return Err(invalid("balancer.n", 0.0, "needs at least one weight"));
                 }
@@ -212,25 +210,26 @@ impl Scene {
                 if d.kind == Kind::Roller {
                     positive("balancer.roller_height", d.roller_height)?;
                 }
-                if let RhoChoice::Value(rho) = d.rho {
-                    crate::design::geometry::check_fits(d.n, rho)?;
-                }
+                let rho = d.resolved_rho()?;
+                crate::design::geometry::check_fits(d.n, rho)?;
             }
-            BalancerSpec::Custom { cargo } => {
-                for (j, c) in cargo.iter().enumerate() {
-                    positive(&format!("balancer.cargo[{j}].mass"), c.mass)?;
-                    positive(&format!("balancer.cargo[{j}].track_radius"), c.track_radius)?;
-                    non_negative(&format!("balancer.cargo[{j}].drag"), c.drag)?;
+            (None, false) => {
+                for (j, c) in self.cargo.iter().enumerate() {
+                    positive(&format!("cargo[{j}].mass"), c.mass)?;
+                    positive(&format!("cargo[{j}].track_radius"), c.track_radius)?;
+                    non_negative(&format!("cargo[{j}].drag"), c.drag)?;
+                    non_negative(&format!("cargo[{j}].rolling_coupling"), c.rolling_coupling)?;
+                    non_negative(&format!("cargo[{j}].rolling_inertia"), c.rolling_inertia)?;
                     if !(c.kappa.is_finite() && c.kappa >= 1.0) {
                         return Err(invalid(
-                            &format!("balancer.cargo[{j}].kappa"),
+                            &format!("cargo[{j}].kappa"),
                             c.kappa,
                             "must be ≥ 1",
                         ));
                     }
                     if c.plane != 0 {
                         return Err(invalid(
-                            &format!("balancer.cargo[{j}].plane"),
+                            &format!("cargo[{j}].plane"),
                             c.plane as f64,
                             "the plane rotor has one balancer plane (0)",
                         ));
@@ -244,8 +243,8 @@ impl Scene {
     /// The cargoes this scene's balancer resolves to.
     pub fn cargoes(&self) -> Result<Vec<Cargo>, SceneError> {
         Ok(match &self.balancer {
-            BalancerSpec::Design(d) => balancer::cargoes(d.kind, d.n, &d.geometry()?)?,
-            BalancerSpec::Custom { cargo } => cargo.clone(),
+            Some(d) => balancer::cargoes(d.kind, d.n, &d.geometry()?)?,
+            None => self.cargo.clone(),
         })
     }
 

@@ -5,3 +5,4 @@ mod design_capacity;
 mod design_transient;
 mod integrate;
 mod model_conservation;
+mod model_physics;

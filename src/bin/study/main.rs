@@ -4,6 +4,7 @@
 
 mod design_cmd;
 mod output;
+mod simulate_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -21,6 +22,9 @@ enum Command {
     /// Analytic design table (Table 1 of seed 000): optimal radius, capacity, p_max, ã.
     #[command(after_help = design_cmd::EXAMPLES)]
     Design(design_cmd::DesignArgs),
+    /// Simulate one scene and print settling time, residual vibration and more.
+    #[command(after_help = simulate_cmd::EXAMPLES)]
+    Simulate(simulate_cmd::SimulateArgs),
 }
 
 /// An error the user caused (bad input): printed and mapped to exit code 2.
@@ -36,6 +40,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
+        Command::Simulate(args) => simulate_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

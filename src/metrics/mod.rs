@@ -1,0 +1,123 @@
+//! What a run's outcome is, defined once and used by every report.
+//!
+//! Definitions (also in `docs/metrics.md`):
+//! - A_ref = U ω² / |k_x − M_Σ ω² + i b_x ω|: the vibration amplitude the
+//!   rotor's own unbalance U = M e would cause with the balancer locked
+//!   (U = Σ m_j l_j when e = 0, so that the scale stays meaningful).
+//! - r(t) = sqrt(x² + y²); ε(t) = |Σ m_j l_j e^{iψ_j} + M e e^{iψ₀}| / U.
+//! - Settling time t_s: the start of the first stretch during which
+//!   r ≤ δ·A_ref holds continuously for W revolutions or until the end of the
+//!   run, checked on dense output at `samples_per_rev` points per revolution
+//!   (≥ 32). A run stops early once the hold is satisfied. The same rule on
+//!   ε ≤ δ gives t_s(ε). t_s is resolved to one sampling interval, reported
+//!   as `settling_time_err`.
+//! - Residual vibration: RMS of r over the last W revolutions simulated,
+//!   absolute and relative to A_ref.
+//! - Outcome: settled, not_settled, diverged (non-finite state or r beyond
+//!   `divergence_factor`·A_ref) or solver_failed, each with a reason.
+//!
+//! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
+//! the ramp's final speed or the motor's synchronous speed).
+
+pub mod observer;
+pub mod reference;
+
+use serde::{Deserialize, Serialize};
+
+/// Parameters of the metric definitions above.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MetricOptions {
+    /// Settling band δ as a fraction of A_ref (and of U for ε).
+    pub delta: f64,
+    /// Hold window W in revolutions.
+    pub hold_revs: f64,
+    /// Run length T_end in revolutions.
+    pub t_end_revs: f64,
+    /// Dense-output samples per revolution (at least 32).
+    pub samples_per_rev: u32,
+    /// Stop the run as soon as the hold is satisfied.
+    pub stop_when_settled: bool,
+    /// r beyond this multiple of A_ref counts as divergence.
+    pub divergence_factor: f64,
+}
+
+impl Default for MetricOptions {
+    fn default() -> Self {
+        MetricOptions {
+            delta: 0.05,
+            hold_revs: 50.0,
+            t_end_revs: 2000.0,
+            samples_per_rev: 32,
+            stop_when_settled: true,
+            divergence_factor: 1e4,
+        }
+    }
+}
+
+/// How a run ended, in physical terms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// r stayed within δ·A_ref for the hold window (or until the end).
+    Settled,
+    /// The run ended without settling.
+    NotSettled,
+    /// The state became non-finite or r exceeded the divergence bound.
+    Diverged,
+    /// The integrator could not continue (step-size underflow, too many steps).
+    SolverFailed,
+}
+
+impl Outcome {
+    /// snake_case name used in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Settled => "settled",
+            Outcome::NotSettled => "not_settled",
+            Outcome::Diverged => "diverged",
+            Outcome::SolverFailed => "solver_failed",
+        }
+    }
+}
+
+/// Every metric of one run (the fields of `study simulate --json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunMetrics {
+    /// True when the settling rule on r was met.
+    pub settled: bool,
+    /// Settling time t_s on r (s), if settled.
+    pub settling_time: Option<f64>,
+    /// t_s in revolutions.
+    pub settling_revs: Option<f64>,
+    /// Resolution of t_s (one sampling interval, s).
+    pub settling_time_err: f64,
+    /// Settling time on the balancing error ε ≤ δ (s), if met.
+    pub settling_time_eps: Option<f64>,
+    /// True when the band held for the whole window W (false: only until the end of the run).
+    pub hold_complete: bool,
+    /// RMS of r over the last W revolutions.
+    pub residual_abs: f64,
+    /// residual_abs / A_ref.
+    pub residual_rel: f64,
+    /// Reference amplitude A_ref.
+    pub a_ref: f64,
+    /// Balancing error ε at the end of the run.
+    pub balancing_error: f64,
+    /// Largest r seen.
+    pub peak_r: f64,
+    /// Final cargo angles relative to the rotor, degrees in [0, 360).
+    pub final_rel_angles_deg: Vec<f64>,
+    /// Position parameter p (eq 2 of seed 000) of the final cargo angles.
+    pub p_final: f64,
+    /// Outcome class.
+    pub outcome: Outcome,
+    /// Why the run ended as it did.
+    pub reason: String,
+    /// Time simulated (s).
+    pub t_final: f64,
+    /// Accepted integrator steps.
+    pub steps: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_calls: u64,
+}

@@ -1,0 +1,263 @@
+//! The step observer that measures a run: samples r and ε on dense output,
+//! detects settling, watches for divergence, and optionally records a series.
+
+use super::reference::{a_ref, balancing_error, reference_unbalance};
+use super::{MetricOptions, Outcome, RunMetrics};
+use crate::design::transient::position_parameter;
+use crate::integrate::{Failure, Flow, SolveReport, Status, Step, StepObserver};
+use crate::model::system::RotorSystem;
+use std::f64::consts::PI;
+
+/// A sampled time history: t, x, y, r, ε and every ψ_j.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// Sample times (s).
+    pub t: Vec<f64>,
+    /// Shaft displacement x.
+    pub x: Vec<f64>,
+    /// Shaft displacement y.
+    pub y: Vec<f64>,
+    /// r = sqrt(x² + y²).
+    pub r: Vec<f64>,
+    /// Balancing error ε.
+    pub eps: Vec<f64>,
+    /// Cargo angles relative to the rotor, one vector per cargo (rad).
+    pub psi: Vec<Vec<f64>>,
+}
+
+/// Tracks one "holds continuously" rule (r ≤ band or ε ≤ band).
+#[derive(Debug, Clone, Copy, Default)]
+struct Hold {
+    stretch_start: Option<f64>,
+    met_at: Option<f64>,
+}
+
+impl Hold {
+    fn update(&mut self, t: f64, inside: bool, window: f64) {
+        if self.met_at.is_some() {
+            return;
+        }
+        if inside {
+            let start = *self.stretch_start.get_or_insert(t);
+            if t - start >= window {
+                self.met_at = Some(start);
+            }
+        } else {
+            self.stretch_start = None;
+        }
+    }
+
+    /// t_s under the rule "for W revolutions or until the end", and whether the full window held.
+    fn settling_time(&self) -> (Option<f64>, bool) {
+        match self.met_at {
+            Some(t) => (Some(t), true),
+            None => (self.stretch_start, false),
+        }
+    }
+}
+
+/// Measures one run of a [`RotorSystem`]; see the definitions in [`super`].
+pub struct SettlingObserver<'a> {
+    system: &'a RotorSystem,
+    options: MetricOptions,
+    a_ref: f64,
+    u_ref: f64,
+    band: f64,
+    window: f64,
+    dt: f64,
+    t0: f64,
+    next_index: u64,
+    scratch: Vec<f64>,
+    ring: Vec<f64>,
+    ring_pos: usize,
+    ring_filled: usize,
+    r_hold: Hold,
+    eps_hold: Hold,
+    peak_r: f64,
+    diverged: Option<String>,
+    series: Option<Series>,
+}
+
+impl<'a> SettlingObserver<'a> {
+    /// An observer for `system` running at nominal speed `omega`.
+    pub fn new(system: &'a RotorSystem, omega: f64, options: MetricOptions, record: bool) -> Self {
+        let rev = 2.0 * PI / omega;
+        let samples = options.samples_per_rev.max(32);
+        let ring_len = ((options.hold_revs * f64::from(samples)).ceil() as usize).max(1);
+        let a = a_ref(system, omega);
+        SettlingObserver {
+            system,
+            a_ref: a,
+            u_ref: reference_unbalance(system),
+            band: options.delta * a,
+            window: options.hold_revs * rev,
+            dt: rev / f64::from(samples),
+            t0: 0.0,
+            next_index: 0,
+            scratch: vec![0.0; crate::integrate::OdeSystem::dim(system)],
+            ring: vec![0.0; ring_len],
+            ring_pos: 0,
+            ring_filled: 0,
+            r_hold: Hold::default(),
+            eps_hold: Hold::default(),
+            peak_r: 0.0,
+            diverged: None,
+            series: record.then(|| Series {
+                psi: vec![Vec::new(); system.cargo().len()],
+                ..Series::default()
+            }),
+            options,
+        }
+    }
+
+    /// The reference amplitude A_ref of this run.
+    pub fn a_ref(&self) -> f64 {
+        self.a_ref
+    }
+
+    /// Process one sample; returns Stop when the run should end.
+    fn sample(&mut self, t: f64) -> Flow {
+        let lay = self.system.layout();
+        let y = &self.scratch;
+        let r = y[0].hypot(y[1]);
+        let psi = &y[lay.head()..lay.nq()];
+        let eps = balancing_error(self.system, psi, self.u_ref);
+        if !r.is_finite() || !eps.is_finite() {
+            self.diverged = Some(format!("non-finite state at t = {t}"));
+            return Flow::Stop;
+        }
+        self.peak_r = self.peak_r.max(r);
+        if r > self.options.divergence_factor * self.a_ref {
+            self.diverged = Some(format!(
+                "r = {r:.3e} exceeded {} A_ref at t = {t:.4}",
+                self.options.divergence_factor
+            ));
+            return Flow::Stop;
+        }
+        self.ring[self.ring_pos] = r * r;
+        self.ring_pos = (self.ring_pos + 1) % self.ring.len();
+        self.ring_filled = (self.ring_filled + 1).min(self.ring.len());
+        self.r_hold.update(t, r <= self.band, self.window);
+        self.eps_hold
+            .update(t, eps <= self.options.delta, self.window);
+        if let Some(series) = &mut self.series {
+            series.t.push(t);
+            series.x.push(y[0]);
+            series.y.push(y[1]);
+            series.r.push(r);
+            series.eps.push(eps);
+            for (j, p) in psi.iter().enumerate() {
+                series.psi[j].push(*p);
+            }
+        }
+        if self.options.stop_when_settled && self.r_hold.met_at.is_some() {
+            Flow::Stop
+        } else {
+            Flow::Continue
+        }
+    }
+
+    /// Turn the observations and the solver's report into the run's metrics.
+    pub fn finish(self, report: &SolveReport) -> (RunMetrics, Option<Series>) {
+        let lay = self.system.layout();
+        let psi = &report.y[lay.head()..lay.nq()];
+        let rms = if self.ring_filled == 0 {
+            0.0
+        } else {
+            let sum: f64 = if self.ring_filled == self.ring.len() {
+                self.ring.iter().sum()
+            } else {
+                self.ring[..self.ring_filled].iter().sum()
+            };
+            (sum / self.ring_filled as f64).sqrt()
+        };
+        let (t_s, hold_complete) = self.r_hold.settling_time();
+        let (t_eps, _) = self.eps_hold.settling_time();
+        let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
+        let (outcome, reason) = match (&self.diverged, &report.status) {
+            (Some(why), _) => (Outcome::Diverged, why.clone()),
+            (None, Status::Failed(Failure::NonFinite { t })) => {
+                (Outcome::Diverged, format!("non-finite state at t = {t}"))
+            }
+            (None, Status::Failed(f)) => (Outcome::SolverFailed, f.to_string()),
+            (None, _) => match t_s {
+                Some(t) if hold_complete => (
+                    Outcome::Settled,
+                    format!(
+                        "r ≤ {} A_ref held for {} revolutions from t = {t:.4}",
+                        self.options.delta, self.options.hold_revs
+                    ),
+                ),
+                Some(t) => (
+                    Outcome::Settled,
+                    format!(
+                        "r ≤ {} A_ref from t = {t:.4} until the end of the run (hold window not complete)",
+                        self.options.delta
+                    ),
+                ),
+                None => (
+                    Outcome::NotSettled,
+                    format!(
+                        "r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
+                        report.y[0].hypot(report.y[1]) / self.a_ref,
+                        self.options.delta,
+                        rms / self.a_ref
+                    ),
+                ),
+            },
+        };
+        let settled = outcome == Outcome::Settled;
+        let metrics = RunMetrics {
+            settled,
+            settling_time: if settled { t_s } else { None },
+            settling_revs: if settled {
+                t_s.map(|t| (t - self.t0) / rev)
+            } else {
+                None
+            },
+            settling_time_err: self.dt,
+            settling_time_eps: t_eps,
+            hold_complete: settled && hold_complete,
+            residual_abs: rms,
+            residual_rel: rms / self.a_ref,
+            a_ref: self.a_ref,
+            balancing_error: balancing_error(self.system, psi, self.u_ref),
+            peak_r: self.peak_r,
+            final_rel_angles_deg: psi
+                .iter()
+                .map(|p| p.to_degrees().rem_euclid(360.0))
+                .collect(),
+            p_final: position_parameter(psi),
+            outcome,
+            reason,
+            t_final: report.t,
+            steps: report.stats.steps,
+            rhs_calls: report.stats.rhs_calls,
+        };
+        (metrics, self.series)
+    }
+}
+
+impl StepObserver for SettlingObserver<'_> {
+    fn start(&mut self, t0: f64, y0: &[f64]) {
+        self.t0 = t0;
+        self.scratch.copy_from_slice(y0);
+        self.next_index = 1;
+        // The initial state is sample zero.
+        let _ = self.sample(t0);
+    }
+
+    fn step(&mut self, step: &Step<'_>) -> Flow {
+        loop {
+            let t = self.t0 + self.next_index as f64 * self.dt;
+            if t > step.t {
+                return Flow::Continue;
+            }
+            step.dense.eval(t, &mut self.scratch);
+            self.next_index += 1;
+            if self.sample(t) == Flow::Stop {
+                return Flow::Stop;
+            }
+        }
+    }
+}

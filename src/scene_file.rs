@@ -1,0 +1,152 @@
+//! The TOML file of `study simulate`: one scene plus start, solver and metric
+//! settings. Every key is documented in `docs/scene-file.md`.
+
+use crate::metrics::MetricOptions;
+use crate::model::cargo::Cargo;
+use crate::model::effect::Effects;
+use crate::model::rotor::PlaneRotor;
+use crate::model::scene::{DesignSpec, Scene, SceneError};
+use crate::model::speed::SpeedLaw;
+use crate::model::start::StartMode;
+use crate::simulation::{Simulation, SolverSettings, evenly_spaced};
+use serde::{Deserialize, Serialize};
+
+/// A scene file as written by the user.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Rotor and supports.
+    pub rotor: PlaneRotor,
+    /// The auto-balancer as a design (or give `cargo`).
+    #[serde(default)]
+    pub balancer: Option<DesignSpec>,
+    /// The auto-balancer as explicit cargoes (or give `balancer`).
+    #[serde(default)]
+    pub cargo: Vec<Cargo>,
+    /// Speed law.
+    pub speed: SpeedLaw,
+    /// Optional effects.
+    #[serde(default)]
+    pub effects: Effects,
+    /// Initial state.
+    #[serde(default)]
+    pub start: StartSpec,
+    /// Integrator settings.
+    #[serde(default)]
+    pub solver: SolverSettings,
+    /// Metric definitions.
+    #[serde(default)]
+    pub metrics: MetricOptions,
+}
+
+/// How a single run starts.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartSpec {
+    /// Start mode (default `locked_steady`).
+    #[serde(default)]
+    pub mode: StartMode,
+    /// Cargo angles relative to the rotor in degrees; evenly spaced when omitted.
+    #[serde(default)]
+    pub angles_deg: Option<Vec<f64>>,
+}
+
+/// A scene file that could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneFileError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// TOML syntax or schema error (the message names line, column and key).
+    #[error("{path}: {message}")]
+    Parse {
+        /// The path.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value outside its domain.
+    #[error("{path}: {source}")]
+    Invalid {
+        /// The path.
+        path: String,
+        /// The cause.
+        source: SceneError,
+    },
+}
+
+impl SceneFile {
+    /// Parse TOML text; `path` is used in messages only.
+    pub fn parse(text: &str, path: &str) -> Result<Self, SceneFileError> {
+        toml::from_str(text).map_err(|e| SceneFileError::Parse {
+            path: path.to_string(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Read and parse a file.
+    pub fn read(path: &std::path::Path) -> Result<Self, SceneFileError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
+            path: shown.clone(),
+            source,
+        })?;
+        Self::parse(&text, &shown)
+    }
+
+    /// The scene part.
+    pub fn scene(&self) -> Scene {
+        Scene {
+            rotor: self.rotor.clone(),
+            balancer: self.balancer.clone(),
+            cargo: self.cargo.clone(),
+            speed: self.speed.clone(),
+            effects: self.effects.clone(),
+        }
+    }
+
+    /// Validate and turn into a runnable simulation.
+    pub fn simulation(&self, path: &str) -> Result<Simulation, SceneFileError> {
+        let scene = self.scene();
+        let invalid = |source| SceneFileError::Invalid {
+            path: path.to_string(),
+            source,
+        };
+        scene.validate().map_err(invalid)?;
+        let n = scene.cargoes().map_err(invalid)?.len();
+        let initial_angles = match &self.start.angles_deg {
+            Some(a) => a.iter().map(|d| d.to_radians()).collect(),
+            None => evenly_spaced(n),
+        };
+        let m = &self.metrics;
+        let checks = [
+            ("metrics.delta", m.delta),
+            ("metrics.hold_revs", m.hold_revs),
+            ("metrics.t_end_revs", m.t_end_revs),
+            ("metrics.divergence_factor", m.divergence_factor),
+            ("solver.rtol", self.solver.rtol),
+            ("solver.atol", self.solver.atol),
+        ];
+        for (field, value) in checks {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid(SceneError::Invalid {
+                    field: field.into(),
+                    value: value.to_string(),
+                    reason: "must be positive and finite".into(),
+                }));
+            }
+        }
+        Ok(Simulation {
+            scene,
+            start: self.start.mode,
+            initial_angles,
+            solver: self.solver.clone(),
+            metrics: self.metrics.clone(),
+        })
+    }
+}

@@ -1,0 +1,322 @@
+//! Physics of the plane rotor with auto-balancers: analytic limits and the
+//! published conclusions of seed 004.
+
+use autobal::integrate::{Method, NoObserver, OdeSystem, SolverOptions, solve};
+use autobal::metrics::{MetricOptions, Outcome};
+use autobal::model::balancer::{Geometry, Kind, cargoes};
+use autobal::model::cargo::Cargo;
+use autobal::model::effect::Effects;
+use autobal::model::rotor::PlaneRotor;
+use autobal::model::scene::Scene;
+use autobal::model::speed::SpeedLaw;
+use autobal::model::start::{StartMode, balanced_fan, initial_state};
+use autobal::simulation::{Simulation, SolverSettings};
+use std::f64::consts::PI;
+
+/// Dimensionless rotor: M = 1, k = 1 (ω_n ≈ 1), ζ = 0.05, e = 0.01.
+fn rotor() -> PlaneRotor {
+    PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1)
+}
+
+fn balls(n: usize, mass: f64, drag: f64) -> Vec<Cargo> {
+    vec![Cargo::point(mass, 1.0, drag, 1.4); n]
+}
+
+fn simulation(rotor: PlaneRotor, cargo: Vec<Cargo>, omega: f64, angles_deg: &[f64]) -> Simulation {
+    Simulation {
+        scene: Scene {
+            rotor,
+            balancer: None,
+            cargo,
+            speed: SpeedLaw::Constant { omega },
+            effects: Effects::default(),
+        },
+        start: StartMode::LockedSteady,
+        initial_angles: angles_deg.iter().map(|d| d.to_radians()).collect(),
+        solver: SolverSettings::default(),
+        metrics: MetricOptions {
+            t_end_revs: 600.0,
+            ..MetricOptions::default()
+        },
+    }
+}
+
+/// Signed angle difference wrapped to (−180°, 180°].
+fn wrap_deg(a: f64) -> f64 {
+    let w = a.rem_euclid(360.0);
+    if w > 180.0 { w - 360.0 } else { w }
+}
+
+#[test]
+fn negligible_cargo_leaves_the_closed_form_forced_response() {
+    // Anisotropic supports; cargo 1e-12 of the rotor mass; start at rest.
+    let mut r = rotor();
+    r.ky = 2.3;
+    r.by = 0.05;
+    r.unbalance_angle = 0.7;
+    // Drag scales with the mass so that the cargo's relaxation rate β/(κm) stays O(1).
+    let cargo = balls(2, 1e-12, 1e-12);
+    let omega = 1.7;
+    let scene = Scene {
+        rotor: r.clone(),
+        balancer: None,
+        cargo,
+        speed: SpeedLaw::Constant { omega },
+        effects: Effects::default(),
+    };
+    let system = scene.build().unwrap();
+    let y0 = initial_state(&system, StartMode::Rest, &[0.0, PI]);
+    let options = SolverOptions {
+        rtol: 1e-10,
+        atol: vec![1e-13],
+        ..SolverOptions::default()
+    };
+    let t_end = 37.0;
+    let report = solve(
+        Method::Dp5,
+        &system,
+        0.0,
+        &y0,
+        t_end,
+        &options,
+        &mut NoObserver,
+    );
+    assert_eq!(report.status, autobal::integrate::Status::Finished);
+    // Exact solution of M ẍ + b ẋ + k x = M e ω² cos(ωt + ψ₀) from rest, per axis.
+    let exact = |k: f64, b: f64, phase: f64| {
+        let m = r.mass;
+        let f = r.mass * r.eccentricity * omega * omega;
+        let (dre, dim) = (k - m * omega * omega, b * omega);
+        let amp = f / dre.hypot(dim);
+        let lag = dim.atan2(dre);
+        let xp = |t: f64| amp * (omega * t + phase - lag).cos();
+        let vp = |t: f64| -amp * omega * (omega * t + phase - lag).sin();
+        let (wn, zeta) = ((k / m).sqrt(), b / (2.0 * (k * m).sqrt()));
+        let wd = wn * (1.0 - zeta * zeta).sqrt();
+        let a = -xp(0.0);
+        let bb = (-vp(0.0) + zeta * wn * a) / wd;
+        xp(t_end) + (-zeta * wn * t_end).exp() * (a * (wd * t_end).cos() + bb * (wd * t_end).sin())
+    };
+    let x = exact(r.kx, r.bx, r.unbalance_angle);
+    let y = exact(r.ky, r.by, r.unbalance_angle - PI / 2.0);
+    assert!((report.y[0] - x).abs() < 1e-8, "x {} vs {x}", report.y[0]);
+    assert!((report.y[1] - y).abs() < 1e-8, "y {} vs {y}", report.y[1]);
+}
+
+#[test]
+fn two_equal_cargoes_balance_at_the_textbook_angle() {
+    // Balanced main motion: cos ψ = −M e/(2 m l) relative to the unbalance.
+    let (m, l) = (0.01, 1.0);
+    let sim = simulation(rotor(), balls(2, m, 0.01), 4.0, &[80.0, 100.0]);
+    let result = sim.run(false).unwrap();
+    assert_eq!(
+        result.metrics.outcome,
+        Outcome::Settled,
+        "{}",
+        result.metrics.reason
+    );
+    let expected = (-(1.0 * 0.01) / (2.0 * m * l)).acos().to_degrees();
+    let mut got: Vec<f64> = result
+        .metrics
+        .final_rel_angles_deg
+        .iter()
+        .map(|a| wrap_deg(*a).abs())
+        .collect();
+    got.sort_by(f64::total_cmp);
+    for g in got {
+        assert!(
+            (g - expected).abs() < 0.5,
+            "cargo at ±{g}°, expected ±{expected}°"
+        );
+    }
+    assert!(result.metrics.balancing_error < 0.01);
+}
+
+#[test]
+fn supercritical_rotor_settles_and_subcritical_does_not() {
+    let start = [60.0, 120.0, 180.0];
+    let fast = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start)
+        .run(false)
+        .unwrap();
+    assert_eq!(
+        fast.metrics.outcome,
+        Outcome::Settled,
+        "{}",
+        fast.metrics.reason
+    );
+    assert!(fast.metrics.residual_rel < 0.05);
+
+    let slow = simulation(rotor(), balls(3, 0.01, 0.01), 0.7, &start)
+        .run(false)
+        .unwrap();
+    assert_eq!(
+        slow.metrics.outcome,
+        Outcome::NotSettled,
+        "{}",
+        slow.metrics.reason
+    );
+    // Below resonance the cargoes gather on the heavy side (the unbalance is
+    // at 0°; the phase lag of the rotor's response shifts them a few tens of degrees).
+    let angles: Vec<f64> = slow
+        .metrics
+        .final_rel_angles_deg
+        .iter()
+        .map(|a| wrap_deg(*a))
+        .collect();
+    for a in &angles {
+        assert!(
+            a.abs() < 60.0,
+            "cargo at {a}° should be on the heavy side: {angles:?}"
+        );
+        assert!(
+            (a - angles[0]).abs() < 5.0,
+            "cargoes gather together: {angles:?}"
+        );
+    }
+    assert!(
+        slow.metrics.balancing_error > 3.0,
+        "ε = {}",
+        slow.metrics.balancing_error
+    );
+}
+
+#[test]
+fn constant_speed_runs_are_identical_for_balls_rollers_and_pendulums_of_equal_kappa() {
+    // Seed 004, conclusion 2: at ω = const the rolling coupling drops out.
+    let g = Geometry {
+        race_radius: 1.0,
+        rho: 0.1,
+        density: 10.0,
+        roller_height: 0.0,
+        drag: 0.01,
+    };
+    let ball = cargoes(Kind::Ball, 3, &g).unwrap();
+    assert!(ball[0].rolling_coupling > 0.0);
+    let pendulum: Vec<Cargo> = ball
+        .iter()
+        .map(|c| Cargo::point(c.mass, c.track_radius, c.drag, c.kappa))
+        .collect();
+    let start = [30.0, 150.0, 200.0];
+    let a = simulation(rotor(), ball.clone(), 4.0, &start)
+        .run(true)
+        .unwrap();
+    let b = simulation(rotor(), pendulum.clone(), 4.0, &start)
+        .run(true)
+        .unwrap();
+    assert_eq!(a.metrics, b.metrics);
+    assert_eq!(a.series.unwrap().r, b.series.unwrap().r);
+
+    // Conclusion 1: at variable speed they differ.
+    let motor = SpeedLaw::Motor {
+        stall_torque: 2.0,
+        omega_sync: 4.0,
+        omega_start: 3.5,
+    };
+    let run = |cargo: Vec<Cargo>| {
+        let mut sim = simulation(rotor(), cargo, 4.0, &start);
+        sim.scene.speed = motor.clone();
+        sim.metrics.t_end_revs = 40.0;
+        sim.metrics.stop_when_settled = false;
+        sim.run(true).unwrap().series.unwrap()
+    };
+    let (sa, sb) = (run(ball), run(pendulum));
+    let diff =
+        sa.r.iter()
+            .zip(&sb.r)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+    assert!(
+        diff > 1e-6,
+        "ball and pendulum must differ at variable speed (max |Δr| = {diff:e})"
+    );
+}
+
+#[test]
+fn stiff_speed_controller_tends_to_constant_speed() {
+    let start = [30.0, 150.0, 200.0];
+    let constant = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start)
+        .run(false)
+        .unwrap();
+    let mut errors = Vec::new();
+    for stall in [50.0, 500.0] {
+        let mut sim = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start);
+        // Synchronous speed set so that the unloaded speed is exactly ω = 4.
+        sim.scene.speed = SpeedLaw::Motor {
+            stall_torque: stall,
+            omega_sync: 4.0,
+            omega_start: 4.0,
+        };
+        let run = sim.run(false).unwrap();
+        assert_eq!(run.metrics.outcome, Outcome::Settled);
+        let d =
+            (run.metrics.settling_time.unwrap() - constant.metrics.settling_time.unwrap()).abs();
+        errors.push(d);
+    }
+    assert!(errors[1] < errors[0] || errors[1] < 0.5, "{errors:?}");
+    assert!(
+        errors[1] < 2.0,
+        "stiff motor settles within 2 s of constant speed: {errors:?}"
+    );
+}
+
+#[test]
+fn tightening_the_tolerance_tenfold_does_not_change_the_result() {
+    let start = [60.0, 120.0, 180.0];
+    let base = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start);
+    let mut tight = base.clone();
+    tight.solver.rtol /= 10.0;
+    tight.solver.atol /= 10.0;
+    let (a, b) = (
+        base.run(false).unwrap().metrics,
+        tight.run(false).unwrap().metrics,
+    );
+    let ts = (a.settling_time.unwrap() - b.settling_time.unwrap()).abs();
+    assert!(ts <= 2.0 * a.settling_time_err, "t_s moved by {ts}");
+    for (x, y) in a.final_rel_angles_deg.iter().zip(&b.final_rel_angles_deg) {
+        assert!(wrap_deg(x - y).abs() < 0.1, "{x} vs {y}");
+    }
+}
+
+#[test]
+fn balanced_fan_cancels_the_unbalance() {
+    for n in 2..=8 {
+        let angles = balanced_fan(n, 0.01, 0.013, 0.4).unwrap();
+        let (sx, sy) = angles.iter().fold((0.0, 0.0), |(x, y), a| {
+            (x + 0.01 * a.cos(), y + 0.01 * a.sin())
+        });
+        assert!(
+            (sx + 0.013 * 0.4f64.cos()).abs() < 1e-12 && (sy + 0.013 * 0.4f64.sin()).abs() < 1e-12,
+            "n={n}"
+        );
+    }
+    assert!(
+        balanced_fan(3, 0.01, 0.031, 0.0).is_none(),
+        "beyond capacity"
+    );
+}
+
+#[test]
+fn vertical_axis_gravity_adds_no_term() {
+    let g = autobal::model::effect::gravity::Gravity {
+        g: 9.81,
+        axis_inclination_deg: 90.0,
+    };
+    let effects = Effects { gravity: Some(g) };
+    assert!(effects.build().is_empty());
+    let g = autobal::model::effect::gravity::Gravity {
+        g: 9.81,
+        axis_inclination_deg: 0.0,
+    };
+    assert_eq!(Effects { gravity: Some(g) }.build().len(), 1);
+    let system = Scene {
+        rotor: rotor(),
+        balancer: None,
+        cargo: balls(2, 0.01, 0.01),
+        speed: SpeedLaw::Constant { omega: 2.0 },
+        effects: Effects::default(),
+    }
+    .build()
+    .unwrap();
+    assert_eq!(system.dim(), 8);
+    assert!(system.effect_names().is_empty());
+}
