@@ -22,3 +22,4 @@ pub mod metrics;
 pub mod model;
 pub mod scene_file;
 pub mod simulation;
+pub mod study;

@@ -4,6 +4,7 @@
 
 mod design_cmd;
 mod output;
+mod run_cmd;
 mod simulate_cmd;
 
 use clap::{Parser, Subcommand};
@@ -25,14 +26,27 @@ enum Command {
     /// Simulate one scene and print settling time, residual vibration and more.
     #[command(after_help = simulate_cmd::EXAMPLES)]
     Simulate(simulate_cmd::SimulateArgs),
+    /// Run a Monte Carlo study: every design × sample, statistics, Parquet files.
+    #[command(after_help = run_cmd::RUN_EXAMPLES)]
+    Run(run_cmd::RunArgs),
+    /// Merge the outputs of `study run --shard k/N` into one study's files.
+    #[command(after_help = run_cmd::MERGE_EXAMPLES)]
+    Merge(run_cmd::MergeArgs),
 }
 
-/// An error the user caused (bad input): printed and mapped to exit code 2.
-pub struct UserError(pub String);
+/// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
+pub struct UserError(pub String, pub u8);
+
+impl UserError {
+    /// A failure that is not the user's fault (exit code 1).
+    pub fn internal(message: String) -> Self {
+        UserError(message, 1)
+    }
+}
 
 impl<E: std::fmt::Display> From<E> for UserError {
     fn from(e: E) -> Self {
-        UserError(e.to_string())
+        UserError(e.to_string(), 2)
     }
 }
 
@@ -41,12 +55,14 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
         Command::Simulate(args) => simulate_cmd::run(&args),
+        Command::Run(args) => run_cmd::run(&args),
+        Command::Merge(args) => run_cmd::merge_shards(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(UserError(message)) => {
+        Err(UserError(message, code)) => {
             eprintln!("error: {message}");
-            ExitCode::from(2)
+            ExitCode::from(code)
         }
     }
 }

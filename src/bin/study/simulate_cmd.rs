@@ -52,11 +52,14 @@ fn check_writable(path: &Path) -> Result<(), UserError> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     if !parent.is_dir() {
-        return Err(UserError(format!(
-            "--series {}: folder {} does not exist",
-            path.display(),
-            parent.display()
-        )));
+        return Err(UserError(
+            format!(
+                "--series {}: folder {} does not exist",
+                path.display(),
+                parent.display()
+            ),
+            2,
+        ));
     }
     Ok(())
 }

@@ -11,7 +11,9 @@ use serde::{Deserialize, Serialize};
 pub struct PlaneRotor {
     /// Rotor mass M (kg).
     pub mass: f64,
-    /// Eccentricity e of the rotor's centre of mass (m).
+    /// Eccentricity e of the rotor's centre of mass (m); in studies the
+    /// sampled unbalance sets it.
+    #[serde(default)]
     pub eccentricity: f64,
     /// Direction ψ₀ of the unbalance relative to the rotor at φ = 0 (rad).
     #[serde(default)]

@@ -1,0 +1,173 @@
+//! Per-design statistics of a study (`summary.parquet`), computed with polars.
+//!
+//! Settling statistics use the settled runs and are in revolutions; residual
+//! vibration uses every run that was simulated to the end (settled or not),
+//! i.e. the distribution over the sampled unbalances; diverged and failed runs
+//! are counted, not averaged.
+
+use super::config::StudyPlan;
+use super::record::{RunRecord, to_dataframe};
+use super::sample::{Purpose, stream};
+use polars::prelude::*;
+use rand::RngExt;
+
+/// Bootstrap resamples for the confidence interval of the mean settling time.
+pub const BOOTSTRAP_RESAMPLES: usize = 2000;
+
+/// Normal quantile for 95 % two-sided intervals.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// Wilson score interval (95 %) of a proportion `successes / trials`.
+pub fn wilson_interval(successes: u64, trials: u64) -> (f64, f64) {
+    if trials == 0 {
+        return (0.0, 1.0);
+    }
+    let n = trials as f64;
+    let p = successes as f64 / n;
+    let z2 = Z95 * Z95;
+    let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
+    let half = Z95 * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / (1.0 + z2 / n);
+    ((centre - half).max(0.0), (centre + half).min(1.0))
+}
+
+/// Percentile bootstrap 95 % interval of the mean of `values`, seeded per design.
+pub fn bootstrap_mean_ci(values: &[f64], seed: u64, design: u32) -> Option<(f64, f64)> {
+    if values.len() < 2 {
+        return None;
+    }
+    let mut rng = stream(seed, Some(design), 0, Purpose::Bootstrap);
+    let n = values.len();
+    let mut means: Vec<f64> = (0..BOOTSTRAP_RESAMPLES)
+        .map(|_| (0..n).map(|_| values[rng.random_range(0..n)]).sum::<f64>() / n as f64)
+        .collect();
+    means.sort_by(f64::total_cmp);
+    let at = |q: f64| means[((q * (BOOTSTRAP_RESAMPLES - 1) as f64).round()) as usize];
+    Some((at(0.025), at(0.975)))
+}
+
+/// Quantile of a column with linear interpolation (None when empty).
+fn quantile(ca: &Float64Chunked, q: f64) -> PolarsResult<Option<f64>> {
+    ca.quantile(q, QuantileMethod::Linear)
+}
+
+/// One row per design, in design order.
+pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame> {
+    let df = to_dataframe(runs)?;
+    let design_col = df.column("design_id")?.u32()?.clone();
+    let mut rows = SummaryColumns::default();
+    for design in &plan.designs {
+        let mine = df.filter(&design_col.equal(design.id))?;
+        let outcome = mine.column("outcome")?.str()?.clone();
+        let count = |name: &str| outcome.equal(name).sum().unwrap_or(0) as u64;
+        let settled_mask = mine.column("settled")?.bool()?.clone();
+        let settled = mine.filter(&settled_mask)?;
+        let ts = settled.column("settling_revs")?.f64()?.clone();
+        let simulated = mine.filter(&(outcome.equal("settled") | outcome.equal("not_settled")))?;
+        let residual = simulated.column("residual_rel")?.f64()?.clone();
+        let runs_n = mine.height() as u64;
+        let settled_n = settled.height() as u64;
+        let (lo, hi) = wilson_interval(settled_n, runs_n);
+        let ts_values: Vec<f64> = ts.into_no_null_iter().collect();
+        let ci = bootstrap_mean_ci(&ts_values, plan.file.seed, design.id);
+
+        rows.design_id.push(design.id);
+        rows.kind.push(design.spec.kind.name().to_string());
+        rows.n.push(design.spec.n);
+        rows.rho.push(design.rho);
+        rows.drag.push(design.spec.drag);
+        rows.capacity.push(design.capacity);
+        rows.runs.push(runs_n);
+        rows.settled.push(settled_n);
+        rows.settled_fraction.push(if runs_n == 0 {
+            0.0
+        } else {
+            settled_n as f64 / runs_n as f64
+        });
+        rows.settled_lo.push(lo);
+        rows.settled_hi.push(hi);
+        rows.ts_mean.push(ts.mean());
+        rows.ts_std.push(ts.std(1));
+        rows.ts_median.push(ts.median());
+        rows.ts_p10.push(quantile(&ts, 0.10)?);
+        rows.ts_p90.push(quantile(&ts, 0.90)?);
+        rows.ts_p95.push(quantile(&ts, 0.95)?);
+        rows.ts_max.push(ts.max());
+        rows.ts_ci_lo.push(ci.map(|c| c.0));
+        rows.ts_ci_hi.push(ci.map(|c| c.1));
+        rows.res_mean.push(residual.mean());
+        rows.res_median.push(residual.median());
+        rows.res_p95.push(quantile(&residual, 0.95)?);
+        rows.not_settled.push(count("not_settled"));
+        rows.diverged.push(count("diverged"));
+        rows.solver_failed.push(count("solver_failed"));
+    }
+    rows.into_dataframe()
+}
+
+/// Column buffers of the summary table.
+#[derive(Default)]
+struct SummaryColumns {
+    design_id: Vec<u32>,
+    kind: Vec<String>,
+    n: Vec<u32>,
+    rho: Vec<f64>,
+    drag: Vec<f64>,
+    capacity: Vec<f64>,
+    runs: Vec<u64>,
+    settled: Vec<u64>,
+    settled_fraction: Vec<f64>,
+    settled_lo: Vec<f64>,
+    settled_hi: Vec<f64>,
+    ts_mean: Vec<Option<f64>>,
+    ts_std: Vec<Option<f64>>,
+    ts_median: Vec<Option<f64>>,
+    ts_p10: Vec<Option<f64>>,
+    ts_p90: Vec<Option<f64>>,
+    ts_p95: Vec<Option<f64>>,
+    ts_max: Vec<Option<f64>>,
+    ts_ci_lo: Vec<Option<f64>>,
+    ts_ci_hi: Vec<Option<f64>>,
+    res_mean: Vec<Option<f64>>,
+    res_median: Vec<Option<f64>>,
+    res_p95: Vec<Option<f64>>,
+    not_settled: Vec<u64>,
+    diverged: Vec<u64>,
+    solver_failed: Vec<u64>,
+}
+
+impl SummaryColumns {
+    fn into_dataframe(self) -> PolarsResult<DataFrame> {
+        let height = self.design_id.len();
+        DataFrame::new(
+            height,
+            vec![
+                Column::new("design_id".into(), self.design_id),
+                Column::new("kind".into(), self.kind),
+                Column::new("n".into(), self.n),
+                Column::new("rho".into(), self.rho),
+                Column::new("drag".into(), self.drag),
+                Column::new("capacity".into(), self.capacity),
+                Column::new("runs".into(), self.runs),
+                Column::new("settled".into(), self.settled),
+                Column::new("settled_fraction".into(), self.settled_fraction),
+                Column::new("settled_fraction_lo".into(), self.settled_lo),
+                Column::new("settled_fraction_hi".into(), self.settled_hi),
+                Column::new("settling_revs_mean".into(), self.ts_mean),
+                Column::new("settling_revs_std".into(), self.ts_std),
+                Column::new("settling_revs_median".into(), self.ts_median),
+                Column::new("settling_revs_p10".into(), self.ts_p10),
+                Column::new("settling_revs_p90".into(), self.ts_p90),
+                Column::new("settling_revs_p95".into(), self.ts_p95),
+                Column::new("settling_revs_max".into(), self.ts_max),
+                Column::new("settling_revs_mean_ci_lo".into(), self.ts_ci_lo),
+                Column::new("settling_revs_mean_ci_hi".into(), self.ts_ci_hi),
+                Column::new("residual_rel_mean".into(), self.res_mean),
+                Column::new("residual_rel_median".into(), self.res_median),
+                Column::new("residual_rel_p95".into(), self.res_p95),
+                Column::new("not_settled".into(), self.not_settled),
+                Column::new("diverged".into(), self.diverged),
+                Column::new("solver_failed".into(), self.solver_failed),
+            ],
+        )
+    }
+}

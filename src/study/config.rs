@@ -1,0 +1,596 @@
+//! The study file: scene template, design grid, sampling, solver, metrics,
+//! output and seed (TOML, every key documented in `docs/study-file.md`).
+//!
+//! Parsing rejects unknown keys and wrong types with the line and column of
+//! the problem; [`StudyFile::plan`] then checks every value against its domain
+//! and resolves the design grid, so that a study either starts with a fully
+//! valid plan or fails before anything is written.
+
+use crate::design::geometry::check_fits;
+use crate::metrics::MetricOptions;
+use crate::model::balancer::Kind;
+use crate::model::effect::Effects;
+use crate::model::rotor::PlaneRotor;
+use crate::model::scene::{DesignSpec, RhoChoice, Scene, SceneError};
+use crate::model::speed::SpeedLaw;
+use crate::model::start::StartMode;
+use crate::simulation::SolverSettings;
+use serde::{Deserialize, Serialize};
+
+/// Seed used when a study file gives none (documented in `docs/study-file.md`).
+pub const DEFAULT_SEED: u64 = 20_261_122;
+
+/// A study file as written by the user.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudyFile {
+    /// Name of the output folder under `output`; defaults to the file's stem.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Master seed of every random stream in the study.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Root folder of the outputs.
+    #[serde(default = "default_output")]
+    pub output: String,
+    /// The physics shared by every run.
+    pub scene: SceneTemplate,
+    /// The designs to compare (a Cartesian grid).
+    pub designs: DesignGrid,
+    /// What is sampled for each design.
+    pub sampling: Sampling,
+    /// Integrator settings.
+    #[serde(default)]
+    pub solver: SolverSettings,
+    /// Metric definitions.
+    #[serde(default)]
+    pub metrics: MetricOptions,
+}
+
+fn default_seed() -> u64 {
+    DEFAULT_SEED
+}
+
+fn default_output() -> String {
+    "results".into()
+}
+
+/// The rotor, speed law, effects and start mode shared by every run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneTemplate {
+    /// Rotor and supports; `eccentricity` is set per run from the sampled unbalance.
+    pub rotor: PlaneRotor,
+    /// Speed law.
+    pub speed: SpeedLaw,
+    /// Optional effects.
+    #[serde(default)]
+    pub effects: Effects,
+    /// How each run starts.
+    #[serde(default)]
+    pub start: StartMode,
+}
+
+/// A one-or-many value in the design grid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum OneOrMany<T> {
+    /// A single value.
+    One(T),
+    /// A list of values.
+    Many(Vec<T>),
+}
+
+impl<T: Clone> OneOrMany<T> {
+    /// The values as a list.
+    pub fn values(&self) -> Vec<T> {
+        match self {
+            OneOrMany::One(v) => vec![v.clone()],
+            OneOrMany::Many(v) => v.clone(),
+        }
+    }
+}
+
+/// The design grid: every combination of kind × n × ρ × drag.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignGrid {
+    /// Balancer kinds: "ball", "roller", "pendulum".
+    pub kind: OneOrMany<Kind>,
+    /// Weight counts.
+    pub n: OneOrMany<u32>,
+    /// Radius ratios: numbers, "optimal" (Table 1) or "half_race".
+    pub rho: OneOrMany<RhoChoice>,
+    /// Race radius R (m).
+    pub race_radius: f64,
+    /// Weight density γ (kg/m³).
+    #[serde(default = "steel")]
+    pub density: f64,
+    /// Roller height h (m), required when rollers are in the grid.
+    #[serde(default)]
+    pub roller_height: f64,
+    /// Viscous coefficients β (N·s/m).
+    pub drag: OneOrMany<f64>,
+}
+
+fn steel() -> f64 {
+    7850.0
+}
+
+/// What is drawn for each run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sampling {
+    /// Runs per design.
+    pub samples: u32,
+    /// Unbalance magnitude.
+    pub unbalance: UnbalanceSpec,
+    /// Unbalance direction relative to the rotor.
+    #[serde(default)]
+    pub direction: DirectionSpec,
+    /// Initial cargo positions relative to the rotor.
+    #[serde(default)]
+    pub initial: InitialSpec,
+    /// Reject (true) or only flag (false) absolute unbalances above a design's capacity.
+    #[serde(default = "yes")]
+    pub require_balanceable: bool,
+    /// Draw unbalances, directions and initial positions from streams shared
+    /// by every design (common random numbers), so design differences are not noise.
+    #[serde(default = "yes")]
+    pub common_random_numbers: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Unbalance magnitude U = M e: a distribution, absolute (kg·m) or as a
+/// fraction of each design's balancing capacity.
+// No deny_unknown_fields here: serde cannot combine it with `flatten`; the
+// flattened distribution rejects unknown keys itself.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UnbalanceSpec {
+    /// The distribution.
+    #[serde(flatten)]
+    pub distribution: Distribution,
+    /// "capacity" (fraction of each design's capacity) or "absolute" (kg·m).
+    #[serde(default)]
+    pub relative_to: Scale,
+}
+
+/// Scale of sampled unbalances.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Scale {
+    /// A fraction of the design's capacity.
+    #[default]
+    Capacity,
+    /// kg·m.
+    Absolute,
+}
+
+/// A distribution of a positive quantity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "distribution", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Distribution {
+    /// Always the same value.
+    Fixed {
+        /// The value.
+        value: f64,
+    },
+    /// Uniform on [min, max].
+    Uniform {
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+    /// Log-uniform on [min, max] (min > 0).
+    LogUniform {
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+    /// Normal(mean, std) truncated to [min, max] (rejection sampling).
+    NormalTruncated {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation.
+        std: f64,
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+}
+
+impl Distribution {
+    /// Largest value the distribution can produce.
+    pub fn upper(&self) -> f64 {
+        match *self {
+            Distribution::Fixed { value } => value,
+            Distribution::Uniform { max, .. }
+            | Distribution::LogUniform { max, .. }
+            | Distribution::NormalTruncated { max, .. } => max,
+        }
+    }
+}
+
+/// Unbalance direction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum DirectionSpec {
+    /// Uniform on [0, 2π).
+    #[default]
+    Uniform,
+    /// A fixed angle (degrees).
+    Fixed(f64),
+}
+
+/// Initial cargo positions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum InitialSpec {
+    /// Pressed together (touching) around a uniformly random direction.
+    #[default]
+    Clustered,
+    /// Uniformly random positions without overlap (weights of radius r cannot
+    /// come closer than 2α).
+    Uniform,
+    /// Evenly spaced (a regular polygon).
+    Even,
+    /// Balanced for an unbalance of the same magnitude turned by this many
+    /// degrees (the `step` start: e.g. 90 for the paper's Fig. 1 argument).
+    BalancedForShift(f64),
+}
+
+/// One resolved design of the grid.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Design {
+    /// Index in grid order.
+    pub id: u32,
+    /// The balancer.
+    pub spec: DesignSpec,
+    /// Resolved ρ.
+    pub rho: f64,
+    /// Mass of one weight (kg).
+    pub weight_mass: f64,
+    /// Track radius l = R − r (m).
+    pub track_radius: f64,
+    /// Balancing capacity (kg·m): S_AB of seed 000 for balls and rollers
+    /// (weights pressed together), n m l for pendulums (they can pass each other).
+    pub capacity: f64,
+}
+
+/// A validated study: the file plus its resolved designs.
+#[derive(Debug, Clone)]
+pub struct StudyPlan {
+    /// The study name (output folder).
+    pub name: String,
+    /// The parsed file.
+    pub file: StudyFile,
+    /// The resolved designs in grid order.
+    pub designs: Vec<Design>,
+    /// The study file's text, kept for provenance and resume checks.
+    pub text: String,
+}
+
+impl StudyPlan {
+    /// Total number of runs (designs × samples).
+    pub fn total_runs(&self) -> u64 {
+        self.designs.len() as u64 * u64::from(self.file.sampling.samples)
+    }
+
+    /// The scene of one design with rotor unbalance (U, direction) applied.
+    pub fn scene(&self, design: &Design, unbalance: f64, direction: f64) -> Scene {
+        let t = &self.file.scene;
+        let mut rotor = t.rotor.clone();
+        rotor.eccentricity = unbalance / rotor.mass;
+        rotor.unbalance_angle = direction;
+        Scene {
+            rotor,
+            balancer: Some(design.spec.clone()),
+            cargo: Vec::new(),
+            speed: t.speed.clone(),
+            effects: t.effects.clone(),
+        }
+    }
+}
+
+/// A study file that cannot be used, naming the key and the reason.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// TOML syntax or schema error (with line and column).
+    #[error("{path}: {message}")]
+    Parse {
+        /// The path.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value outside its domain.
+    #[error("{path}: {key} = {value}: {reason}")]
+    Invalid {
+        /// The path.
+        path: String,
+        /// Dotted key.
+        key: String,
+        /// Offending value.
+        value: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+impl StudyFile {
+    /// Parse TOML text (`path` is used in messages only).
+    pub fn parse(text: &str, path: &str) -> Result<Self, StudyError> {
+        toml::from_str(text).map_err(|e| StudyError::Parse {
+            path: path.to_string(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Validate every value and resolve the design grid.
+    pub fn plan(self, text: &str, path: &str) -> Result<StudyPlan, StudyError> {
+        let invalid = |key: &str, value: String, reason: &str| StudyError::Invalid {
+            path: path.to_string(),
+            key: key.to_string(),
+            value,
+            reason: reason.to_string(),
+        };
+        let name = match &self.name {
+            Some(n) => n.clone(),
+            None => std::path::Path::new(path)
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("study")
+                .to_string(),
+        };
+        if name.is_empty() || name.contains(['/', '\\']) || name == ".." || name == "." {
+            return Err(invalid(
+                "name",
+                format!("{name:?}"),
+                "must be a plain folder name",
+            ));
+        }
+        let s = &self.sampling;
+        if s.samples == 0 {
+            return Err(invalid(
+                "sampling.samples",
+                "0".into(),
+                "need at least one sample per design",
+            ));
+        }
+        check_distribution(&s.unbalance.distribution)
+            .map_err(|(k, v, r)| invalid(&format!("sampling.unbalance.{k}"), v, r))?;
+        if let DirectionSpec::Fixed(d) = s.direction {
+            if !d.is_finite() {
+                return Err(invalid(
+                    "sampling.direction.fixed",
+                    d.to_string(),
+                    "must be finite",
+                ));
+            }
+        }
+        if let InitialSpec::BalancedForShift(d) = s.initial {
+            if !d.is_finite() {
+                return Err(invalid(
+                    "sampling.initial.balanced_for_shift",
+                    d.to_string(),
+                    "must be finite",
+                ));
+            }
+        }
+        for (key, value) in [
+            ("solver.rtol", self.solver.rtol),
+            ("solver.atol", self.solver.atol),
+            ("metrics.delta", self.metrics.delta),
+            ("metrics.hold_revs", self.metrics.hold_revs),
+            ("metrics.t_end_revs", self.metrics.t_end_revs),
+            ("metrics.divergence_factor", self.metrics.divergence_factor),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid(
+                    key,
+                    value.to_string(),
+                    "must be positive and finite",
+                ));
+            }
+        }
+        if self.solver.max_steps == 0 {
+            return Err(invalid("solver.max_steps", "0".into(), "must be positive"));
+        }
+        let designs = self
+            .resolve_designs()
+            .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+        if s.unbalance.relative_to == Scale::Absolute && s.require_balanceable {
+            let upper = s.unbalance.distribution.upper();
+            if let Some(d) = designs.iter().find(|d| d.capacity < upper) {
+                return Err(invalid(
+                    "sampling.unbalance.max",
+                    upper.to_string(),
+                    &format!(
+                        "exceeds the capacity {:.4e} kg·m of design {} ({} n = {} ρ = {:.4}); lower it or set require_balanceable = false",
+                        d.capacity, d.id, d.spec.kind, d.spec.n, d.rho
+                    ),
+                ));
+            }
+        }
+        Ok(StudyPlan {
+            name,
+            file: self,
+            designs,
+            text: text.to_string(),
+        })
+    }
+
+    fn resolve_designs(&self) -> Result<Vec<Design>, (String, String, String)> {
+        let g = &self.designs;
+        let scene = Scene {
+            rotor: PlaneRotor {
+                eccentricity: 0.0,
+                ..self.scene.rotor.clone()
+            },
+            balancer: None,
+            cargo: Vec::new(),
+            speed: self.scene.speed.clone(),
+            effects: self.scene.effects.clone(),
+        };
+        let mut designs = Vec::new();
+        let (kinds, ns, rhos, drags) = (
+            g.kind.values(),
+            g.n.values(),
+            g.rho.values(),
+            g.drag.values(),
+        );
+        for (key, empty) in [
+            ("designs.kind", kinds.is_empty()),
+            ("designs.n", ns.is_empty()),
+            ("designs.rho", rhos.is_empty()),
+            ("designs.drag", drags.is_empty()),
+        ] {
+            if empty {
+                return Err((key.into(), "[]".into(), "needs at least one value".into()));
+            }
+        }
+        for kind in &kinds {
+            for &n in &ns {
+                for rho in &rhos {
+                    for &drag in &drags {
+                        let spec = DesignSpec {
+                            kind: *kind,
+                            n,
+                            rho: rho.clone(),
+                            race_radius: g.race_radius,
+                            density: g.density,
+                            roller_height: g.roller_height,
+                            drag,
+                        };
+                        let mut s = scene.clone();
+                        s.balancer = Some(spec.clone());
+                        s.validate().map_err(|e| scene_error_key(e, *kind, n))?;
+                        let geometry = spec.geometry().map_err(|e| {
+                            ("designs.rho".to_string(), format!("{rho:?}"), e.to_string())
+                        })?;
+                        check_fits(n, geometry.rho).map_err(|e| {
+                            (
+                                "designs.rho".to_string(),
+                                geometry.rho.to_string(),
+                                e.to_string(),
+                            )
+                        })?;
+                        let cargo = kind.model().cargo(&geometry).map_err(|e| {
+                            ("designs".to_string(), kind.to_string(), e.to_string())
+                        })?;
+                        let capacity = match kind {
+                            Kind::Pendulum => f64::from(n) * cargo.unbalance(),
+                            _ => crate::design::capacity::capacity_from_mass(
+                                n,
+                                geometry.rho,
+                                cargo.mass,
+                                g.race_radius,
+                            )
+                            .map_err(|e| {
+                                ("designs".to_string(), kind.to_string(), e.to_string())
+                            })?,
+                        };
+                        designs.push(Design {
+                            id: designs.len() as u32,
+                            spec,
+                            rho: geometry.rho,
+                            weight_mass: cargo.mass,
+                            track_radius: cargo.track_radius,
+                            capacity,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(designs)
+    }
+}
+
+/// Map a scene validation error onto the study file's keys.
+fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String) {
+    match e {
+        SceneError::Invalid {
+            field,
+            value,
+            reason,
+        } => {
+            let key = if let Some(rest) = field.strip_prefix("balancer.") {
+                format!("designs.{rest}")
+            } else {
+                format!("scene.{field}")
+            };
+            (key, value, reason)
+        }
+        SceneError::Design(d) => ("designs".into(), format!("{kind} n = {n}"), d.to_string()),
+    }
+}
+
+fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static str)> {
+    let pos = |k: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err((k.to_string(), v.to_string(), "must be positive and finite"))
+        }
+    };
+    match *d {
+        Distribution::Fixed { value } => pos("value", value),
+        Distribution::Uniform { min, max } | Distribution::LogUniform { min, max } => {
+            pos("min", min)?;
+            pos("max", max)?;
+            if max < min {
+                return Err(("max".into(), max.to_string(), "must not be below min"));
+            }
+            Ok(())
+        }
+        Distribution::NormalTruncated {
+            mean,
+            std,
+            min,
+            max,
+        } => {
+            pos("std", std)?;
+            pos("min", min)?;
+            pos("max", max)?;
+            if max < min {
+                return Err(("max".into(), max.to_string(), "must not be below min"));
+            }
+            if !mean.is_finite() {
+                return Err(("mean".into(), mean.to_string(), "must be finite"));
+            }
+            // Rejection sampling needs a reasonable acceptance rate.
+            if (min - mean) / std > 5.0 || (mean - max) / std > 5.0 {
+                return Err((
+                    "mean".into(),
+                    mean.to_string(),
+                    "lies more than 5 std outside [min, max]",
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Read, parse and validate a study file.
+pub fn load(path: &std::path::Path) -> Result<StudyPlan, StudyError> {
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+        path: shown.clone(),
+        source,
+    })?;
+    StudyFile::parse(&text, &shown)?.plan(&text, &shown)
+}

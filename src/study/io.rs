@@ -1,0 +1,117 @@
+//! Parquet files with provenance, written atomically (temporary file + rename)
+//! so that an interrupted run never leaves a half-written file behind.
+
+use polars::prelude::*;
+use sha2::{Digest, Sha256};
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// Provenance stored in every Parquet file's key-value metadata.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Provenance {
+    /// autobal's version.
+    pub version: String,
+    /// Git commit of the autobal source tree, when it can be found.
+    pub git_commit: String,
+    /// The study file's text.
+    pub study_text: String,
+    /// SHA-256 of the study file's text.
+    pub study_sha256: String,
+    /// The master seed.
+    pub seed: u64,
+    /// Which part of the study the file holds ("all" or "k/N").
+    pub shard: String,
+}
+
+impl Provenance {
+    /// Provenance for a study text, seed and shard label.
+    pub fn new(study_text: &str, seed: u64, shard: &str) -> Self {
+        Provenance {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            git_commit: git_commit(),
+            study_text: study_text.to_string(),
+            study_sha256: sha256_hex(study_text),
+            seed,
+            shard: shard.to_string(),
+        }
+    }
+
+    fn pairs(&self) -> Vec<(String, String)> {
+        vec![
+            ("autobal_version".into(), self.version.clone()),
+            ("git_commit".into(), self.git_commit.clone()),
+            ("study_sha256".into(), self.study_sha256.clone()),
+            ("seed".into(), self.seed.to_string()),
+            ("shard".into(), self.shard.clone()),
+            ("study_toml".into(), self.study_text.clone()),
+        ]
+    }
+}
+
+/// Hex SHA-256 of a text.
+pub fn sha256_hex(text: &str) -> String {
+    Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// The commit of the source tree autobal was built from, or "unknown".
+fn git_commit() -> String {
+    std::process::Command::new("git")
+        .args(["-C", env!("CARGO_MANIFEST_DIR"), "rev-parse", "HEAD"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// Temporary sibling path used while writing `path`.
+fn temp_path(path: &Path) -> PathBuf {
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    name.push(format!(".tmp-{}", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Write `df` to `path` atomically, with provenance in the key-value metadata.
+pub fn write_parquet(path: &Path, df: &mut DataFrame, provenance: &Provenance) -> PolarsResult<()> {
+    let tmp = temp_path(path);
+    let file = File::create(&tmp)?;
+    ParquetWriter::new(file)
+        .with_key_value_metadata(Some(KeyValueMetadata::from_static(provenance.pairs())))
+        .finish(df)?;
+    std::fs::rename(&tmp, path)?;
+    Ok(())
+}
+
+/// Read a Parquet file written by [`write_parquet`].
+pub fn read_parquet(path: &Path) -> PolarsResult<DataFrame> {
+    ParquetReader::new(File::open(path)?).finish()
+}
+
+/// Read the key-value metadata of a Parquet file as (key, value) pairs.
+pub fn read_metadata(path: &Path) -> PolarsResult<Vec<(String, String)>> {
+    let mut reader = ParquetReader::new(File::open(path)?);
+    let meta = reader.get_metadata()?;
+    Ok(meta
+        .key_value_metadata()
+        .as_ref()
+        .map(|kv| {
+            kv.iter()
+                .map(|p| (p.key.clone(), p.value.clone().unwrap_or_default()))
+                .collect()
+        })
+        .unwrap_or_default())
+}
+
+/// Write a text file atomically.
+pub fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
+    let tmp = temp_path(path);
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}

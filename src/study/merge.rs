@@ -1,0 +1,118 @@
+//! `study merge`: combine shard outputs into exactly what one unsharded run writes.
+
+use super::aggregate::summarize;
+use super::config::StudyPlan;
+use super::io::{Provenance, read_metadata, read_parquet, write_parquet};
+use super::record::{RunRecord, from_dataframe, to_dataframe};
+use super::run::{RunError, StudyOutput};
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+/// Why shard outputs cannot be merged.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// A shard folder has no finished `runs.parquet`.
+    #[error("{0}: no runs.parquet (is the shard finished?)")]
+    Missing(String),
+    /// Shards come from different study files.
+    #[error("{0}: comes from a different study file than {1}")]
+    DifferentStudy(String, String),
+    /// Two shards hold the same run.
+    #[error("run {0} appears in more than one shard")]
+    Duplicate(u64),
+    /// Runs are missing from the union of the shards.
+    #[error("{missing} of {total} runs are missing (first: run {first}); merge every shard")]
+    Incomplete {
+        /// Count of missing runs.
+        missing: u64,
+        /// Expected total.
+        total: u64,
+        /// First missing run index.
+        first: u64,
+    },
+    /// The study text stored in the shards cannot be parsed.
+    #[error("study stored in {0} is invalid: {1}")]
+    BadStudy(String, String),
+    /// Reading or writing failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+}
+
+impl From<polars::prelude::PolarsError> for MergeError {
+    fn from(e: polars::prelude::PolarsError) -> Self {
+        MergeError::Run(RunError::Polars(e))
+    }
+}
+
+/// Merge shard folders; the result goes to `out` (default: the shards' parent folder).
+pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<StudyOutput, MergeError> {
+    let mut runs: Vec<RunRecord> = Vec::new();
+    let mut study: Option<(String, String)> = None;
+    for dir in dirs {
+        let path = dir.join("runs.parquet");
+        if !path.exists() {
+            return Err(MergeError::Missing(dir.display().to_string()));
+        }
+        let meta = read_metadata(&path)?;
+        let text = meta
+            .iter()
+            .find(|(k, _)| k == "study_toml")
+            .map(|(_, v)| v.clone())
+            .unwrap_or_default();
+        match &study {
+            None => study = Some((text, dir.display().to_string())),
+            Some((first, first_dir)) if *first != text => {
+                return Err(MergeError::DifferentStudy(
+                    dir.display().to_string(),
+                    first_dir.clone(),
+                ));
+            }
+            Some(_) => {}
+        }
+        runs.extend(from_dataframe(&read_parquet(&path)?)?);
+    }
+    let (text, first_dir) =
+        study.ok_or_else(|| MergeError::Missing("(no shard folders given)".into()))?;
+    let plan: StudyPlan = super::config::StudyFile::parse(&text, &first_dir)
+        .and_then(|f| f.plan(&text, &first_dir))
+        .map_err(|e| MergeError::BadStudy(first_dir.clone(), e.to_string()))?;
+    let mut seen = HashSet::new();
+    for r in &runs {
+        if !seen.insert(r.run_id) {
+            return Err(MergeError::Duplicate(r.run_id));
+        }
+    }
+    let total = plan.total_runs();
+    if let Some(first) = (0..total).find(|id| !seen.contains(id)) {
+        let missing = (0..total).filter(|id| !seen.contains(id)).count() as u64;
+        return Err(MergeError::Incomplete {
+            missing,
+            total,
+            first,
+        });
+    }
+    runs.sort_by_key(|r| r.run_id);
+    let dir = match out {
+        Some(o) => o.to_path_buf(),
+        None => dirs[0]
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from(".")),
+    };
+    std::fs::create_dir_all(&dir).map_err(|source| RunError::NotWritable {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
+    let mut df = to_dataframe(&runs)?;
+    write_parquet(&dir.join("runs.parquet"), &mut df, &provenance)?;
+    let mut summary = summarize(&plan, &runs)?;
+    write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
+    super::io::write_text(&dir.join("study.toml"), &plan.text).map_err(RunError::Io)?;
+    Ok(StudyOutput {
+        dir,
+        runs,
+        summary: Some(summary),
+        executed: 0,
+    })
+}

@@ -1,0 +1,18 @@
+//! The study runner: TOML studies → Monte Carlo on all cores → polars
+//! statistics → Parquet.
+//!
+//! - [`config`]: the study file schema, validation and the resolved plan.
+//! - [`sample`]: per-run random streams and draws.
+//! - [`run`]: the executor (rayon, chunked writes, resume, shards).
+//! - [`record`]: one row of `runs.parquet`.
+//! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`merge`]: combining shard outputs.
+//! - [`io`]: Parquet with provenance, atomic writes.
+
+pub mod aggregate;
+pub mod config;
+pub mod io;
+pub mod merge;
+pub mod record;
+pub mod run;
+pub mod sample;

@@ -1,0 +1,256 @@
+//! One row of `runs.parquet`: the design, the sample, every metric, the
+//! outcome and the solver's cost; and its conversion to and from polars.
+
+use crate::metrics::{Outcome, RunMetrics};
+use polars::prelude::*;
+
+/// Everything recorded about one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunRecord {
+    /// Global run index: design_id × samples + sample_id.
+    pub run_id: u64,
+    /// Design index in grid order.
+    pub design_id: u32,
+    /// Sample index within the design.
+    pub sample_id: u32,
+    /// Balancer kind.
+    pub kind: String,
+    /// Number of weights.
+    pub n: u32,
+    /// Radius ratio ρ.
+    pub rho: f64,
+    /// Race radius R (m).
+    pub race_radius: f64,
+    /// Mass of one weight (kg).
+    pub weight_mass: f64,
+    /// Design capacity (kg·m).
+    pub capacity: f64,
+    /// Drag coefficient β (N·s/m).
+    pub drag: f64,
+    /// Sampled unbalance U (kg·m).
+    pub unbalance: f64,
+    /// U / capacity.
+    pub unbalance_fraction: f64,
+    /// Unbalance direction (degrees).
+    pub direction_deg: f64,
+    /// Initial cargo angles relative to the rotor (degrees).
+    pub initial_angles_deg: Vec<f64>,
+    /// The run's metrics.
+    pub metrics: RunMetrics,
+    /// Integrator used.
+    pub method: String,
+    /// Wall-clock time of the run (s); excluded from determinism checks.
+    pub wall_time_s: f64,
+}
+
+fn list_column(name: &str, rows: impl Iterator<Item = Vec<f64>>) -> Column {
+    let series: Vec<Series> = rows.map(|v| Series::new(PlSmallStr::EMPTY, v)).collect();
+    Column::new(name.into(), series)
+}
+
+/// Records as a DataFrame with one column per field (in the documented order).
+pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
+    macro_rules! col {
+        ($name:expr, $f:expr) => {
+            Column::new($name.into(), rows.iter().map($f).collect::<Vec<_>>())
+        };
+    }
+    let columns = vec![
+        col!("run_id", |r: &RunRecord| r.run_id),
+        col!("design_id", |r: &RunRecord| r.design_id),
+        col!("sample_id", |r: &RunRecord| r.sample_id),
+        col!("kind", |r: &RunRecord| r.kind.clone()),
+        col!("n", |r: &RunRecord| r.n),
+        col!("rho", |r: &RunRecord| r.rho),
+        col!("race_radius", |r: &RunRecord| r.race_radius),
+        col!("weight_mass", |r: &RunRecord| r.weight_mass),
+        col!("capacity", |r: &RunRecord| r.capacity),
+        col!("drag", |r: &RunRecord| r.drag),
+        col!("unbalance", |r: &RunRecord| r.unbalance),
+        col!("unbalance_fraction", |r: &RunRecord| r.unbalance_fraction),
+        col!("direction_deg", |r: &RunRecord| r.direction_deg),
+        list_column(
+            "initial_angles_deg",
+            rows.iter().map(|r| r.initial_angles_deg.clone()),
+        ),
+        col!("settled", |r: &RunRecord| r.metrics.settled),
+        col!("settling_time", |r: &RunRecord| r.metrics.settling_time),
+        col!("settling_revs", |r: &RunRecord| r.metrics.settling_revs),
+        col!("settling_time_err", |r: &RunRecord| r
+            .metrics
+            .settling_time_err),
+        col!("settling_time_eps", |r: &RunRecord| r
+            .metrics
+            .settling_time_eps),
+        col!("hold_complete", |r: &RunRecord| r.metrics.hold_complete),
+        col!("residual_abs", |r: &RunRecord| r.metrics.residual_abs),
+        col!("residual_rel", |r: &RunRecord| r.metrics.residual_rel),
+        col!("a_ref", |r: &RunRecord| r.metrics.a_ref),
+        col!("balancing_error", |r: &RunRecord| r.metrics.balancing_error),
+        col!("peak_r", |r: &RunRecord| r.metrics.peak_r),
+        list_column(
+            "final_rel_angles_deg",
+            rows.iter().map(|r| r.metrics.final_rel_angles_deg.clone()),
+        ),
+        col!("p_final", |r: &RunRecord| r.metrics.p_final),
+        col!("outcome", |r: &RunRecord| r
+            .metrics
+            .outcome
+            .name()
+            .to_string()),
+        col!("reason", |r: &RunRecord| r.metrics.reason.clone()),
+        col!("t_final", |r: &RunRecord| r.metrics.t_final),
+        col!("steps", |r: &RunRecord| r.metrics.steps),
+        col!("rhs_calls", |r: &RunRecord| r.metrics.rhs_calls),
+        col!("method", |r: &RunRecord| r.method.clone()),
+        col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
+    ];
+    DataFrame::new(rows.len(), columns)
+}
+
+/// Column names that hold nothing machine- or schedule-dependent (all but wall time).
+pub fn deterministic_columns(df: &DataFrame) -> Vec<String> {
+    df.get_column_names()
+        .into_iter()
+        .filter(|c| c.as_str() != "wall_time_s")
+        .map(|c| c.to_string())
+        .collect()
+}
+
+fn outcome_from(name: &str) -> PolarsResult<Outcome> {
+    Ok(match name {
+        "settled" => Outcome::Settled,
+        "not_settled" => Outcome::NotSettled,
+        "diverged" => Outcome::Diverged,
+        "solver_failed" => Outcome::SolverFailed,
+        other => polars_bail!(ComputeError: "unknown outcome '{other}' in runs file"),
+    })
+}
+
+/// Read records back from a DataFrame written by [`to_dataframe`].
+pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
+    let f64s = |name: &str| -> PolarsResult<Vec<Option<f64>>> {
+        Ok(df.column(name)?.f64()?.iter().collect())
+    };
+    let req = |name: &str| -> PolarsResult<Vec<f64>> {
+        f64s(name)?
+            .into_iter()
+            .map(|v| v.ok_or_else(|| polars_err!(ComputeError: "null in column {name}")))
+            .collect()
+    };
+    let u64s = |name: &str| -> PolarsResult<Vec<u64>> {
+        Ok(df.column(name)?.u64()?.into_no_null_iter().collect())
+    };
+    let u32s = |name: &str| -> PolarsResult<Vec<u32>> {
+        Ok(df.column(name)?.u32()?.into_no_null_iter().collect())
+    };
+    let bools = |name: &str| -> PolarsResult<Vec<bool>> {
+        Ok(df
+            .column(name)?
+            .bool()?
+            .iter()
+            .map(|v| v.unwrap_or(false))
+            .collect())
+    };
+    let strs = |name: &str| -> PolarsResult<Vec<String>> {
+        Ok(df
+            .column(name)?
+            .str()?
+            .iter()
+            .map(|v| v.unwrap_or_default().to_string())
+            .collect())
+    };
+    let lists = |name: &str| -> PolarsResult<Vec<Vec<f64>>> {
+        let list = df.column(name)?.list()?;
+        (0..list.len())
+            .map(|i| match list.get_as_series(i) {
+                Some(s) => Ok(s.f64()?.no_null_iter().collect()),
+                None => Ok(Vec::new()),
+            })
+            .collect()
+    };
+    let (run_id, design_id, sample_id, n) = (
+        u64s("run_id")?,
+        u32s("design_id")?,
+        u32s("sample_id")?,
+        u32s("n")?,
+    );
+    let (kind, outcome, reason, method) = (
+        strs("kind")?,
+        strs("outcome")?,
+        strs("reason")?,
+        strs("method")?,
+    );
+    let (rho, race_radius, weight_mass, capacity, drag) = (
+        req("rho")?,
+        req("race_radius")?,
+        req("weight_mass")?,
+        req("capacity")?,
+        req("drag")?,
+    );
+    let (unbalance, fraction, direction) = (
+        req("unbalance")?,
+        req("unbalance_fraction")?,
+        req("direction_deg")?,
+    );
+    let (initial, finals) = (lists("initial_angles_deg")?, lists("final_rel_angles_deg")?);
+    let (settled, hold) = (bools("settled")?, bools("hold_complete")?);
+    let (ts, tr, te, teps) = (
+        f64s("settling_time")?,
+        f64s("settling_revs")?,
+        req("settling_time_err")?,
+        f64s("settling_time_eps")?,
+    );
+    let (ra, rr, aref, be, peak, pf, tf) = (
+        req("residual_abs")?,
+        req("residual_rel")?,
+        req("a_ref")?,
+        req("balancing_error")?,
+        req("peak_r")?,
+        req("p_final")?,
+        req("t_final")?,
+    );
+    let (steps, rhs, wall) = (u64s("steps")?, u64s("rhs_calls")?, req("wall_time_s")?);
+    let mut out = Vec::with_capacity(df.height());
+    for i in 0..df.height() {
+        out.push(RunRecord {
+            run_id: run_id[i],
+            design_id: design_id[i],
+            sample_id: sample_id[i],
+            kind: kind[i].clone(),
+            n: n[i],
+            rho: rho[i],
+            race_radius: race_radius[i],
+            weight_mass: weight_mass[i],
+            capacity: capacity[i],
+            drag: drag[i],
+            unbalance: unbalance[i],
+            unbalance_fraction: fraction[i],
+            direction_deg: direction[i],
+            initial_angles_deg: initial[i].clone(),
+            metrics: RunMetrics {
+                settled: settled[i],
+                settling_time: ts[i],
+                settling_revs: tr[i],
+                settling_time_err: te[i],
+                settling_time_eps: teps[i],
+                hold_complete: hold[i],
+                residual_abs: ra[i],
+                residual_rel: rr[i],
+                a_ref: aref[i],
+                balancing_error: be[i],
+                peak_r: peak[i],
+                final_rel_angles_deg: finals[i].clone(),
+                p_final: pf[i],
+                outcome: outcome_from(&outcome[i])?,
+                reason: reason[i].clone(),
+                t_final: tf[i],
+                steps: steps[i],
+                rhs_calls: rhs[i],
+            },
+            method: method[i].clone(),
+            wall_time_s: wall[i],
+        });
+    }
+    Ok(out)
+}

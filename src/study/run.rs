@@ -1,0 +1,435 @@
+//! The study executor: every pending run of the plan on all cores (rayon),
+//! finished runs written in chunks as they complete, resumable, shardable.
+//!
+//! Results never depend on the schedule: each run draws from its own stream
+//! ([`super::sample`]) and the final files are sorted by run index, so they
+//! are bit-identical (but for the wall-time column) for any thread count,
+//! any interruption and resumption, and any sharding followed by a merge.
+
+use super::aggregate::summarize;
+use super::config::StudyPlan;
+use super::io::{Provenance, read_parquet, write_parquet, write_text};
+use super::record::{RunRecord, from_dataframe, to_dataframe};
+use super::sample::draw_sample;
+use crate::metrics::{Outcome, RunMetrics};
+use crate::simulation::Simulation;
+use polars::prelude::{DataFrame, PolarsError};
+use rayon::prelude::*;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// The k-th of N disjoint slices of a study (k counted from 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// Which slice, 1..=count.
+    pub index: u32,
+    /// How many slices.
+    pub count: u32,
+}
+
+impl Shard {
+    /// Parse "k/N" with 1 ≤ k ≤ N.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let (k, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("--shard {text}: expected k/N, e.g. 2/8"))?;
+        let parse = |s: &str| {
+            s.trim()
+                .parse::<u32>()
+                .map_err(|_| format!("--shard {text}: '{s}' is not a whole number"))
+        };
+        let (index, count) = (parse(k)?, parse(n)?);
+        if count == 0 || index == 0 || index > count {
+            return Err(format!("--shard {text}: need 1 ≤ k ≤ N"));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// True when run `run_id` belongs to this slice (runs are dealt round-robin,
+    /// so that slow designs are spread over all shards).
+    pub fn contains(&self, run_id: u64) -> bool {
+        run_id % u64::from(self.count) == u64::from(self.index - 1)
+    }
+
+    /// "k/N".
+    pub fn label(&self) -> String {
+        format!("{}/{}", self.index, self.count)
+    }
+}
+
+/// How to execute a plan.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Continue an interrupted run instead of starting afresh.
+    pub resume: bool,
+    /// Run only one slice.
+    pub shard: Option<Shard>,
+    /// Worker threads (default: rayon's global pool, RAYON_NUM_THREADS).
+    pub threads: Option<usize>,
+    /// Write a chunk after this many finished runs …
+    pub chunk_runs: usize,
+    /// … or after this much time, whichever comes first.
+    pub chunk_interval: Duration,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            resume: false,
+            shard: None,
+            threads: None,
+            chunk_runs: 256,
+            chunk_interval: Duration::from_secs(2),
+        }
+    }
+}
+
+/// Receives progress events (the CLI draws a progress bar; the library never prints).
+pub trait Progress: Sync {
+    /// The run is about to start: `total` runs in this slice, `done` already finished.
+    fn begin(&self, _total: u64, _done: u64) {}
+    /// One more run finished.
+    fn advance(&self, _record: &RunRecord) {}
+    /// Everything is written.
+    fn end(&self) {}
+}
+
+/// A progress sink that ignores everything.
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
+
+/// What a finished study produced.
+#[derive(Debug)]
+pub struct StudyOutput {
+    /// Folder holding the files.
+    pub dir: PathBuf,
+    /// Every run of the slice, sorted by run index.
+    pub runs: Vec<RunRecord>,
+    /// Per-design statistics (unsharded runs only; shards are summarised by `merge`).
+    pub summary: Option<DataFrame>,
+    /// Runs executed in this invocation (the rest came from a resumed run).
+    pub executed: u64,
+}
+
+/// Why a study could not run or finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The output folder cannot be created or written.
+    #[error("output folder {path} cannot be written: {source}")]
+    NotWritable {
+        /// The folder.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// `--resume` on a folder whose run began from a different study file.
+    #[error(
+        "cannot resume in {path}: the study file changed since the run began (delete the folder or run without --resume)"
+    )]
+    StudyChanged {
+        /// The folder.
+        path: String,
+    },
+    /// Reading or writing Parquet failed.
+    #[error("parquet: {0}")]
+    Polars(#[from] PolarsError),
+    /// Other I/O.
+    #[error("i/o: {0}")]
+    Io(#[from] std::io::Error),
+    /// The thread pool could not be built.
+    #[error("thread pool: {0}")]
+    Pool(String),
+}
+
+impl RunError {
+    /// True when the error is the user's (bad folder, changed study): exit code 2.
+    pub fn is_user_error(&self) -> bool {
+        matches!(
+            self,
+            RunError::NotWritable { .. } | RunError::StudyChanged { .. }
+        )
+    }
+}
+
+/// Folder of a study's (or a shard's) files.
+pub fn output_dir(plan: &StudyPlan, shard: Option<Shard>) -> PathBuf {
+    let base = Path::new(&plan.file.output).join(&plan.name);
+    match shard {
+        Some(s) => base.join(format!("shard-{}-of-{}", s.index, s.count)),
+        None => base,
+    }
+}
+
+/// Execute one run of the plan. Never panics: a failed run is a row with a reason.
+pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
+    let samples = u64::from(plan.file.sampling.samples);
+    let design = &plan.designs[(run_id / samples) as usize];
+    let sample_id = run_id % samples;
+    let sample = draw_sample(plan, design, sample_id);
+    let simulation = Simulation {
+        scene: plan.scene(design, sample.unbalance, sample.direction),
+        start: plan.file.scene.start,
+        initial_angles: sample.initial_angles.clone(),
+        solver: plan.file.solver.clone(),
+        metrics: plan.file.metrics.clone(),
+    };
+    let clock = Instant::now();
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| simulation.run(false)));
+    let metrics = match result {
+        Ok(Ok(r)) => r.metrics,
+        Ok(Err(e)) => failed(format!("invalid scene: {e}")),
+        Err(panic) => {
+            let why = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            failed(format!("internal error: {why}"))
+        }
+    };
+    RunRecord {
+        run_id,
+        design_id: design.id,
+        sample_id: sample_id as u32,
+        kind: design.spec.kind.name().to_string(),
+        n: design.spec.n,
+        rho: design.rho,
+        race_radius: design.spec.race_radius,
+        weight_mass: design.weight_mass,
+        capacity: design.capacity,
+        drag: design.spec.drag,
+        unbalance: sample.unbalance,
+        unbalance_fraction: sample.fraction,
+        direction_deg: sample.direction.to_degrees(),
+        initial_angles_deg: sample
+            .initial_angles
+            .iter()
+            .map(|a| a.to_degrees())
+            .collect(),
+        metrics,
+        method: plan.file.solver.method.name().to_string(),
+        wall_time_s: clock.elapsed().as_secs_f64(),
+    }
+}
+
+/// Metrics of a run that could not be simulated at all.
+fn failed(reason: String) -> RunMetrics {
+    RunMetrics {
+        settled: false,
+        settling_time: None,
+        settling_revs: None,
+        settling_time_err: 0.0,
+        settling_time_eps: None,
+        hold_complete: false,
+        residual_abs: 0.0,
+        residual_rel: 0.0,
+        a_ref: 0.0,
+        balancing_error: 0.0,
+        peak_r: 0.0,
+        final_rel_angles_deg: Vec::new(),
+        p_final: 0.0,
+        outcome: Outcome::SolverFailed,
+        reason,
+        t_final: 0.0,
+        steps: 0,
+        rhs_calls: 0,
+    }
+}
+
+/// Label stored in provenance: "all" or "k/N".
+pub fn shard_label(shard: Option<Shard>) -> String {
+    shard.map_or_else(|| "all".to_string(), |s| s.label())
+}
+
+/// Run (or resume) the plan and write `runs.parquet` (and `summary.parquet`
+/// for an unsharded run) under [`output_dir`].
+pub fn run_study(
+    plan: &StudyPlan,
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<StudyOutput, RunError> {
+    let dir = output_dir(plan, options.shard);
+    let not_writable = |source| RunError::NotWritable {
+        path: dir.display().to_string(),
+        source,
+    };
+    std::fs::create_dir_all(&dir).map_err(not_writable)?;
+    let probe = dir.join(".write-probe");
+    std::fs::write(&probe, b"").map_err(not_writable)?;
+    std::fs::remove_file(&probe)?;
+
+    let manifest = dir.join("study.toml");
+    let chunks = dir.join("chunks");
+    let runs_path = dir.join("runs.parquet");
+    let mut done: Vec<RunRecord> = Vec::new();
+    if options.resume && manifest.exists() {
+        if std::fs::read_to_string(&manifest)? != plan.text {
+            return Err(RunError::StudyChanged {
+                path: dir.display().to_string(),
+            });
+        }
+        if runs_path.exists() {
+            done.extend(from_dataframe(&read_parquet(&runs_path)?)?);
+        }
+        done.extend(read_chunks(&chunks)?);
+    } else {
+        for stale in [&runs_path, &dir.join("summary.parquet")] {
+            if stale.exists() {
+                std::fs::remove_file(stale)?;
+            }
+        }
+        if chunks.exists() {
+            std::fs::remove_dir_all(&chunks)?;
+        }
+        write_text(&manifest, &plan.text)?;
+    }
+    std::fs::create_dir_all(&chunks)?;
+    let provenance = Provenance::new(&plan.text, plan.file.seed, &shard_label(options.shard));
+
+    let mut seen = HashSet::new();
+    done.retain(|r| seen.insert(r.run_id));
+    let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
+    let pending: Vec<u64> = (0..plan.total_runs())
+        .filter(in_slice)
+        .filter(|id| !seen.contains(id))
+        .collect();
+    let total = (0..plan.total_runs()).filter(in_slice).count() as u64;
+    progress.begin(total, done.len() as u64);
+
+    let executed = pending.len() as u64;
+    let fresh = execute(plan, &pending, options, &chunks, &provenance, progress)?;
+    done.extend(fresh);
+    done.sort_by_key(|r| r.run_id);
+
+    let mut df = to_dataframe(&done)?;
+    write_parquet(&runs_path, &mut df, &provenance)?;
+    let summary = if options.shard.is_none() {
+        let mut summary = summarize(plan, &done)?;
+        write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
+        Some(summary)
+    } else {
+        None
+    };
+    std::fs::remove_dir_all(&chunks)?;
+    progress.end();
+    Ok(StudyOutput {
+        dir,
+        runs: done,
+        summary,
+        executed,
+    })
+}
+
+/// Run `pending` on the pool, writing chunks as results arrive.
+fn execute(
+    plan: &StudyPlan,
+    pending: &[u64],
+    options: &RunOptions,
+    chunks: &Path,
+    provenance: &Provenance,
+    progress: &dyn Progress,
+) -> Result<Vec<RunRecord>, RunError> {
+    let pool = match options.threads {
+        Some(t) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .map_err(|e| RunError::Pool(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let mut next_chunk = next_chunk_index(chunks)?;
+    let (tx, rx) = mpsc::channel::<RunRecord>();
+    std::thread::scope(|scope| {
+        scope.spawn(move || {
+            let work = move || {
+                pending.par_iter().for_each_with(tx, |tx, &id| {
+                    // The receiver only disappears if writing failed; the error is reported there.
+                    let _ = tx.send(run_one(plan, id));
+                });
+            };
+            match &pool {
+                Some(p) => p.install(work),
+                None => work(),
+            }
+        });
+        let mut all = Vec::with_capacity(pending.len());
+        let mut buffer: Vec<RunRecord> = Vec::new();
+        let mut last_flush = Instant::now();
+        let mut flush = |buffer: &mut Vec<RunRecord>| -> Result<(), RunError> {
+            if buffer.is_empty() {
+                return Ok(());
+            }
+            let mut df = to_dataframe(buffer)?;
+            write_parquet(
+                &chunks.join(format!("chunk-{next_chunk:06}.parquet")),
+                &mut df,
+                provenance,
+            )?;
+            next_chunk += 1;
+            buffer.clear();
+            Ok(())
+        };
+        loop {
+            match rx.recv_timeout(Duration::from_millis(200)) {
+                Ok(record) => {
+                    progress.advance(&record);
+                    all.push(record.clone());
+                    buffer.push(record);
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            if buffer.len() >= options.chunk_runs || last_flush.elapsed() >= options.chunk_interval
+            {
+                flush(&mut buffer)?;
+                last_flush = Instant::now();
+            }
+        }
+        flush(&mut buffer)?;
+        Ok(all)
+    })
+}
+
+/// Records of every complete chunk in `dir` (leftover temporary files are removed).
+fn read_chunks(dir: &Path) -> Result<Vec<RunRecord>, RunError> {
+    let mut out = Vec::new();
+    if !dir.exists() {
+        return Ok(out);
+    }
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default();
+        if name.contains(".tmp-") {
+            std::fs::remove_file(&path)?;
+        } else if name.ends_with(".parquet") {
+            out.extend(from_dataframe(&read_parquet(&path)?)?);
+        }
+    }
+    Ok(out)
+}
+
+fn next_chunk_index(dir: &Path) -> Result<u64, RunError> {
+    let mut next = 0;
+    for entry in std::fs::read_dir(dir)? {
+        let name = entry?.file_name().to_string_lossy().to_string();
+        if let Some(num) = name
+            .strip_prefix("chunk-")
+            .and_then(|s| s.strip_suffix(".parquet"))
+        {
+            if let Ok(i) = num.parse::<u64>() {
+                next = next.max(i + 1);
+            }
+        }
+    }
+    Ok(next)
+}

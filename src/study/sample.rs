@@ -1,0 +1,162 @@
+//! Random streams and the draws of one run.
+//!
+//! Every run draws from its own stream, seeded by mixing (study seed, design
+//! index, sample index) through SplitMix64 steps: results do not depend on
+//! thread count, scheduling or sharding. With common random numbers (the
+//! default) the design index is left out of the unbalance and direction
+//! draws, so every design meets the same unbalances and differences between
+//! designs are not sampling noise.
+
+use super::config::{Design, DirectionSpec, Distribution, InitialSpec, Scale, StudyPlan};
+use crate::design::geometry::{half_angle, pressed_angles};
+use crate::model::start::balanced_fan;
+use rand::{RngExt, SeedableRng};
+use rand_distr::{Distribution as _, Exp1, Normal};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::f64::consts::PI;
+
+/// One SplitMix64 step: a bijective 64-bit mixer (Steele, Lea & Flood 2014).
+pub fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Purposes of streams, so that independent draws never share a stream.
+#[derive(Debug, Clone, Copy)]
+#[repr(u64)]
+pub enum Purpose {
+    /// Unbalance magnitude and direction.
+    Unbalance = 1,
+    /// Initial cargo positions.
+    Initial = 2,
+    /// Bootstrap resampling of a design's statistics.
+    Bootstrap = 3,
+}
+
+/// The stream for (seed, design, sample, purpose); `design = None` for
+/// streams shared by every design (common random numbers).
+pub fn stream(seed: u64, design: Option<u32>, sample: u64, purpose: Purpose) -> Xoshiro256PlusPlus {
+    let d = design.map_or(u64::MAX, u64::from);
+    let mut h = splitmix64(seed);
+    h = splitmix64(h ^ d);
+    h = splitmix64(h ^ sample);
+    h = splitmix64(h ^ purpose as u64);
+    Xoshiro256PlusPlus::seed_from_u64(h)
+}
+
+/// What was drawn for one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    /// Unbalance magnitude U = M e (kg·m).
+    pub unbalance: f64,
+    /// U as a fraction of the design's capacity.
+    pub fraction: f64,
+    /// Unbalance direction relative to the rotor (rad).
+    pub direction: f64,
+    /// Initial cargo angles relative to the rotor (rad).
+    pub initial_angles: Vec<f64>,
+}
+
+fn draw(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
+    match *d {
+        Distribution::Fixed { value } => value,
+        Distribution::Uniform { min, max } => min + (max - min) * rng.random::<f64>(),
+        Distribution::LogUniform { min, max } => {
+            (min.ln() + (max.ln() - min.ln()) * rng.random::<f64>()).exp()
+        }
+        Distribution::NormalTruncated {
+            mean,
+            std,
+            min,
+            max,
+        } => {
+            let normal = Normal::new(mean, std).expect("std validated positive");
+            loop {
+                let v = normal.sample(rng);
+                if (min..=max).contains(&v) {
+                    return v;
+                }
+            }
+        }
+    }
+}
+
+/// Draw the sample of run (design, sample index).
+pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
+    let s = &plan.file.sampling;
+    let seed = plan.file.seed;
+    let shared = if s.common_random_numbers {
+        None
+    } else {
+        Some(design.id)
+    };
+    let mut rng = stream(seed, shared, sample, Purpose::Unbalance);
+    let value = draw(&s.unbalance.distribution, &mut rng);
+    let (unbalance, fraction) = match s.unbalance.relative_to {
+        Scale::Capacity => (value * design.capacity, value),
+        Scale::Absolute => (value, value / design.capacity),
+    };
+    let direction = match s.direction {
+        DirectionSpec::Uniform => 2.0 * PI * rng.random::<f64>(),
+        DirectionSpec::Fixed(deg) => deg.to_radians(),
+    };
+    let mut rng = stream(seed, shared, sample, Purpose::Initial);
+    let n = design.spec.n as usize;
+    let initial_angles = match s.initial {
+        InitialSpec::Clustered => {
+            let centre = 2.0 * PI * rng.random::<f64>();
+            cluster(design, centre)
+        }
+        InitialSpec::Even => {
+            let start = 2.0 * PI * rng.random::<f64>();
+            (0..n)
+                .map(|j| start + 2.0 * PI * j as f64 / n as f64)
+                .collect()
+        }
+        InitialSpec::Uniform => uniform_without_overlap(design, &mut rng),
+        InitialSpec::BalancedForShift(shift) => {
+            let old = direction - shift.to_radians();
+            balanced_fan(n, design.weight_mass * design.track_radius, unbalance, old)
+                // Beyond what the point cargoes can cancel: press them together opposite.
+                .unwrap_or_else(|| cluster(design, old + PI))
+        }
+    };
+    Sample {
+        unbalance,
+        fraction,
+        direction,
+        initial_angles,
+    }
+}
+
+/// The weights pressed together, centred on `centre`.
+fn cluster(design: &Design, centre: f64) -> Vec<f64> {
+    match pressed_angles(design.spec.n, design.rho) {
+        Ok(angles) => angles.into_iter().map(|a| a + centre).collect(),
+        Err(_) => vec![centre; design.spec.n as usize],
+    }
+}
+
+/// Uniformly random positions of n weights that may not overlap: the free
+/// arc 2π − 2nα is cut into n gaps with uniform spacings (normalised
+/// exponentials), which is exactly uniform over non-overlapping configurations.
+fn uniform_without_overlap(design: &Design, rng: &mut Xoshiro256PlusPlus) -> Vec<f64> {
+    let n = design.spec.n as usize;
+    let start = 2.0 * PI * rng.random::<f64>();
+    if n == 1 {
+        return vec![start];
+    }
+    let width = 2.0 * half_angle(design.rho.min(0.5)).unwrap_or(0.0);
+    let free = (2.0 * PI - n as f64 * width).max(0.0);
+    let gaps: Vec<f64> = (0..n).map(|_| Exp1.sample(rng)).collect();
+    let total: f64 = gaps.iter().sum();
+    let mut angle = start;
+    let mut out = Vec::with_capacity(n);
+    for g in gaps {
+        out.push(angle);
+        angle += width + free * g / total;
+    }
+    out
+}
