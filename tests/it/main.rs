@@ -6,3 +6,4 @@ mod design_transient;
 mod integrate;
 mod model_conservation;
 mod model_physics;
+mod study_runner;

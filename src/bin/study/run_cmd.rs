@@ -41,6 +41,9 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Write finished runs to disk after this many (smaller: less lost on a kill).
+    #[arg(long, default_value_t = 256)]
+    chunk_runs: usize,
 }
 
 /// Arguments of `study merge`.

@@ -1,0 +1,250 @@
+//! The study runner: determinism, sharding, resume, statistics, bad input.
+
+use autobal::study::config::{StudyFile, StudyPlan};
+use autobal::study::io::read_parquet;
+use autobal::study::record::deterministic_columns;
+use autobal::study::run::{NoProgress, RunOptions, Shard, run_study};
+use polars::prelude::*;
+use std::path::Path;
+use std::process::Command;
+
+/// A small, fast study: two ball designs, dimensionless-ish rotor.
+fn small_study(output: &Path, samples: u32, extra: &str) -> String {
+    format!(
+        r#"
+name = "small"
+seed = 7
+output = "{}"
+
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+
+[scene.speed]
+mode = "constant"
+omega = 300.0
+
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.05
+drag = [10.0, 50.0]
+
+[sampling]
+samples = {samples}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+
+[metrics]
+t_end_revs = 400
+{extra}
+"#,
+        output.display()
+    )
+}
+
+fn plan(text: &str) -> StudyPlan {
+    StudyFile::parse(text, "small.toml")
+        .unwrap()
+        .plan(text, "small.toml")
+        .unwrap()
+}
+
+/// The deterministic columns of a Parquet file (wall time left out).
+fn stable(path: &Path) -> DataFrame {
+    let df = read_parquet(path).unwrap();
+    let cols = deterministic_columns(&df);
+    df.select(cols).unwrap()
+}
+
+#[test]
+fn results_are_identical_for_one_and_two_threads() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let run = |dir: &Path, threads| {
+        let p = plan(&small_study(dir, 12, ""));
+        let opts = RunOptions {
+            threads: Some(threads),
+            ..RunOptions::default()
+        };
+        run_study(&p, &opts, &NoProgress).unwrap().dir
+    };
+    let (da, db) = (run(a.path(), 1), run(b.path(), 2));
+    assert!(stable(&da.join("runs.parquet")).equals_missing(&stable(&db.join("runs.parquet"))));
+    assert!(
+        read_parquet(&da.join("summary.parquet"))
+            .unwrap()
+            .equals_missing(&read_parquet(&db.join("summary.parquet")).unwrap())
+    );
+}
+
+#[test]
+fn sharded_and_merged_equals_whole() {
+    let whole = tempfile::tempdir().unwrap();
+    let sharded = tempfile::tempdir().unwrap();
+    let p = plan(&small_study(whole.path(), 10, ""));
+    let dir = run_study(&p, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .dir;
+    let p = plan(&small_study(sharded.path(), 10, ""));
+    let mut dirs = Vec::new();
+    for k in 1..=3 {
+        let opts = RunOptions {
+            shard: Some(Shard { index: k, count: 3 }),
+            ..RunOptions::default()
+        };
+        let out = run_study(&p, &opts, &NoProgress).unwrap();
+        assert!(out.summary.is_none());
+        assert!(out.runs.iter().all(|r| r.run_id % 3 == u64::from(k - 1)));
+        dirs.push(out.dir);
+    }
+    // Shards are disjoint and together hold every run.
+    let merged = autobal::study::merge::merge(&dirs, None).unwrap();
+    assert_eq!(merged.runs.len(), 20);
+    assert!(
+        stable(&dir.join("runs.parquet")).equals_missing(&stable(&merged.dir.join("runs.parquet")))
+    );
+    assert!(
+        read_parquet(&dir.join("summary.parquet"))
+            .unwrap()
+            .equals_missing(&read_parquet(&merged.dir.join("summary.parquet")).unwrap())
+    );
+    // Merging an incomplete set fails and names what is missing.
+    let err = autobal::study::merge::merge(&dirs[..2], Some(&sharded.path().join("partial")))
+        .unwrap_err();
+    assert!(err.to_string().contains("missing"), "{err}");
+}
+
+#[test]
+fn resume_after_a_kill_ends_with_the_same_files() {
+    let whole = tempfile::tempdir().unwrap();
+    let killed = tempfile::tempdir().unwrap();
+    let text = small_study(killed.path(), 150, "");
+    let study = killed.path().join("small.toml");
+    std::fs::write(&study, &text).unwrap();
+    let out = killed.path().join("small");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args([
+            "run",
+            study.to_str().unwrap(),
+            "--quiet",
+            "--chunk-runs",
+            "5",
+            "--threads",
+            "1",
+        ])
+        .spawn()
+        .unwrap();
+    // Kill once at least one chunk of finished runs is on disk.
+    let chunks = out.join("chunks");
+    let start = std::time::Instant::now();
+    while std::fs::read_dir(&chunks)
+        .map(|d| {
+            d.filter_map(Result::ok)
+                .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
+        })
+        .unwrap_or(false)
+        == false
+    {
+        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !out.join("runs.parquet").exists(),
+        "the run must have been interrupted"
+    );
+    let status = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", study.to_str().unwrap(), "--quiet", "--resume"])
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let p = plan(&small_study(whole.path(), 150, ""));
+    let dir = run_study(&p, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .dir;
+    assert!(stable(&dir.join("runs.parquet")).equals_missing(&stable(&out.join("runs.parquet"))));
+    assert!(!out.join("chunks").exists());
+}
+
+#[test]
+fn resume_refuses_a_changed_study() {
+    let tmp = tempfile::tempdir().unwrap();
+    let study = tmp.path().join("small.toml");
+    std::fs::write(&study, small_study(tmp.path(), 2, "")).unwrap();
+    let ok = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", study.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert!(ok.status.success());
+    std::fs::write(&study, small_study(tmp.path(), 3, "")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", study.to_str().unwrap(), "--quiet", "--resume"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("study file changed"));
+}
+
+#[test]
+fn golden_study_makes_physical_sense() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = plan(&small_study(tmp.path(), 24, ""));
+    let out = run_study(&p, &RunOptions::default(), &NoProgress).unwrap();
+    let summary = out.summary.unwrap();
+    let frac: Vec<f64> = summary
+        .column("settled_fraction")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .no_null_iter()
+        .collect();
+    let median: Vec<f64> = summary
+        .column("settling_revs_median")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .iter()
+        .map(Option::unwrap)
+        .collect();
+    // Three times above resonance every run settles …
+    assert!(frac.iter().all(|f| *f == 1.0), "{frac:?}");
+    // … and in the overdamped regime more drag is slower (β = 50 vs 10).
+    assert!(median[1] > median[0] * 1.3, "{median:?}");
+    // Summary columns the README promises.
+    for c in [
+        "settled_fraction_lo",
+        "settling_revs_p95",
+        "settling_revs_mean_ci_lo",
+        "residual_rel_p95",
+        "diverged",
+    ] {
+        assert!(summary.column(c).is_ok(), "{c}");
+    }
+}
+
+#[test]
+fn provenance_is_stored_in_the_parquet_metadata() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = small_study(tmp.path(), 2, "");
+    let out = run_study(&plan(&text), &RunOptions::default(), &NoProgress).unwrap();
+    let meta = autobal::study::io::read_metadata(&out.dir.join("runs.parquet")).unwrap();
+    let get = |k: &str| {
+        meta.iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.clone())
+            .unwrap()
+    };
+    assert_eq!(get("study_toml"), text);
+    assert_eq!(get("seed"), "7");
+    assert_eq!(get("shard"), "all");
+    assert_eq!(get("study_sha256"), autobal::study::io::sha256_hex(&text));
+    assert_eq!(get("autobal_version"), env!("CARGO_PKG_VERSION"));
+}
