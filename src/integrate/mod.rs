@@ -13,6 +13,7 @@
 //! two of them had correctness bugs for time-dependent right-hand sides (see
 //! `docs/integrators.md` for the numbers).
 
+pub mod dop853;
 pub mod dp5;
 pub mod norm;
 
@@ -77,14 +78,41 @@ pub enum Method {
     /// Dormand–Prince 5(4) with 4th-order dense output: the default.
     #[default]
     Dp5,
+    /// Dormand–Prince 8(5,3) with 7th-order dense output: tight tolerances.
+    Dop853,
 }
 
 impl Method {
+    /// Every method, in the order they are documented.
+    pub const ALL: &'static [Method] = &[Method::Dp5, Method::Dop853];
+
     /// Name used in files and output.
     pub fn name(self) -> &'static str {
         match self {
             Method::Dp5 => "dp5",
+            Method::Dop853 => "dop853",
         }
+    }
+}
+
+/// A method name that [`Method::from_str`](std::str::FromStr) does not know.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "unknown integration method `{name}` (expected one of: {known})",
+    name = .0,
+    known = Method::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+)]
+pub struct UnknownMethod(pub String);
+
+impl std::str::FromStr for Method {
+    type Err = UnknownMethod;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Method::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| UnknownMethod(s.to_string()))
     }
 }
 
@@ -211,5 +239,6 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     }
     match method {
         Method::Dp5 => dp5::solve(system, t0, y0, t_end, options, observer),
+        Method::Dop853 => dop853::solve(system, t0, y0, t_end, options, observer),
     }
 }
