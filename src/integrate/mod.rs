@@ -15,7 +15,9 @@
 
 pub mod dop853;
 pub mod dp5;
+mod lu;
 pub mod norm;
+pub mod radau5;
 
 use serde::{Deserialize, Serialize};
 
@@ -25,6 +27,12 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Evaluate f(t, y) into `dydt` (same length as `y`); must not allocate.
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]);
+    /// Write ∂f_i/∂y_j at (t, y) row-major into `jac[i·dim + j]` and return
+    /// true, or return false (the default) to let implicit methods use
+    /// finite differences.
+    fn jacobian(&self, _t: f64, _y: &[f64], _jac: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// Continuous solution over the last accepted step, valid on [t_prev, t].
@@ -80,17 +88,20 @@ pub enum Method {
     Dp5,
     /// Dormand–Prince 8(5,3) with 7th-order dense output: tight tolerances.
     Dop853,
+    /// Radau IIA order 5, implicit and L-stable: stiff problems.
+    Radau5,
 }
 
 impl Method {
     /// Every method, in the order they are documented.
-    pub const ALL: &'static [Method] = &[Method::Dp5, Method::Dop853];
+    pub const ALL: &'static [Method] = &[Method::Dp5, Method::Dop853, Method::Radau5];
 
     /// Name used in files and output.
     pub fn name(self) -> &'static str {
         match self {
             Method::Dp5 => "dp5",
             Method::Dop853 => "dop853",
+            Method::Radau5 => "radau5",
         }
     }
 }
@@ -240,5 +251,6 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     match method {
         Method::Dp5 => dp5::solve(system, t0, y0, t_end, options, observer),
         Method::Dop853 => dop853::solve(system, t0, y0, t_end, options, observer),
+        Method::Radau5 => radau5::solve(system, t0, y0, t_end, options, observer),
     }
 }
