@@ -13,8 +13,11 @@
 //! two of them had correctness bugs for time-dependent right-hand sides (see
 //! `docs/integrators.md` for the numbers).
 
+pub mod dop853;
 pub mod dp5;
+mod lu;
 pub mod norm;
+pub mod radau5;
 
 use serde::{Deserialize, Serialize};
 
@@ -24,6 +27,12 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Evaluate f(t, y) into `dydt` (same length as `y`); must not allocate.
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]);
+    /// Write ∂f_i/∂y_j at (t, y) row-major into `jac[i·dim + j]` and return
+    /// true, or return false (the default) to let implicit methods use
+    /// finite differences.
+    fn jacobian(&self, _t: f64, _y: &[f64], _jac: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// Continuous solution over the last accepted step, valid on [t_prev, t].
@@ -77,14 +86,44 @@ pub enum Method {
     /// Dormand–Prince 5(4) with 4th-order dense output: the default.
     #[default]
     Dp5,
+    /// Dormand–Prince 8(5,3) with 7th-order dense output: tight tolerances.
+    Dop853,
+    /// Radau IIA order 5, implicit and L-stable: stiff problems.
+    Radau5,
 }
 
 impl Method {
+    /// Every method, in the order they are documented.
+    pub const ALL: &'static [Method] = &[Method::Dp5, Method::Dop853, Method::Radau5];
+
     /// Name used in files and output.
     pub fn name(self) -> &'static str {
         match self {
             Method::Dp5 => "dp5",
+            Method::Dop853 => "dop853",
+            Method::Radau5 => "radau5",
         }
+    }
+}
+
+/// A method name that [`Method::from_str`](std::str::FromStr) does not know.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "unknown integration method `{name}` (expected one of: {known})",
+    name = .0,
+    known = Method::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+)]
+pub struct UnknownMethod(pub String);
+
+impl std::str::FromStr for Method {
+    type Err = UnknownMethod;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Method::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| UnknownMethod(s.to_string()))
     }
 }
 
@@ -211,5 +250,7 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     }
     match method {
         Method::Dp5 => dp5::solve(system, t0, y0, t_end, options, observer),
+        Method::Dop853 => dop853::solve(system, t0, y0, t_end, options, observer),
+        Method::Radau5 => radau5::solve(system, t0, y0, t_end, options, observer),
     }
 }
