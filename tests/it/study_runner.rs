@@ -140,14 +140,15 @@ fn resume_after_a_kill_ends_with_the_same_files() {
     // Kill once at least one chunk of finished runs is on disk.
     let chunks = out.join("chunks");
     let start = std::time::Instant::now();
-    while std::fs::read_dir(&chunks)
-        .map(|d| {
-            d.filter_map(Result::ok)
-                .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
-        })
-        .unwrap_or(false)
-        == false
-    {
+    let has_chunk = || {
+        std::fs::read_dir(&chunks)
+            .map(|d| {
+                d.filter_map(Result::ok)
+                    .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
+            })
+            .unwrap_or(false)
+    };
+    while !has_chunk() {
         assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
