@@ -2,6 +2,7 @@
 //! library, prints results on stdout and errors on stderr (exit code 2 for
 //! bad input).
 
+mod bench_cmd;
 mod design_cmd;
 mod output;
 mod simulate_cmd;
@@ -25,6 +26,9 @@ enum Command {
     /// Simulate one scene and print settling time, residual vibration and more.
     #[command(after_help = simulate_cmd::EXAMPLES)]
     Simulate(simulate_cmd::SimulateArgs),
+    /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
+    #[command(after_help = bench_cmd::EXAMPLES)]
+    Bench(bench_cmd::BenchArgs),
 }
 
 /// An error the user caused (bad input): printed and mapped to exit code 2.
@@ -41,6 +45,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
         Command::Simulate(args) => simulate_cmd::run(&args),
+        Command::Bench(args) => bench_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
