@@ -48,7 +48,7 @@ pub const ATOL_PER_RTOL: f64 = 1e-2;
 /// What to measure and how often.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BenchConfig {
-    /// Cargo counts n of the right-hand-side series.
+    /// Cargo counts n (each ≥ 1) of the right-hand-side series.
     pub cargo_counts: Vec<usize>,
     /// Timed batches per cargo count (the median is reported).
     pub rhs_samples: usize,
@@ -396,13 +396,16 @@ fn time_rhs(system: &RotorSystem, y: &[f64], dydt: &mut [f64], calls: u64) -> Du
 
 /// Ordinary least squares y ≈ a + b x; `None` without two distinct x.
 pub fn linear_fit(points: &[(f64, f64)]) -> Option<LinearFit> {
+    if points.len() < 2 {
+        return None;
+    }
     let n = points.len() as f64;
     let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
     let my = points.iter().map(|p| p.1).sum::<f64>() / n;
     let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
     let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
     let syy: f64 = points.iter().map(|p| (p.1 - my).powi(2)).sum();
-    if points.len() < 2 || sxx <= 0.0 {
+    if sxx <= 0.0 {
         return None;
     }
     let slope = sxy / sxx;

@@ -28,7 +28,7 @@ pub struct BenchArgs {
     /// Horizon of each solve in revolutions (default 500; 20 with --quick).
     #[arg(long)]
     revolutions: Option<f64>,
-    /// Timed repeats of each solve (default 11; 3 with --quick).
+    /// Timed solves per case and RHS batches per n (default 11 and 21; 3 with --quick).
     #[arg(long)]
     repeats: Option<usize>,
 }
