@@ -16,6 +16,7 @@
 // chains over several parallel arrays would hide them.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bench;
 pub mod design;
 pub mod integrate;
 pub mod metrics;

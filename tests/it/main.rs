@@ -1,5 +1,6 @@
 //! autobal's integration tests, linked into one binary to keep builds fast.
 
+mod bench;
 mod cli_design;
 mod design_capacity;
 mod design_transient;

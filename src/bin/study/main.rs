@@ -2,6 +2,7 @@
 //! library, prints results on stdout and errors on stderr (exit code 2 for
 //! bad input).
 
+mod bench_cmd;
 mod design_cmd;
 mod output;
 mod run_cmd;
@@ -32,6 +33,9 @@ enum Command {
     /// Merge the outputs of `study run --shard k/N` into one study's files.
     #[command(after_help = run_cmd::MERGE_EXAMPLES)]
     Merge(run_cmd::MergeArgs),
+    /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
+    #[command(after_help = bench_cmd::EXAMPLES)]
+    Bench(bench_cmd::BenchArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -57,6 +61,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
+        Command::Bench(args) => bench_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
