@@ -7,4 +7,6 @@ mod design_transient;
 mod integrate;
 mod model_conservation;
 mod model_physics;
+mod study_input;
 mod study_runner;
+mod study_summary;

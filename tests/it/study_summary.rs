@@ -1,0 +1,142 @@
+//! Per-design statistics against hand computations on a small fixture.
+
+use autobal::metrics::{Outcome, RunMetrics};
+use autobal::study::aggregate::{bootstrap_mean_ci, summarize, wilson_interval};
+use autobal::study::config::StudyFile;
+use autobal::study::record::RunRecord;
+
+fn plan() -> autobal::study::config::StudyPlan {
+    let text = r#"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.05
+drag = 10.0
+[sampling]
+samples = 6
+unbalance = { distribution = "fixed", value = 0.5 }
+"#;
+    StudyFile::parse(text, "fixture.toml")
+        .unwrap()
+        .plan(text, "fixture.toml")
+        .unwrap()
+}
+
+fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> RunRecord {
+    RunRecord {
+        run_id: id,
+        design_id: 0,
+        sample_id: id as u32,
+        kind: "ball".into(),
+        n: 3,
+        rho: 0.36,
+        race_radius: 0.05,
+        weight_mass: 0.2,
+        capacity: 0.016,
+        drag: 10.0,
+        unbalance: 0.008,
+        unbalance_fraction: 0.5,
+        direction_deg: 0.0,
+        initial_angles_deg: vec![0.0, 10.0, 20.0],
+        metrics: RunMetrics {
+            settled: outcome == Outcome::Settled,
+            settling_time: revs.map(|r| r * 0.02),
+            settling_revs: revs,
+            settling_time_err: 0.001,
+            settling_time_eps: None,
+            hold_complete: revs.is_some(),
+            residual_abs: residual_rel * 1e-4,
+            residual_rel,
+            a_ref: 1e-4,
+            balancing_error: 0.0,
+            peak_r: 1e-3,
+            final_rel_angles_deg: vec![120.0, 180.0, 240.0],
+            p_final: 0.0,
+            outcome,
+            reason: String::new(),
+            t_final: 10.0,
+            steps: 100,
+            rhs_calls: 600,
+        },
+        method: "dp5".into(),
+        wall_time_s: 0.001,
+    }
+}
+
+#[test]
+fn summary_matches_a_hand_computation() {
+    let runs = vec![
+        record(0, Outcome::Settled, Some(10.0), 0.01),
+        record(1, Outcome::Settled, Some(40.0), 0.02),
+        record(2, Outcome::Settled, Some(20.0), 0.03),
+        record(3, Outcome::NotSettled, None, 0.50),
+        record(4, Outcome::Settled, Some(30.0), 0.04),
+        record(5, Outcome::Diverged, None, 99.0),
+    ];
+    let df = summarize(&plan(), &runs).unwrap();
+    let f = |c: &str| df.column(c).unwrap().f64().unwrap().get(0).unwrap();
+    let u = |c: &str| df.column(c).unwrap().u64().unwrap().get(0).unwrap();
+    assert_eq!(u("runs"), 6);
+    assert_eq!(u("settled"), 4);
+    assert_eq!(u("not_settled"), 1);
+    assert_eq!(u("diverged"), 1);
+    assert_eq!(u("solver_failed"), 0);
+    assert!((f("settled_fraction") - 4.0 / 6.0).abs() < 1e-15);
+    // Settled runs: 10, 20, 30, 40 revolutions.
+    assert_eq!(f("settling_revs_mean"), 25.0);
+    assert_eq!(f("settling_revs_median"), 25.0);
+    assert!((f("settling_revs_std") - (500.0f64 / 3.0).sqrt()).abs() < 1e-12);
+    assert!((f("settling_revs_p10") - 13.0).abs() < 1e-12);
+    assert!((f("settling_revs_p90") - 37.0).abs() < 1e-12);
+    assert!((f("settling_revs_p95") - 38.5).abs() < 1e-12);
+    assert_eq!(f("settling_revs_max"), 40.0);
+    // Residual over the runs simulated to the end (settled or not): 0.01..0.04 and 0.5.
+    assert!((f("residual_rel_mean") - 0.6 / 5.0).abs() < 1e-15);
+    assert!((f("residual_rel_median") - 0.03).abs() < 1e-15);
+    let (lo, hi) = (f("settling_revs_mean_ci_lo"), f("settling_revs_mean_ci_hi"));
+    assert!(
+        lo < 25.0 && 25.0 < hi && lo >= 10.0 && hi <= 40.0,
+        "[{lo}, {hi}]"
+    );
+}
+
+#[test]
+fn wilson_interval_matches_closed_forms() {
+    // All failures: upper limit z²/(n + z²); all successes: lower limit n/(n + z²).
+    let z2 = 1.959_963_984_540_054f64.powi(2);
+    let (lo, hi) = wilson_interval(0, 10);
+    assert_eq!(lo, 0.0);
+    assert!((hi - z2 / (10.0 + z2)).abs() < 1e-12);
+    let (lo, hi) = wilson_interval(10, 10);
+    assert!((lo - 10.0 / (10.0 + z2)).abs() < 1e-12 && (hi - 1.0).abs() < 1e-15);
+    // Newcombe (1998), example: 81/263 → 0.2553 … 0.3662.
+    let (lo, hi) = wilson_interval(81, 263);
+    assert!(
+        (lo - 0.2553).abs() < 5e-5 && (hi - 0.3662).abs() < 5e-5,
+        "{lo} {hi}"
+    );
+}
+
+#[test]
+fn bootstrap_is_seeded_and_brackets_the_mean() {
+    let values: Vec<f64> = (1..=50).map(f64::from).collect();
+    let a = bootstrap_mean_ci(&values, 1, 0).unwrap();
+    assert_eq!(a, bootstrap_mean_ci(&values, 1, 0).unwrap());
+    assert_ne!(a, bootstrap_mean_ci(&values, 2, 0).unwrap());
+    // Normal approximation: 25.5 ± 1.96·σ/√n with σ ≈ 14.58 → half-width ≈ 4.04.
+    assert!(
+        (a.0 - (25.5 - 4.04)).abs() < 1.0 && (a.1 - (25.5 + 4.04)).abs() < 1.0,
+        "{a:?}"
+    );
+    assert!(bootstrap_mean_ci(&[1.0], 1, 0).is_none());
+}
