@@ -115,3 +115,52 @@ pub fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
     std::fs::write(&tmp, text)?;
     std::fs::rename(&tmp, path)
 }
+
+/// A sampled time history as a DataFrame: t, x, y, r, eps, psi_0 … psi_{n−1}.
+pub fn series_dataframe(series: &crate::metrics::observer::Series) -> PolarsResult<DataFrame> {
+    let mut columns = vec![
+        Column::new("t".into(), series.t.clone()),
+        Column::new("x".into(), series.x.clone()),
+        Column::new("y".into(), series.y.clone()),
+        Column::new("r".into(), series.r.clone()),
+        Column::new("eps".into(), series.eps.clone()),
+    ];
+    for (j, psi) in series.psi.iter().enumerate() {
+        columns.push(Column::new(format!("psi_{j}").into(), psi.clone()));
+    }
+    DataFrame::new(series.t.len(), columns)
+}
+
+/// Write a time history atomically: Parquet for `.parquet`, CSV otherwise.
+pub fn write_series(
+    path: &Path,
+    series: &crate::metrics::observer::Series,
+    provenance: &Provenance,
+) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    let mut df = series_dataframe(series)?;
+    if path.extension().is_some_and(|e| e == "parquet") {
+        write_parquet(path, &mut df, provenance)?;
+        return Ok(());
+    }
+    let tmp = temp_path(path);
+    {
+        let mut w = csv::Writer::from_path(&tmp)?;
+        let names: Vec<String> = df
+            .get_column_names()
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        w.write_record(&names)?;
+        let cols: Vec<Vec<f64>> = df
+            .columns()
+            .iter()
+            .map(|c| c.f64().map(|ca| ca.no_null_iter().collect()))
+            .collect::<PolarsResult<_>>()?;
+        for i in 0..df.height() {
+            w.write_record(cols.iter().map(|c| c[i].to_string()))?;
+        }
+        w.flush()?;
+    }
+    std::fs::rename(&tmp, path)?;
+    Ok(())
+}

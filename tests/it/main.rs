@@ -2,6 +2,7 @@
 
 mod bench;
 mod cli_design;
+mod cli_simulate;
 mod design_capacity;
 mod design_transient;
 mod integrate;

@@ -2,8 +2,8 @@
 
 use crate::UserError;
 use autobal::metrics::RunMetrics;
-use autobal::metrics::observer::Series;
 use autobal::scene_file::SceneFile;
+use autobal::study::io::{Provenance, write_series};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 pub const EXAMPLES: &str = "Examples:
   study simulate scenes/three_balls.toml
   study simulate scenes/three_balls.toml --json
-  study simulate scenes/three_balls.toml --series run.csv";
+  study simulate scenes/three_balls.toml --series run.csv
+  study simulate scenes/three_balls.toml --series run.parquet";
 
 /// Arguments of `study simulate`.
 #[derive(Args)]
@@ -21,7 +22,8 @@ pub struct SimulateArgs {
     /// Print the metrics as one JSON object.
     #[arg(long)]
     json: bool,
-    /// Write the sampled time history (t, x, y, r, ε, ψ_j) to this CSV file.
+    /// Write the sampled time history (t, x, y, r, ε, ψ_j) to this file:
+    /// Parquet when it ends in .parquet, CSV otherwise.
     #[arg(long)]
     series: Option<PathBuf>,
 }
@@ -36,7 +38,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     }
     let result = simulation.run(args.series.is_some())?;
     if let (Some(path), Some(series)) = (&args.series, &result.series) {
-        write_series_csv(path, series)?;
+        let text = std::fs::read_to_string(&args.scene)?;
+        let provenance = Provenance::new(&text, 0, "single run");
+        write_series(path, series, &provenance).map_err(|e| UserError::internal(e.to_string()))?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&result.metrics)?);
@@ -61,37 +65,6 @@ fn check_writable(path: &Path) -> Result<(), UserError> {
             2,
         ));
     }
-    Ok(())
-}
-
-/// Write the series atomically (temporary file, then rename).
-fn write_series_csv(path: &Path, series: &Series) -> Result<(), UserError> {
-    let tmp = path.with_extension("csv.tmp");
-    {
-        let mut w = csv::Writer::from_path(&tmp)?;
-        let mut header = vec![
-            "t".to_string(),
-            "x".into(),
-            "y".into(),
-            "r".into(),
-            "eps".into(),
-        ];
-        header.extend((0..series.psi.len()).map(|j| format!("psi_{j}")));
-        w.write_record(&header)?;
-        for i in 0..series.t.len() {
-            let mut row = vec![
-                series.t[i],
-                series.x[i],
-                series.y[i],
-                series.r[i],
-                series.eps[i],
-            ];
-            row.extend(series.psi.iter().map(|p| p[i]));
-            w.write_record(row.iter().map(|v| v.to_string()))?;
-        }
-        w.flush()?;
-    }
-    std::fs::rename(&tmp, path)?;
     Ok(())
 }
 
