@@ -2,7 +2,7 @@
 //! executed and measured. This is the executor for a single simulation; the
 //! study runner fans many of them out over threads.
 
-use crate::integrate::{Method, SolverOptions, solve};
+use crate::integrate::{Failure, Method, SolverOptions, Status, solve};
 use crate::metrics::observer::{Series, SettlingObserver};
 use crate::metrics::{MetricOptions, RunMetrics};
 use crate::model::scene::{Scene, SceneError};
@@ -29,6 +29,10 @@ pub struct SolverSettings {
     pub atol: f64,
     /// Step budget (accepted plus rejected).
     pub max_steps: u64,
+    /// When an explicit method finds the problem stiff, runs out of steps or
+    /// underflows its step size, re-run the whole simulation with Radau5 and
+    /// record the switch (`method` becomes e.g. "dp5→radau5").
+    pub implicit_fallback: bool,
 }
 
 impl Default for SolverSettings {
@@ -38,6 +42,7 @@ impl Default for SolverSettings {
             rtol: 1e-6,
             atol: 1e-8,
             max_steps: 5_000_000,
+            implicit_fallback: true,
         }
     }
 }
@@ -94,27 +99,49 @@ impl Simulation {
             });
         }
         let omega = self.scene.speed.nominal_speed();
-        let observer = SettlingObserver::new(&system, omega, self.metrics.clone(), record);
-        let options = SolverOptions {
-            rtol: self.solver.rtol,
-            atol: scaled_atol(&system, self.solver.atol, observer.a_ref(), omega),
-            h0: None,
-            h_max: f64::INFINITY,
-            max_steps: self.solver.max_steps,
-        };
         let y0 = initial_state(&system, self.start, &self.initial_angles);
         let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
-        let mut observer = observer;
-        let report = solve(
-            self.solver.method,
-            &system,
-            0.0,
-            &y0,
-            t_end,
-            &options,
-            &mut observer,
+        let method = self.solver.method;
+        let explicit = method != Method::Radau5;
+        let attempt = |method: Method| {
+            let mut observer = SettlingObserver::new(&system, omega, self.metrics.clone(), record);
+            let options = SolverOptions {
+                rtol: self.solver.rtol,
+                atol: scaled_atol(&system, self.solver.atol, observer.a_ref(), omega),
+                h0: None,
+                h_max: f64::INFINITY,
+                max_steps: self.solver.max_steps,
+                detect_stiffness: explicit && self.solver.implicit_fallback,
+            };
+            let report = solve(method, &system, 0.0, &y0, t_end, &options, &mut observer);
+            (report, observer)
+        };
+        let (report, observer) = attempt(method);
+        let stalled = matches!(
+            &report.status,
+            Status::Failed(
+                Failure::StiffnessDetected { .. }
+                    | Failure::TooManySteps { .. }
+                    | Failure::StepSizeUnderflow { .. }
+            )
         );
-        let (metrics, series) = observer.finish(&report);
+        let (metrics, series) = if explicit && self.solver.implicit_fallback && stalled {
+            let why = match &report.status {
+                Status::Failed(f) => f.to_string(),
+                _ => String::new(),
+            };
+            let (retry, observer) = attempt(Method::Radau5);
+            let (mut metrics, series) = observer.finish(&retry);
+            metrics.method = format!("{}→{}", method.name(), Method::Radau5.name());
+            metrics.reason = format!("{} (switched to radau5: {why})", metrics.reason);
+            metrics.steps += report.stats.steps;
+            metrics.rhs_calls += report.stats.rhs_calls;
+            (metrics, series)
+        } else {
+            let (mut metrics, series) = observer.finish(&report);
+            metrics.method = method.name().to_string();
+            (metrics, series)
+        };
         Ok(RunResult { metrics, series })
     }
 }

@@ -9,6 +9,7 @@
 //! [`optimum::optimal_rho`] (Table 1) and [`transient`] (eqs 1, 2, 10–16).
 
 pub mod capacity;
+pub mod complete;
 pub mod error;
 pub mod geometry;
 pub mod optimum;

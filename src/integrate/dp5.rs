@@ -111,6 +111,8 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     };
     let mut t = t0;
     let mut fac_old: f64 = 1e-4;
+    // Hairer's stiffness test: h·|λ| estimated from the last two stages.
+    let (mut stiff_count, mut non_stiff_count) = (0u32, 0u32);
     let mut last_rejected = false;
     let fail = |status, t, y: Vec<f64>, stats| SolveReport {
         status,
@@ -186,6 +188,26 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
             let mut h_new = h / fac;
             fac_old = e.max(1e-4);
             stats.steps += 1;
+            if options.detect_stiffness {
+                let (mut num, mut den) = (0.0, 0.0);
+                for i in 0..n {
+                    num += (k7[i] - k6[i]).powi(2);
+                    den += (y1[i] - ystage[i]).powi(2);
+                }
+                if den > 0.0 && h * (num / den).sqrt() > 3.25 {
+                    non_stiff_count = 0;
+                    stiff_count += 1;
+                    if stiff_count == 15 {
+                        let f = Failure::StiffnessDetected { t };
+                        return fail(Status::Failed(f), t, y, stats);
+                    }
+                } else {
+                    non_stiff_count += 1;
+                    if non_stiff_count == 6 {
+                        stiff_count = 0;
+                    }
+                }
+            }
             // Dense output coefficients for [t, t + h].
             {
                 let [r1, r2, r3, r4, r5] = &mut dense.r;

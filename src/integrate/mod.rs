@@ -140,6 +140,10 @@ pub struct SolverOptions {
     pub h_max: f64,
     /// Give up after this many steps (accepted plus rejected).
     pub max_steps: u64,
+    /// Explicit methods stop with [`Failure::StiffnessDetected`] when the step
+    /// size is held at the stability boundary (Hairer's test), so that a caller
+    /// can switch to an implicit method instead of crawling.
+    pub detect_stiffness: bool,
 }
 
 impl Default for SolverOptions {
@@ -150,6 +154,7 @@ impl Default for SolverOptions {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: 10_000_000,
+            detect_stiffness: false,
         }
     }
 }
@@ -191,6 +196,12 @@ pub enum Failure {
     /// The right-hand side or the state became NaN or infinite.
     #[error("non-finite state at t = {t}")]
     NonFinite {
+        /// Time reached.
+        t: f64,
+    },
+    /// An explicit method's step size was held by stability, not accuracy.
+    #[error("problem is stiff at t = {t}: explicit steps are limited by stability")]
+    StiffnessDetected {
         /// Time reached.
         t: f64,
     },

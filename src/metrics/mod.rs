@@ -120,4 +120,6 @@ pub struct RunMetrics {
     pub steps: u64,
     /// Right-hand-side evaluations.
     pub rhs_calls: u64,
+    /// Integrator that produced the result ("dp5", or "dp5→radau5" after an automatic switch).
+    pub method: String,
 }

@@ -233,6 +233,7 @@ impl<'a> SettlingObserver<'a> {
             t_final: report.t,
             steps: report.stats.steps,
             rhs_calls: report.stats.rhs_calls,
+            method: String::new(),
         };
         (metrics, self.series)
     }

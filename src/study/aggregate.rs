@@ -171,3 +171,24 @@ impl SummaryColumns {
         )
     }
 }
+
+/// Bootstrap standard error of a statistic of `values` (200 resamples, seeded).
+pub fn bootstrap_std_error(values: &[f64], statistic: impl Fn(&[f64]) -> f64, seed: u64) -> f64 {
+    const RESAMPLES: usize = 200;
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let mut rng = stream(seed, None, 0, Purpose::Bootstrap);
+    let n = values.len();
+    let mut buf = vec![0.0; n];
+    let stats: Vec<f64> = (0..RESAMPLES)
+        .map(|_| {
+            for b in buf.iter_mut() {
+                *b = values[rng.random_range(0..n)];
+            }
+            statistic(&buf)
+        })
+        .collect();
+    let mean = stats.iter().sum::<f64>() / RESAMPLES as f64;
+    (stats.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (RESAMPLES - 1) as f64).sqrt()
+}

@@ -45,6 +45,9 @@ pub struct StudyFile {
     /// Metric definitions.
     #[serde(default)]
     pub metrics: MetricOptions,
+    /// Settings of `study optimize` (ignored by `study run`).
+    #[serde(default)]
+    pub optimize: Option<crate::optimize::spec::OptimizeSpec>,
 }
 
 fn default_seed() -> u64 {
@@ -434,18 +437,66 @@ impl StudyFile {
         })
     }
 
-    fn resolve_designs(&self) -> Result<Vec<Design>, (String, String, String)> {
-        let g = &self.designs;
+    /// Validate one design of this study's scene and compute its mass and capacity.
+    ///
+    /// Errors are (key, value, reason) in the study file's terms.
+    pub fn resolve_design(
+        &self,
+        id: u32,
+        spec: DesignSpec,
+    ) -> Result<Design, (String, String, String)> {
+        let (kind, n) = (spec.kind, spec.n);
         let scene = Scene {
             rotor: PlaneRotor {
                 eccentricity: 0.0,
                 ..self.scene.rotor.clone()
             },
-            balancer: None,
+            balancer: Some(spec.clone()),
             cargo: Vec::new(),
             speed: self.scene.speed.clone(),
             effects: self.scene.effects.clone(),
         };
+        scene.validate().map_err(|e| scene_error_key(e, kind, n))?;
+        let geometry = spec.geometry().map_err(|e| {
+            (
+                "designs.rho".to_string(),
+                format!("{:?}", spec.rho),
+                e.to_string(),
+            )
+        })?;
+        check_fits(n, geometry.rho).map_err(|e| {
+            (
+                "designs.rho".to_string(),
+                geometry.rho.to_string(),
+                e.to_string(),
+            )
+        })?;
+        let cargo = kind
+            .model()
+            .cargo(&geometry)
+            .map_err(|e| ("designs".to_string(), kind.to_string(), e.to_string()))?;
+        let capacity = match kind {
+            Kind::Pendulum => f64::from(n) * cargo.unbalance(),
+            _ => crate::design::capacity::capacity_from_mass(
+                n,
+                geometry.rho,
+                cargo.mass,
+                spec.race_radius,
+            )
+            .map_err(|e| ("designs".to_string(), kind.to_string(), e.to_string()))?,
+        };
+        Ok(Design {
+            id,
+            spec,
+            rho: geometry.rho,
+            weight_mass: cargo.mass,
+            track_radius: cargo.track_radius,
+            capacity,
+        })
+    }
+
+    fn resolve_designs(&self) -> Result<Vec<Design>, (String, String, String)> {
+        let g = &self.designs;
         let mut designs = Vec::new();
         let (kinds, ns, rhos, drags) = (
             g.kind.values(),
@@ -476,42 +527,7 @@ impl StudyFile {
                             roller_height: g.roller_height,
                             drag,
                         };
-                        let mut s = scene.clone();
-                        s.balancer = Some(spec.clone());
-                        s.validate().map_err(|e| scene_error_key(e, *kind, n))?;
-                        let geometry = spec.geometry().map_err(|e| {
-                            ("designs.rho".to_string(), format!("{rho:?}"), e.to_string())
-                        })?;
-                        check_fits(n, geometry.rho).map_err(|e| {
-                            (
-                                "designs.rho".to_string(),
-                                geometry.rho.to_string(),
-                                e.to_string(),
-                            )
-                        })?;
-                        let cargo = kind.model().cargo(&geometry).map_err(|e| {
-                            ("designs".to_string(), kind.to_string(), e.to_string())
-                        })?;
-                        let capacity = match kind {
-                            Kind::Pendulum => f64::from(n) * cargo.unbalance(),
-                            _ => crate::design::capacity::capacity_from_mass(
-                                n,
-                                geometry.rho,
-                                cargo.mass,
-                                g.race_radius,
-                            )
-                            .map_err(|e| {
-                                ("designs".to_string(), kind.to_string(), e.to_string())
-                            })?,
-                        };
-                        designs.push(Design {
-                            id: designs.len() as u32,
-                            spec,
-                            rho: geometry.rho,
-                            weight_mass: cargo.mass,
-                            track_radius: cargo.track_radius,
-                            capacity,
-                        });
+                        designs.push(self.resolve_design(designs.len() as u32, spec)?);
                     }
                 }
             }

@@ -247,6 +247,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 t_final: tf[i],
                 steps: steps[i],
                 rhs_calls: rhs[i],
+                method: method[i].clone(),
             },
             method: method[i].clone(),
             wall_time_s: wall[i],

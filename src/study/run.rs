@@ -7,7 +7,7 @@
 //! any interruption and resumption, and any sharding followed by a merge.
 
 use super::aggregate::summarize;
-use super::config::StudyPlan;
+use super::config::{Design, StudyPlan};
 use super::io::{Provenance, read_parquet, write_parquet, write_text};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::sample::draw_sample;
@@ -167,7 +167,17 @@ pub fn output_dir(plan: &StudyPlan, shard: Option<Shard>) -> PathBuf {
 pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
     let samples = u64::from(plan.file.sampling.samples);
     let design = &plan.designs[(run_id / samples) as usize];
-    let sample_id = run_id % samples;
+    run_design_sample(plan, design, run_id % samples, run_id)
+}
+
+/// Execute sample `sample_id` of any design (also one outside the plan's grid,
+/// as the optimiser's candidates are), recorded under `run_id`.
+pub fn run_design_sample(
+    plan: &StudyPlan,
+    design: &Design,
+    sample_id: u64,
+    run_id: u64,
+) -> RunRecord {
     let sample = draw_sample(plan, design, sample_id);
     let simulation = Simulation {
         scene: plan.scene(design, sample.unbalance, sample.direction),
@@ -209,8 +219,12 @@ pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
             .iter()
             .map(|a| a.to_degrees())
             .collect(),
+        method: if metrics.method.is_empty() {
+            plan.file.solver.method.name().to_string()
+        } else {
+            metrics.method.clone()
+        },
         metrics,
-        method: plan.file.solver.method.name().to_string(),
         wall_time_s: clock.elapsed().as_secs_f64(),
     }
 }
@@ -236,6 +250,7 @@ fn failed(reason: String) -> RunMetrics {
         t_final: 0.0,
         steps: 0,
         rhs_calls: 0,
+        method: String::new(),
     }
 }
 

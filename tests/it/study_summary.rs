@@ -67,6 +67,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             t_final: 10.0,
             steps: 100,
             rhs_calls: 600,
+            method: "dp5".into(),
         },
         method: "dp5".into(),
         wall_time_s: 0.001,

@@ -4,6 +4,7 @@
 
 mod bench_cmd;
 mod design_cmd;
+mod optimize_cmd;
 mod output;
 mod run_cmd;
 mod simulate_cmd;
@@ -33,6 +34,9 @@ enum Command {
     /// Merge the outputs of `study run --shard k/N` into one study's files.
     #[command(after_help = run_cmd::MERGE_EXAMPLES)]
     Merge(run_cmd::MergeArgs),
+    /// Optimise weight count, radius (and drag) for an analytic or simulated objective.
+    #[command(after_help = optimize_cmd::EXAMPLES)]
+    Optimize(optimize_cmd::OptimizeArgs),
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
+        Command::Optimize(args) => optimize_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
     };
     match result {

@@ -1,0 +1,79 @@
+//! `study optimize`: choose counts, radii and drag for an objective.
+
+use crate::UserError;
+use crate::output::text_table;
+use autobal::optimize::optimize;
+use autobal::study::config::load;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study optimize --help`.
+pub const EXAMPLES: &str = "Examples:
+  study optimize studies/optimize_capacity.toml     analytic: Table 1 under a housing limit
+  study optimize studies/optimize_settling.toml     simulated: mean settling time, CRN, standard errors";
+
+/// Arguments of `study optimize`.
+#[derive(Args)]
+pub struct OptimizeArgs {
+    /// Study file with an [optimize] table.
+    study: PathBuf,
+}
+
+/// Run `study optimize`.
+pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
+    let plan = load(&args.study)?;
+    let out = optimize(&plan)?;
+    let objective = plan
+        .file
+        .optimize
+        .as_ref()
+        .map_or("", |o| o.objective.name());
+    let rows: Vec<Vec<String>> = out
+        .best
+        .iter()
+        .map(|b| {
+            let e = &b.evaluation;
+            vec![
+                b.scope.clone(),
+                e.candidate.kind.to_string(),
+                e.candidate.n.to_string(),
+                format!("{:.4}", e.candidate.rho),
+                format!("{:.3}", e.candidate.drag),
+                e.value.map_or("–".into(), |v| format!("{v:.5}")),
+                format!("{:.5}", e.std_err),
+                e.capacity.map_or("–".into(), |c| format!("{c:.4e}")),
+                if e.feasible {
+                    "ok".into()
+                } else {
+                    e.constraint.clone()
+                },
+            ]
+        })
+        .collect();
+    print!(
+        "{}",
+        text_table(
+            &[
+                "scope",
+                "kind",
+                "n",
+                "ρ",
+                "β",
+                objective,
+                "± SE",
+                "capacity kg·m",
+                "constraints"
+            ],
+            &rows
+        )
+    );
+    for (kind, n, why) in &out.terminations {
+        eprintln!("{kind} n = {n}: {why}");
+    }
+    eprintln!(
+        "{} candidates evaluated; wrote {}/optimize.parquet and optimum.parquet",
+        out.evaluations.len(),
+        out.dir.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,180 @@
+//! Evaluating one candidate design: analytic figures in microseconds, or a
+//! Monte Carlo sample with common random numbers, with its standard error.
+
+use super::spec::{Objective, OptimizeSpec};
+use crate::design::transient::a_tilde;
+use crate::model::balancer::Kind;
+use crate::model::scene::{DesignSpec, RhoChoice};
+use crate::study::aggregate::bootstrap_std_error;
+use crate::study::config::{Design, StudyPlan};
+use crate::study::run::run_design_sample;
+use rayon::prelude::*;
+
+/// A point of the design space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// Balancer kind.
+    pub kind: Kind,
+    /// Number of weights.
+    pub n: u32,
+    /// Radius ratio.
+    pub rho: f64,
+    /// Drag β (N·s/m).
+    pub drag: f64,
+}
+
+/// One evaluated candidate, as written to `optimize.parquet`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluation {
+    /// The candidate.
+    pub candidate: Candidate,
+    /// Objective value in its natural sign (None when infeasible).
+    pub value: Option<f64>,
+    /// Monte Carlo standard error of the value (0 for analytic objectives).
+    pub std_err: f64,
+    /// Capacity of the candidate (kg·m), when it could be built.
+    pub capacity: Option<f64>,
+    /// True when every constraint holds.
+    pub feasible: bool,
+    /// Which constraint failed, or "ok".
+    pub constraint: String,
+    /// Which search produced it (scan, brent, nelder_mead, analytic).
+    pub phase: &'static str,
+}
+
+/// Evaluates candidates of one study plan against one objective.
+pub struct Evaluator<'a> {
+    /// The study (scene, sampling, solver, metrics).
+    pub plan: &'a StudyPlan,
+    /// The optimisation settings.
+    pub spec: &'a OptimizeSpec,
+    /// Monte Carlo samples per candidate.
+    pub samples: u32,
+}
+
+impl Evaluator<'_> {
+    /// Build the candidate as a design, or say which constraint it breaks.
+    fn design(&self, c: &Candidate) -> Result<Design, String> {
+        if let Some(h) = self.spec.housing_rho_max {
+            if c.rho > h {
+                return Err(format!("ρ = {:.4} exceeds the housing limit {h}", c.rho));
+            }
+        }
+        let g = &self.plan.file.designs;
+        let spec = DesignSpec {
+            kind: c.kind,
+            n: c.n,
+            rho: RhoChoice::Value(c.rho),
+            race_radius: g.race_radius,
+            density: g.density,
+            roller_height: g.roller_height,
+            drag: c.drag,
+        };
+        let design = self
+            .plan
+            .file
+            .resolve_design(u32::MAX, spec)
+            .map_err(|(key, value, reason)| format!("{key} = {value}: {reason}"))?;
+        if let (Some(sf), Some(u)) = (self.spec.safety_factor, self.spec.max_unbalance) {
+            if design.capacity < sf * u {
+                return Err(format!(
+                    "capacity {:.4e} kg·m below {sf} × {u:.4e} kg·m",
+                    design.capacity
+                ));
+            }
+        }
+        Ok(design)
+    }
+
+    /// Evaluate a candidate (deterministic for a given plan and seed).
+    pub fn evaluate(&self, c: Candidate, phase: &'static str) -> Evaluation {
+        let design = match self.design(&c) {
+            Ok(d) => d,
+            Err(why) => {
+                return Evaluation {
+                    candidate: c,
+                    value: None,
+                    std_err: 0.0,
+                    capacity: None,
+                    feasible: false,
+                    constraint: why,
+                    phase,
+                };
+            }
+        };
+        let (value, std_err) = match self.spec.objective {
+            Objective::Capacity => (design.capacity, 0.0),
+            Objective::ATilde => {
+                let shape = c.kind.model().shape();
+                (a_tilde(shape, c.n, c.rho).unwrap_or(0.0), 0.0)
+            }
+            objective => self.simulate(&design, objective),
+        };
+        Evaluation {
+            candidate: c,
+            value: Some(value),
+            std_err,
+            capacity: Some(design.capacity),
+            feasible: true,
+            constraint: "ok".into(),
+            phase,
+        }
+    }
+
+    /// Monte Carlo estimate and standard error of a simulated objective.
+    ///
+    /// Samples k = 0..N draw from the same streams for every candidate (common
+    /// random numbers), and are reduced in index order, so the estimate does
+    /// not depend on the thread count.
+    fn simulate(&self, design: &Design, objective: Objective) -> (f64, f64) {
+        let t_end = self.plan.file.metrics.t_end_revs;
+        let metrics: Vec<_> = (0..u64::from(self.samples))
+            .into_par_iter()
+            .map(|k| run_design_sample(self.plan, design, k, k).metrics)
+            .collect();
+        let n = metrics.len() as f64;
+        let mean_se = |v: &[f64]| {
+            let mean = v.iter().sum::<f64>() / n;
+            let var = if v.len() > 1 {
+                v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)
+            } else {
+                0.0
+            };
+            (mean, (var / n).sqrt())
+        };
+        // Runs that never settle count as the whole run: a censored, conservative value.
+        let censored: Vec<f64> = metrics
+            .iter()
+            .map(|m| m.settling_revs.unwrap_or(t_end))
+            .collect();
+        match objective {
+            Objective::SettlingMean => mean_se(&censored),
+            Objective::SettlingP90 => {
+                let p90 = quantile(&censored, 0.9);
+                (
+                    p90,
+                    bootstrap_std_error(&censored, |v| quantile(v, 0.9), self.plan.file.seed),
+                )
+            }
+            Objective::SettledFraction => {
+                let p = metrics.iter().filter(|m| m.settled).count() as f64 / n;
+                (p, (p * (1.0 - p) / n).sqrt())
+            }
+            Objective::Residual => {
+                mean_se(&metrics.iter().map(|m| m.residual_rel).collect::<Vec<_>>())
+            }
+            Objective::Capacity | Objective::ATilde => {
+                unreachable!("analytic objectives are not simulated")
+            }
+        }
+    }
+}
+
+/// Linear-interpolation quantile of unsorted values.
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let pos = q * (v.len() - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    v[lo] + (v[hi] - v[lo]) * (pos - lo as f64)
+}

@@ -1,0 +1,344 @@
+//! `study optimize`: choose weight counts, radii (and drag) for an objective,
+//! analytic (milliseconds) or simulated (Monte Carlo with common random
+//! numbers and standard errors).
+//!
+//! Problem / solver / executor as in argmin: [`evaluate`] says what a
+//! candidate is worth, [`search`] runs argmin's solvers over the continuous
+//! variables, and [`optimize`] enumerates the integer n and kinds and writes
+//! the results.
+
+pub mod evaluate;
+pub mod search;
+pub mod spec;
+
+use crate::design::complete::{best_per_n_optimum, complete_optimization};
+use crate::study::config::StudyPlan;
+use crate::study::io::{Provenance, write_parquet};
+use evaluate::{Evaluation, Evaluator};
+use polars::prelude::*;
+use rayon::prelude::*;
+use spec::{Objective, OptimizeSpec};
+use std::path::PathBuf;
+
+/// The best evaluation of one scope (a kind and n, a kind, or overall).
+#[derive(Debug, Clone)]
+pub struct Best {
+    /// "kind_n", "overall" or "complete" (the paper's complete optimisation).
+    pub scope: String,
+    /// The evaluation.
+    pub evaluation: Evaluation,
+}
+
+/// Everything an optimisation produced.
+#[derive(Debug)]
+pub struct OptimizeOutput {
+    /// Every evaluated candidate, in (kind, n, evaluation) order.
+    pub evaluations: Vec<Evaluation>,
+    /// Per (kind, n): why its search stopped.
+    pub terminations: Vec<(String, u32, String)>,
+    /// Best per (kind, n), then overall, then (capacity objective) the complete optimisation per kind.
+    pub best: Vec<Best>,
+    /// Folder of the files.
+    pub dir: PathBuf,
+}
+
+/// Why an optimisation cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum OptimizeError {
+    /// The study file has no `[optimize]` table.
+    #[error("{0}: no [optimize] table (see docs/optimize.md)")]
+    NoSpec(String),
+    /// A setting is out of its domain.
+    #[error("optimize.{key} = {value}: {reason}")]
+    Invalid {
+        /// Key.
+        key: String,
+        /// Value.
+        value: String,
+        /// Reason.
+        reason: String,
+    },
+    /// Writing the results failed.
+    #[error("{0}")]
+    Output(String),
+}
+
+fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> {
+    let bad = |key: &str, value: String, reason: &str| OptimizeError::Invalid {
+        key: key.into(),
+        value,
+        reason: reason.into(),
+    };
+    if spec.free.is_empty() || !spec.free.contains(&spec::Variable::Rho) {
+        return Err(bad(
+            "free",
+            format!("{:?}", spec.free),
+            "must contain \"rho\" (and optionally \"drag\")",
+        ));
+    }
+    if let Some([lo, hi]) = spec.rho_bounds {
+        if !(lo > 0.0 && hi > lo && hi < 1.0) {
+            return Err(bad(
+                "rho_bounds",
+                format!("[{lo}, {hi}]"),
+                "need 0 < lo < hi < 1",
+            ));
+        }
+    }
+    if let Some([lo, hi]) = spec.drag_bounds {
+        if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+            return Err(bad(
+                "drag_bounds",
+                format!("[{lo}, {hi}]"),
+                "need 0 < lo < hi",
+            ));
+        }
+    }
+    if let Some(h) = spec.housing_rho_max {
+        if !(h > 0.0 && h < 1.0) {
+            return Err(bad("housing_rho_max", h.to_string(), "must lie in (0, 1)"));
+        }
+    }
+    for (key, v) in [
+        ("safety_factor", spec.safety_factor),
+        ("max_unbalance", spec.max_unbalance),
+    ] {
+        if let Some(v) = v {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(key, v.to_string(), "must be positive and finite"));
+            }
+        }
+    }
+    if spec.safety_factor.is_some() != spec.max_unbalance.is_some() {
+        return Err(bad(
+            "safety_factor",
+            "…".into(),
+            "give safety_factor and max_unbalance together",
+        ));
+    }
+    if spec.samples == Some(0) {
+        return Err(bad(
+            "samples",
+            "0".into(),
+            "need at least one sample per candidate",
+        ));
+    }
+    let ns = plan.file.designs.n.values();
+    if let Some(min) = spec.min_n {
+        if !ns.iter().any(|&n| n >= min) {
+            return Err(bad(
+                "min_n",
+                min.to_string(),
+                "excludes every n of [designs]",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Run the optimisation of `plan`'s `[optimize]` table and write
+/// `optimize.parquet` and `optimum.parquet` under the study's output folder.
+pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
+    let spec = plan
+        .file
+        .optimize
+        .clone()
+        .ok_or_else(|| OptimizeError::NoSpec(plan.name.clone()))?;
+    validate(&spec, plan)?;
+    // Common random numbers: every candidate meets the same sampled unbalances.
+    let mut plan = plan.clone();
+    plan.file.sampling.common_random_numbers = true;
+    let evaluator = Evaluator {
+        plan: &plan,
+        spec: &spec,
+        samples: spec.samples.unwrap_or(plan.file.sampling.samples),
+    };
+    let g = &plan.file.designs;
+    let drag = g.drag.values()[0];
+    let mut cells = Vec::new();
+    for kind in g.kind.values() {
+        for n in g.n.values() {
+            if spec.min_n.is_none_or(|m| n >= m) {
+                cells.push((kind, n));
+            }
+        }
+    }
+    let results: Vec<_> = cells
+        .par_iter()
+        .map(|&(kind, n)| (kind, n, search::search(&evaluator, kind, n, drag)))
+        .collect();
+    let mut evaluations = Vec::new();
+    let mut terminations = Vec::new();
+    let mut best = Vec::new();
+    for (kind, n, r) in &results {
+        if let Some(b) = best_of(&r.evaluations, spec.objective) {
+            best.push(Best {
+                scope: format!("{kind}_{n}"),
+                evaluation: b,
+            });
+        }
+        terminations.push((kind.to_string(), *n, r.termination.clone()));
+        evaluations.extend(r.evaluations.iter().cloned());
+    }
+    if let Some(b) = best_of(
+        &best
+            .iter()
+            .map(|b| b.evaluation.clone())
+            .collect::<Vec<_>>(),
+        spec.objective,
+    ) {
+        best.push(Best {
+            scope: "overall".into(),
+            evaluation: b,
+        });
+    }
+    if spec.objective == Objective::Capacity {
+        best.extend(complete_rows(&evaluator, &spec));
+    }
+    let dir = crate::study::run::output_dir(&plan, None);
+    write_outputs(&plan, &dir, &evaluations, &best)
+        .map_err(|e| OptimizeError::Output(e.to_string()))?;
+    Ok(OptimizeOutput {
+        evaluations,
+        terminations,
+        best,
+        dir,
+    })
+}
+
+/// The paper's complete optimisation per kind (grow ρ to the housing limit,
+/// dropping excess weights), next to the best per-n optimum under the same limit.
+fn complete_rows(evaluator: &Evaluator<'_>, spec: &OptimizeSpec) -> Vec<Best> {
+    let g = &evaluator.plan.file.designs;
+    let n_max = g.n.values().into_iter().max().unwrap_or(1);
+    let limit = spec.housing_rho_max.unwrap_or(0.5);
+    let mut out = Vec::new();
+    for kind in g.kind.values() {
+        let shape = kind.model().shape();
+        if let Ok(c) = complete_optimization(shape, n_max, limit) {
+            let e = evaluator.evaluate(
+                evaluate::Candidate {
+                    kind,
+                    n: c.n,
+                    rho: c.rho,
+                    drag: g.drag.values()[0],
+                },
+                "complete",
+            );
+            out.push(Best {
+                scope: format!("complete_{kind}"),
+                evaluation: e,
+            });
+        }
+        if let Ok((n, rho, _)) = best_per_n_optimum(shape, n_max, limit) {
+            let e = evaluator.evaluate(
+                evaluate::Candidate {
+                    kind,
+                    n,
+                    rho,
+                    drag: g.drag.values()[0],
+                },
+                "analytic",
+            );
+            out.push(Best {
+                scope: format!("per_n_{kind}"),
+                evaluation: e,
+            });
+        }
+    }
+    out
+}
+
+/// The best feasible evaluation (ties: the first).
+fn best_of(evals: &[Evaluation], objective: Objective) -> Option<Evaluation> {
+    let key = |e: &Evaluation| e.value.map(|v| if objective.maximise() { -v } else { v });
+    evals
+        .iter()
+        .filter(|e| e.feasible && e.value.is_some())
+        .min_by(|a, b| {
+            key(a)
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&key(b).unwrap_or(f64::INFINITY))
+        })
+        .cloned()
+}
+
+/// Evaluations as a DataFrame (one row each), with an optional scope column.
+pub fn evaluations_frame(
+    evals: &[Evaluation],
+    scopes: Option<&[String]>,
+) -> PolarsResult<DataFrame> {
+    let mut cols = Vec::new();
+    if let Some(s) = scopes {
+        cols.push(Column::new("scope".into(), s.to_vec()));
+    }
+    cols.extend([
+        Column::new(
+            "kind".into(),
+            evals
+                .iter()
+                .map(|e| e.candidate.kind.name().to_string())
+                .collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "n".into(),
+            evals.iter().map(|e| e.candidate.n).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "rho".into(),
+            evals.iter().map(|e| e.candidate.rho).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "drag".into(),
+            evals.iter().map(|e| e.candidate.drag).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "objective".into(),
+            evals.iter().map(|e| e.value).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "std_err".into(),
+            evals.iter().map(|e| e.std_err).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "capacity".into(),
+            evals.iter().map(|e| e.capacity).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "feasible".into(),
+            evals.iter().map(|e| e.feasible).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "constraint".into(),
+            evals
+                .iter()
+                .map(|e| e.constraint.clone())
+                .collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "phase".into(),
+            evals
+                .iter()
+                .map(|e| e.phase.to_string())
+                .collect::<Vec<_>>(),
+        ),
+    ]);
+    DataFrame::new(evals.len(), cols)
+}
+
+fn write_outputs(
+    plan: &StudyPlan,
+    dir: &std::path::Path,
+    evals: &[Evaluation],
+    best: &[Best],
+) -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all(dir)?;
+    let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
+    let mut all = evaluations_frame(evals, None)?;
+    write_parquet(&dir.join("optimize.parquet"), &mut all, &provenance)?;
+    let scopes: Vec<String> = best.iter().map(|b| b.scope.clone()).collect();
+    let chosen: Vec<Evaluation> = best.iter().map(|b| b.evaluation.clone()).collect();
+    let mut optimum = evaluations_frame(&chosen, Some(&scopes))?;
+    write_parquet(&dir.join("optimum.parquet"), &mut optimum, &provenance)?;
+    Ok(())
+}

@@ -1,0 +1,103 @@
+//! The `[optimize]` table of a study file: objective, free variables, bounds
+//! and constraints (documented in `docs/optimize.md`).
+
+use serde::{Deserialize, Serialize};
+
+/// What the optimiser maximises or minimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Objective {
+    /// Analytic dimensional capacity S_AB (maximised): Table 1 of seed 000.
+    Capacity,
+    /// Analytic transient measure ã (eqs 15/16, maximised).
+    ATilde,
+    /// Mean settling time in revolutions over a Monte Carlo sample (minimised;
+    /// runs that do not settle count as the full run length).
+    SettlingMean,
+    /// 90th percentile of the settling time in revolutions (minimised, same censoring).
+    SettlingP90,
+    /// Fraction of runs that settle (maximised).
+    SettledFraction,
+    /// Mean residual vibration relative to A_ref (minimised).
+    Residual,
+}
+
+impl Objective {
+    /// True when larger values are better.
+    pub fn maximise(self) -> bool {
+        matches!(
+            self,
+            Objective::Capacity | Objective::ATilde | Objective::SettledFraction
+        )
+    }
+
+    /// True when the value comes from simulation (and carries a Monte Carlo error).
+    pub fn simulated(self) -> bool {
+        !matches!(self, Objective::Capacity | Objective::ATilde)
+    }
+
+    /// snake_case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::Capacity => "capacity",
+            Objective::ATilde => "a_tilde",
+            Objective::SettlingMean => "settling_mean",
+            Objective::SettlingP90 => "settling_p90",
+            Objective::SettledFraction => "settled_fraction",
+            Objective::Residual => "residual",
+        }
+    }
+}
+
+/// A continuous design variable the optimiser may move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Variable {
+    /// Radius ratio ρ.
+    Rho,
+    /// Drag β.
+    Drag,
+}
+
+/// The `[optimize]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimizeSpec {
+    /// The objective.
+    pub objective: Objective,
+    /// Continuous variables: ["rho"] (Brent per kind and n) or ["rho", "drag"] (Nelder–Mead).
+    #[serde(default = "rho_only")]
+    pub free: Vec<Variable>,
+    /// Bounds on ρ (default: (0.02, ρ_max(n))).
+    #[serde(default)]
+    pub rho_bounds: Option<[f64; 2]>,
+    /// Bounds on β (N·s/m) when drag is free.
+    #[serde(default)]
+    pub drag_bounds: Option<[f64; 2]>,
+    /// Largest ρ the housing allows (a torus-shaped race limits the weight radius).
+    #[serde(default)]
+    pub housing_rho_max: Option<f64>,
+    /// Required capacity margin: capacity ≥ safety_factor × max_unbalance.
+    #[serde(default)]
+    pub safety_factor: Option<f64>,
+    /// Largest unbalance the machine meets (kg·m), for the capacity constraint.
+    #[serde(default)]
+    pub max_unbalance: Option<f64>,
+    /// Smallest weight count allowed (e.g. 3, as seed 000 recommends).
+    #[serde(default)]
+    pub min_n: Option<u32>,
+    /// Monte Carlo samples per candidate (default: `sampling.samples`).
+    #[serde(default)]
+    pub samples: Option<u32>,
+    /// Objective evaluations per (kind, n) at most.
+    #[serde(default = "default_evaluations")]
+    pub max_evaluations: u64,
+}
+
+fn rho_only() -> Vec<Variable> {
+    vec![Variable::Rho]
+}
+
+fn default_evaluations() -> u64 {
+    25
+}

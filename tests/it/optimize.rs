@@ -1,0 +1,190 @@
+//! `study optimize`: analytic optimum = Table 1, constraints, common random
+//! numbers, determinism; the paper's complete optimisation.
+
+use autobal::design::Shape;
+use autobal::design::complete::{complete_optimization, rho_excess_onset};
+use autobal::design::geometry::excess_weights;
+use autobal::design::optimum::optimal_rho;
+use autobal::model::balancer::Kind;
+use autobal::optimize::evaluate::{Candidate, Evaluator};
+use autobal::optimize::optimize;
+use autobal::study::config::{StudyFile, StudyPlan};
+use std::path::Path;
+
+fn plan(output: &Path, designs: &str, sampling: &str, optimize: &str) -> StudyPlan {
+    let text = format!(
+        r#"
+name = "opt"
+seed = 11
+output = "{}"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+race_radius = 0.05
+roller_height = 0.01
+{designs}
+[sampling]
+{sampling}
+[metrics]
+t_end_revs = 300
+[optimize]
+{optimize}
+"#,
+        output.display()
+    );
+    StudyFile::parse(&text, "opt.toml")
+        .unwrap()
+        .plan(&text, "opt.toml")
+        .unwrap()
+}
+
+const FIXED: &str = "samples = 1\nunbalance = { distribution = \"fixed\", value = 0.5 }";
+
+#[test]
+fn analytic_capacity_optimum_is_table_1() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = plan(
+        tmp.path(),
+        "kind = [\"ball\", \"roller\"]\nn = [1, 2, 3, 4, 5, 6, 7, 8]\nrho = \"optimal\"\ndrag = 10.0",
+        FIXED,
+        "objective = \"capacity\"",
+    );
+    let out = optimize(&p).unwrap();
+    for b in out.best.iter().filter(|b| {
+        b.scope.contains('_') && !b.scope.starts_with("complete") && !b.scope.starts_with("per_n")
+    }) {
+        let c = b.evaluation.candidate;
+        let want = optimal_rho(c.kind.model().shape(), c.n).unwrap().rho;
+        assert!(
+            (c.rho - want).abs() < 2e-3,
+            "{}: ρ {} vs Table 1 {want}",
+            b.scope,
+            c.rho
+        );
+    }
+    assert!(out.dir.join("optimize.parquet").exists() && out.dir.join("optimum.parquet").exists());
+}
+
+#[test]
+fn every_constraint_is_respected() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = plan(
+        tmp.path(),
+        "kind = \"ball\"\nn = [2, 3, 4, 5, 6]\nrho = \"optimal\"\ndrag = 10.0",
+        FIXED,
+        "objective = \"capacity\"\nhousing_rho_max = 0.27\nsafety_factor = 1.5\nmax_unbalance = 0.004\nmin_n = 3",
+    );
+    let out = optimize(&p).unwrap();
+    let ns: Vec<u32> = out.evaluations.iter().map(|e| e.candidate.n).collect();
+    assert!(ns.iter().all(|&n| n >= 3), "min_n");
+    for e in out.evaluations.iter().filter(|e| e.feasible) {
+        assert!(
+            e.candidate.rho <= 0.27 + 1e-12,
+            "housing: {}",
+            e.candidate.rho
+        );
+        assert!(
+            e.capacity.unwrap() >= 1.5 * 0.004,
+            "capacity {:?}",
+            e.capacity
+        );
+    }
+    // Some candidates were pushed against the capacity constraint and marked.
+    assert!(
+        out.evaluations
+            .iter()
+            .any(|e| !e.feasible && e.constraint.contains("capacity"))
+    );
+    for b in &out.best {
+        assert!(b.evaluation.feasible, "{}", b.scope);
+    }
+}
+
+#[test]
+fn common_random_numbers_rank_the_better_design_first() {
+    // In the fast regime (drag below the optimum) more drag settles faster.
+    let tmp = tempfile::tempdir().unwrap();
+    let p = plan(
+        tmp.path(),
+        "kind = \"ball\"\nn = 3\nrho = \"optimal\"\ndrag = 2.0",
+        "samples = 12\nunbalance = { distribution = \"uniform\", min = 0.002, max = 0.006, relative_to = \"absolute\" }\nrequire_balanceable = false",
+        "objective = \"settling_mean\"",
+    );
+    let spec = p.file.optimize.clone().unwrap();
+    let ev = Evaluator {
+        plan: &p,
+        spec: &spec,
+        samples: 12,
+    };
+    let at = |drag| {
+        ev.evaluate(
+            Candidate {
+                kind: Kind::Ball,
+                n: 3,
+                rho: 0.36,
+                drag,
+            },
+            "test",
+        )
+    };
+    let (slow, fast) = (at(2.0), at(8.0));
+    let (vs, vf) = (slow.value.unwrap(), fast.value.unwrap());
+    assert!(
+        vf < vs,
+        "β = 8 ({vf} ± {}) should beat β = 2 ({vs} ± {})",
+        fast.std_err,
+        slow.std_err
+    );
+    assert!(slow.std_err > 0.0 && fast.std_err > 0.0);
+    // The same candidate evaluates identically (same streams).
+    assert_eq!(at(2.0).value, slow.value);
+}
+
+#[test]
+fn optimisation_is_identical_for_any_thread_count() {
+    let run = |threads| {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = plan(
+            tmp.path(),
+            "kind = \"ball\"\nn = [3, 4]\nrho = \"optimal\"\ndrag = 10.0",
+            "samples = 8\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8 }",
+            "objective = \"settling_mean\"\nmax_evaluations = 8",
+        );
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| optimize(&p).unwrap()).evaluations
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn complete_optimisation_drops_weights_as_they_become_excess() {
+    let limit = optimal_rho(Shape::Ball, 3).unwrap().rho;
+    let c = complete_optimization(Shape::Ball, 10, limit).unwrap();
+    assert_eq!(c.n, 3);
+    assert_eq!(
+        excess_weights(c.n, c.rho).unwrap(),
+        0,
+        "final design has no excess weight"
+    );
+    assert!(
+        excess_weights(c.n + 1, c.rho).unwrap() > 0,
+        "one more weight would be excess"
+    );
+    // Stages hand over exactly where the outermost weight reaches the horizontal.
+    for w in c.stages.windows(2) {
+        assert_eq!(w[0].rho_to, w[1].rho_from);
+        assert_eq!(w[0].rho_to, rho_excess_onset(w[0].n).unwrap().unwrap());
+        assert_eq!(w[1].n, w[0].n - 1);
+    }
+    assert_eq!(c.stages.first().unwrap().n, 10);
+}
