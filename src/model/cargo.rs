@@ -29,6 +29,10 @@ pub struct Cargo {
     /// Index of the balancer plane the cargo runs in.
     #[serde(default)]
     pub plane: usize,
+    /// Radius r of the weight (m), for the optional contact effect; 0 for
+    /// cargoes that can pass each other (pendulums on separate arms, points).
+    #[serde(default)]
+    pub radius: f64,
 }
 
 impl Cargo {
@@ -52,6 +56,7 @@ impl Cargo {
             rolling_coupling: 0.0,
             rolling_inertia: 0.0,
             plane: 0,
+            radius: 0.0,
         }
     }
 }

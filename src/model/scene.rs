@@ -251,11 +251,13 @@ impl Scene {
     /// Validate and assemble the ODE system.
     pub fn build(&self) -> Result<RotorSystem, SceneError> {
         self.validate()?;
+        let cargo = self.cargoes()?;
+        let effects = self.effects.build(&cargo, self.speed.nominal_speed());
         Ok(RotorSystem::new(
             Box::new(self.rotor.clone()),
-            self.cargoes()?,
+            cargo,
             self.speed.clone(),
-            self.effects.build(),
+            effects,
         ))
     }
 }

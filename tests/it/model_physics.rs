@@ -301,13 +301,24 @@ fn vertical_axis_gravity_adds_no_term() {
         g: 9.81,
         axis_inclination_deg: 90.0,
     };
-    let effects = Effects { gravity: Some(g) };
-    assert!(effects.build().is_empty());
+    let effects = Effects {
+        gravity: Some(g),
+        ..Effects::default()
+    };
+    assert!(effects.build(&balls(2, 0.01, 0.01), 2.0).is_empty());
     let g = autobal::model::effect::gravity::Gravity {
         g: 9.81,
         axis_inclination_deg: 0.0,
     };
-    assert_eq!(Effects { gravity: Some(g) }.build().len(), 1);
+    assert_eq!(
+        Effects {
+            gravity: Some(g),
+            ..Effects::default()
+        }
+        .build(&balls(2, 0.01, 0.01), 2.0)
+        .len(),
+        1
+    );
     let system = Scene {
         rotor: rotor(),
         balancer: None,
@@ -319,4 +330,57 @@ fn vertical_axis_gravity_adds_no_term() {
     .unwrap();
     assert_eq!(system.dim(), 8);
     assert!(system.effect_names().is_empty());
+}
+
+#[test]
+fn weights_in_contact_carry_the_capacity_of_seed_000() {
+    // An unbalance beyond what the weights can cancel presses them together
+    // opposite it: with contact their total unbalance is then the capacity
+    // m l sin(nα)/sin α of eq 5; without contact they all meet in one point (n m l).
+    use autobal::design::capacity::cluster_factor;
+    use autobal::model::effect::contact::ContactSpec;
+    for (n, rho) in [(3_u32, 0.25), (4, 0.3), (5, 0.2)] {
+        let g = Geometry {
+            race_radius: 1.0,
+            rho,
+            density: 1.0,
+            roller_height: 0.0,
+            drag: 0.0,
+        };
+        let mut cargo = cargoes(Kind::Ball, n, &g).unwrap();
+        for c in &mut cargo {
+            c.drag = 0.5 * c.mass;
+        }
+        let ml = cargo[0].unbalance();
+        let start: Vec<f64> = (0..n).map(|j| 60.0 + 40.0 * f64::from(j)).collect();
+        let run = |contact: bool| {
+            let mut rotor = rotor();
+            rotor.eccentricity = 1.5 * f64::from(n) * ml / rotor.mass;
+            let mut sim = simulation(rotor, cargo.clone(), 4.0, &start);
+            sim.scene.effects.contact = contact.then(ContactSpec::default);
+            sim.metrics.t_end_revs = 300.0;
+            let m = sim.run(false).unwrap().metrics;
+            assert_eq!(m.outcome, Outcome::NotSettled, "{}", m.reason);
+            let psi: Vec<f64> = m
+                .final_rel_angles_deg
+                .iter()
+                .map(|a| a.to_radians())
+                .collect();
+            let (sx, sy) = psi
+                .iter()
+                .fold((0.0, 0.0), |(x, y), p| (x + ml * p.cos(), y + ml * p.sin()));
+            sx.hypot(sy)
+        };
+        let expected = ml * cluster_factor(n, rho).unwrap();
+        let with = run(true);
+        assert!(
+            (with / expected - 1.0).abs() < 0.01,
+            "n={n} ρ={rho}: {with} vs S_AB {expected}"
+        );
+        let without = run(false);
+        assert!(
+            (without / (f64::from(n) * ml) - 1.0).abs() < 0.01,
+            "n={n}: {without} vs n m l"
+        );
+    }
 }

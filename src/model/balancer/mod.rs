@@ -106,5 +106,6 @@ pub(crate) fn rolling_cargo(mass: f64, j: f64, geometry: &Geometry) -> Cargo {
         rolling_coupling: jc * ratio * (ratio + 1.0),
         rolling_inertia: jc * (ratio + 1.0) * (ratio + 1.0),
         plane: 0,
+        radius: r,
     }
 }

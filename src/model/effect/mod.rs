@@ -5,6 +5,7 @@
 //! To add an effect: write one file implementing [`Effect`], add its
 //! parameters to [`Effects`] and one line to [`Effects::build`].
 
+pub mod contact;
 pub mod gravity;
 
 use super::cargo::Cargo;
@@ -56,15 +57,25 @@ pub struct Effects {
     /// Gravity in the plane of the rotor (absent: none, e.g. a vertical axis).
     #[serde(default)]
     pub gravity: Option<gravity::Gravity>,
+    /// Contact between neighbouring weights of finite size (absent: weights
+    /// pass through each other, as the analytic theory assumes).
+    #[serde(default)]
+    pub contact: Option<contact::ContactSpec>,
 }
 
 impl Effects {
-    /// Build the enabled effects; an effect that would add nothing is left out.
-    pub fn build(&self) -> Vec<Box<dyn Effect>> {
+    /// Build the enabled effects for these cargoes at nominal speed `omega`;
+    /// an effect that would add nothing is left out.
+    pub fn build(&self, cargo: &[Cargo], omega: f64) -> Vec<Box<dyn Effect>> {
         let mut list: Vec<Box<dyn Effect>> = Vec::new();
         if let Some(g) = &self.gravity {
             if g.in_plane() != 0.0 {
                 list.push(Box::new(g.clone()));
+            }
+        }
+        if let Some(c) = &self.contact {
+            if let Some(effect) = contact::Contact::new(c, cargo, omega) {
+                list.push(Box::new(effect));
             }
         }
         list
