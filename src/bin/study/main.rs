@@ -3,6 +3,7 @@
 //! bad input).
 
 mod bench_cmd;
+mod claims_cmd;
 mod design_cmd;
 mod optimize_cmd;
 mod output;
@@ -37,6 +38,9 @@ enum Command {
     /// Optimise weight count, radius (and drag) for an analytic or simulated objective.
     #[command(after_help = optimize_cmd::EXAMPLES)]
     Optimize(optimize_cmd::OptimizeArgs),
+    /// Put seed 000's design claims to a virtual experiment and write a report.
+    #[command(after_help = claims_cmd::EXAMPLES)]
+    Claims(claims_cmd::ClaimsArgs),
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
@@ -66,6 +70,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Optimize(args) => optimize_cmd::run(&args),
+        Command::Claims(args) => claims_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
     };
     match result {

@@ -1,0 +1,44 @@
+//! `study claims`: the virtual experiment on seed 000's design claims.
+
+use crate::UserError;
+use autobal::claims::{report::render, run_claims};
+use autobal::study::config::load;
+use autobal::study::run::NoProgress;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study claims --help`.
+pub const EXAMPLES: &str = "Examples:
+  study claims studies/paper_claims.toml --report docs/paper-claims.md";
+
+/// Arguments of `study claims`.
+#[derive(Args)]
+pub struct ClaimsArgs {
+    /// Claims study file (rotor, race, kinds, n range, drag, sampling).
+    study: PathBuf,
+    /// Write the markdown report here (default: print it).
+    #[arg(long)]
+    report: Option<PathBuf>,
+}
+
+/// Run `study claims`.
+pub fn run(args: &ClaimsArgs) -> Result<(), UserError> {
+    let plan = load(&args.study)?;
+    let out = run_claims(&plan, &NoProgress).map_err(|e| UserError::internal(e.to_string()))?;
+    let command = format!(
+        "study claims {}{}",
+        args.study.display(),
+        args.report
+            .as_ref()
+            .map_or(String::new(), |r| format!(" --report {}", r.display()))
+    );
+    let text = render(&plan, &out, &command);
+    match &args.report {
+        Some(path) => {
+            autobal::study::io::write_text(path, &text)?;
+            eprintln!("wrote {}", path.display());
+        }
+        None => print!("{text}"),
+    }
+    Ok(())
+}
