@@ -188,3 +188,33 @@ fn complete_optimisation_drops_weights_as_they_become_excess() {
     }
     assert_eq!(c.stages.first().unwrap().n, 10);
 }
+
+#[test]
+fn nelder_mead_searches_rho_and_drag_within_bounds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = plan(
+        tmp.path(),
+        "kind = \"ball\"\nn = 3\nrho = \"optimal\"\ndrag = 3.0",
+        "samples = 6\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8 }",
+        "objective = \"settling_mean\"\nfree = [\"rho\", \"drag\"]\nrho_bounds = [0.2, 0.4]\ndrag_bounds = [1.0, 40.0]\nmax_evaluations = 24",
+    );
+    let out = optimize(&p).unwrap();
+    assert!(out.evaluations.iter().all(|e| e.phase == "nelder_mead"));
+    let best = &out
+        .best
+        .iter()
+        .find(|b| b.scope == "overall")
+        .unwrap()
+        .evaluation;
+    assert!(
+        (0.2..=0.4).contains(&best.candidate.rho) && (1.0..=40.0).contains(&best.candidate.drag)
+    );
+    // Starting from β = 3 (under-damped weights), the search moves to more drag.
+    let start = out.evaluations[0].value.unwrap();
+    assert!(
+        best.value.unwrap() <= start,
+        "{} vs start {start}",
+        best.value.unwrap()
+    );
+    assert!(best.candidate.drag > 3.0, "drag {}", best.candidate.drag);
+}
