@@ -2,9 +2,13 @@
 //! executed and measured. This is the executor for a single simulation; the
 //! study runner fans many of them out over threads.
 
-use crate::integrate::{Failure, Method, SolverOptions, Status, solve};
+use crate::integrate::{
+    Failure, Flow, Method, OdeSystem, SolverOptions, Status, Step, StepObserver, solve,
+};
 use crate::metrics::observer::{Series, SettlingObserver};
-use crate::metrics::{MetricOptions, RunMetrics};
+use crate::metrics::{MetricOptions, Outcome, RunMetrics};
+use crate::model::frame::{RotatingSystem, rotating_frame_obstacle};
+use crate::model::quasi_static::slow_mode;
 use crate::model::scene::{Scene, SceneError};
 use crate::model::start::{StartMode, initial_state};
 use crate::model::system::RotorSystem;
@@ -21,8 +25,12 @@ use std::f64::consts::PI;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
-    /// Integration method.
-    pub method: Method,
+    /// Formulation: analytic, rotating, full, or auto (rotating when exact for the scene).
+    pub fidelity: Fidelity,
+    /// Integration method: `auto` (dp5 in the inertial frame, radau5 in the
+    /// rotating frame, whose fixed point only an A-stable method can step
+    /// across in large steps), or `dp5`, `dop853`, `radau5`.
+    pub method: MethodChoice,
     /// Relative tolerance.
     pub rtol: f64,
     /// Absolute tolerance relative to the problem's scales (see above).
@@ -38,7 +46,8 @@ pub struct SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         SolverSettings {
-            method: Method::Dp5,
+            fidelity: Fidelity::Auto,
+            method: MethodChoice::Auto,
             rtol: 1e-6,
             atol: 1e-8,
             max_steps: 5_000_000,
@@ -86,7 +95,82 @@ pub fn scaled_atol(system: &RotorSystem, atol: f64, a_ref: f64, omega: f64) -> V
     v
 }
 
+/// The integrator a study asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MethodChoice {
+    /// dp5 for the inertial frame, radau5 for the rotating frame.
+    #[default]
+    Auto,
+    /// Dormand–Prince 5(4).
+    Dp5,
+    /// Dormand–Prince 8(5,3).
+    Dop853,
+    /// Radau IIA order 5.
+    Radau5,
+}
+
+impl MethodChoice {
+    /// The method for a run in the rotating (true) or inertial (false) frame.
+    pub fn resolve(self, rotating: bool) -> Method {
+        match self {
+            MethodChoice::Auto if rotating => Method::Radau5,
+            MethodChoice::Auto | MethodChoice::Dp5 => Method::Dp5,
+            MethodChoice::Dop853 => Method::Dop853,
+            MethodChoice::Radau5 => Method::Radau5,
+        }
+    }
+
+    /// snake_case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodChoice::Auto => "auto",
+            MethodChoice::Dp5 => "dp5",
+            MethodChoice::Dop853 => "dop853",
+            MethodChoice::Radau5 => "radau5",
+        }
+    }
+}
+
+/// Which formulation computes a run (the fidelity ladder, cheapest first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Fidelity {
+    /// Closed-form slow mode (quasi-static, `model::quasi_static`): microseconds,
+    /// a settling estimate ln(1/δ)/|Re λ| and nothing else.
+    Analytic,
+    /// Exact equations in the rotor-fixed frame: autonomous for isotropic
+    /// supports at constant speed without in-plane gravity.
+    Rotating,
+    /// Exact equations in the inertial frame: anything.
+    Full,
+    /// `rotating` when the scene allows it, `full` otherwise.
+    #[default]
+    Auto,
+}
+
+impl Fidelity {
+    /// snake_case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fidelity::Analytic => "analytic",
+            Fidelity::Rotating => "rotating",
+            Fidelity::Full => "full",
+            Fidelity::Auto => "auto",
+        }
+    }
+}
+
 impl Simulation {
+    /// The fidelity this run uses (`auto` resolved against the scene).
+    pub fn resolved_fidelity(&self) -> Fidelity {
+        match self.solver.fidelity {
+            Fidelity::Auto if rotating_frame_obstacle(&self.scene).is_none() => Fidelity::Rotating,
+            Fidelity::Auto => Fidelity::Full,
+            f => f,
+        }
+    }
+
     /// Build, integrate and measure the run; `record` keeps the sampled series.
     pub fn run(&self, record: bool) -> Result<RunResult, SceneError> {
         let system = self.scene.build()?;
@@ -100,23 +184,50 @@ impl Simulation {
         }
         let omega = self.scene.speed.nominal_speed();
         let y0 = initial_state(&system, self.start, &self.initial_angles);
-        let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
-        let method = self.solver.method;
-        let explicit = method != Method::Radau5;
-        let attempt = |method: Method| {
-            let mut observer = SettlingObserver::new(&system, omega, self.metrics.clone(), record);
-            let options = SolverOptions {
-                rtol: self.solver.rtol,
-                atol: scaled_atol(&system, self.solver.atol, observer.a_ref(), omega),
-                h0: None,
-                h_max: f64::INFINITY,
-                max_steps: self.solver.max_steps,
-                detect_stiffness: explicit && self.solver.implicit_fallback,
-            };
-            let report = solve(method, &system, 0.0, &y0, t_end, &options, &mut observer);
-            (report, observer)
+        let fidelity = self.resolved_fidelity();
+        let (mut metrics, series) = match fidelity {
+            Fidelity::Analytic => (self.analytic(&system, omega), None),
+            Fidelity::Rotating => {
+                let rotating = RotatingSystem::new(&self.scene)?;
+                let nq = system.layout().nq();
+                let [u, ud, v, vd] = rotating.from_inertial(0.0, y0[0], y0[nq], y0[1], y0[nq + 1]);
+                let mut z0 = y0.clone();
+                (z0[0], z0[1], z0[nq], z0[nq + 1]) = (u, v, ud, vd);
+                self.integrate(&rotating, &system, &z0, Some(omega), record)
+            }
+            Fidelity::Full | Fidelity::Auto => self.integrate(&system, &system, &y0, None, record),
         };
-        let (report, observer) = attempt(method);
+        metrics.fidelity = fidelity.name().to_string();
+        Ok(RunResult { metrics, series })
+    }
+
+    /// Integrate `ode` (whose state has the layout of `system`), switching to
+    /// Radau5 when an explicit method stalls; `frame` is ω for the rotating frame.
+    fn integrate<S: OdeSystem>(
+        &self,
+        ode: &S,
+        system: &RotorSystem,
+        y0: &[f64],
+        frame: Option<f64>,
+        record: bool,
+    ) -> (RunMetrics, Option<Series>) {
+        let omega = self.scene.speed.nominal_speed();
+        let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
+        let method = self.solver.method.resolve(frame.is_some());
+        let explicit = method != Method::Radau5;
+        let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);
+        if let Some(w) = frame {
+            observer = observer.in_rotating_frame(w);
+        }
+        let options = SolverOptions {
+            rtol: self.solver.rtol,
+            atol: scaled_atol(system, self.solver.atol, observer.a_ref(), omega),
+            h0: None,
+            h_max: f64::INFINITY,
+            max_steps: self.solver.max_steps,
+            detect_stiffness: explicit && self.solver.implicit_fallback,
+        };
+        let report = solve(method, ode, 0.0, y0, t_end, &options, &mut observer);
         let stalled = matches!(
             &report.status,
             Status::Failed(
@@ -125,24 +236,103 @@ impl Simulation {
                     | Failure::StepSizeUnderflow { .. }
             )
         );
-        let (metrics, series) = if explicit && self.solver.implicit_fallback && stalled {
-            let why = match &report.status {
-                Status::Failed(f) => f.to_string(),
-                _ => String::new(),
-            };
-            let (retry, observer) = attempt(Method::Radau5);
-            let (mut metrics, series) = observer.finish(&retry);
-            metrics.method = format!("{}→{}", method.name(), Method::Radau5.name());
-            metrics.reason = format!("{} (switched to radau5: {why})", metrics.reason);
-            metrics.steps += report.stats.steps;
-            metrics.rhs_calls += report.stats.rhs_calls;
-            (metrics, series)
-        } else {
+        if !(explicit && self.solver.implicit_fallback && stalled) {
             let (mut metrics, series) = observer.finish(&report);
             metrics.method = method.name().to_string();
-            (metrics, series)
+            return (metrics, series);
+        }
+        // Continue from where the explicit method stalled with Radau5; the
+        // observer keeps its samples, so the run's metrics are seamless.
+        let why = match &report.status {
+            Status::Failed(f) => f.to_string(),
+            _ => String::new(),
         };
-        Ok(RunResult { metrics, series })
+        let rest = solve(
+            Method::Radau5,
+            ode,
+            report.t,
+            &report.y,
+            t_end,
+            &options,
+            &mut Continuation(&mut observer),
+        );
+        let (mut metrics, series) = observer.finish(&rest);
+        metrics.method = format!("{}→{}", method.name(), Method::Radau5.name());
+        metrics.reason = format!(
+            "{} (switched to radau5 at t = {:.4}: {why})",
+            metrics.reason, report.t
+        );
+        metrics.steps += report.stats.steps;
+        metrics.rhs_calls += report.stats.rhs_calls;
+        (metrics, series)
+    }
+
+    /// The closed-form estimate: settled when the slow mode decays, with
+    /// t_s = ln(1/δ)/|Re λ|; no residual, no steps.
+    fn analytic(&self, system: &RotorSystem, omega: f64) -> RunMetrics {
+        let rev = 2.0 * PI / omega;
+        let a_ref = crate::metrics::reference::a_ref(system, omega);
+        let base = RunMetrics {
+            settled: false,
+            settling_time: None,
+            settling_revs: None,
+            settling_time_err: 0.0,
+            settling_time_eps: None,
+            hold_complete: false,
+            residual_abs: 0.0,
+            residual_rel: 0.0,
+            a_ref,
+            balancing_error: 0.0,
+            peak_r: 0.0,
+            final_rel_angles_deg: Vec::new(),
+            p_final: 0.0,
+            outcome: Outcome::NotSettled,
+            reason: String::new(),
+            t_final: 0.0,
+            steps: 0,
+            rhs_calls: 0,
+            method: "closed_form".into(),
+            fidelity: String::new(),
+        };
+        match slow_mode(&self.scene) {
+            Ok(mode) if mode.decay_rate < 0.0 => {
+                let t = (1.0 / self.metrics.delta).ln() / -mode.decay_rate;
+                RunMetrics {
+                    settled: true,
+                    settling_time: Some(t),
+                    settling_revs: Some(t / rev),
+                    hold_complete: true,
+                    p_final: mode.p,
+                    outcome: Outcome::Settled,
+                    reason: format!(
+                        "analytic estimate ln(1/δ)/|Re λ| with λ = {:.4e} 1/s at p = {:.3}",
+                        mode.decay_rate, mode.p
+                    ),
+                    ..base
+                }
+            }
+            Ok(mode) => RunMetrics {
+                p_final: mode.p,
+                reason: format!(
+                    "analytic: the slow mode does not decay (Re λ = {:.3e})",
+                    mode.decay_rate
+                ),
+                ..base
+            },
+            Err(e) => RunMetrics {
+                reason: format!("analytic: {e}"),
+                ..base
+            },
+        }
+    }
+}
+
+/// Passes a continued run's steps to an observer that already saw its start.
+struct Continuation<'a, O: StepObserver>(&'a mut O);
+
+impl<O: StepObserver> StepObserver for Continuation<'_, O> {
+    fn step(&mut self, step: &Step<'_>) -> Flow {
+        self.0.step(step)
     }
 }
 

@@ -122,4 +122,6 @@ pub struct RunMetrics {
     pub rhs_calls: u64,
     /// Integrator that produced the result ("dp5", or "dp5→radau5" after an automatic switch).
     pub method: String,
+    /// Formulation that produced it ("rotating", "full", "analytic").
+    pub fidelity: String,
 }

@@ -76,9 +76,17 @@ pub struct SettlingObserver<'a> {
     peak_r: f64,
     diverged: Option<String>,
     series: Option<Series>,
+    frame: Option<f64>,
 }
 
 impl<'a> SettlingObserver<'a> {
+    /// The state holds rotor-frame (u, v) turning at `omega`: r and ε are the
+    /// same, the recorded (x, y) are turned back to the inertial frame.
+    pub fn in_rotating_frame(mut self, omega: f64) -> Self {
+        self.frame = Some(omega);
+        self
+    }
+
     /// An observer for `system` running at nominal speed `omega`.
     pub fn new(system: &'a RotorSystem, omega: f64, options: MetricOptions, record: bool) -> Self {
         let rev = 2.0 * PI / omega;
@@ -106,6 +114,7 @@ impl<'a> SettlingObserver<'a> {
                 psi: vec![Vec::new(); system.cargo().len()],
                 ..Series::default()
             }),
+            frame: None,
             options,
         }
     }
@@ -142,8 +151,16 @@ impl<'a> SettlingObserver<'a> {
             .update(t, eps <= self.options.delta, self.window);
         if let Some(series) = &mut self.series {
             series.t.push(t);
-            series.x.push(y[0]);
-            series.y.push(y[1]);
+            // The rotating frame integrates (u, v): report inertial (x, y).
+            let (x, yy) = match self.frame {
+                Some(w) => {
+                    let (s, c) = (w * t).sin_cos();
+                    (y[0] * c - y[1] * s, y[0] * s + y[1] * c)
+                }
+                None => (y[0], y[1]),
+            };
+            series.x.push(x);
+            series.y.push(yy);
             series.r.push(r);
             series.eps.push(eps);
             for (j, p) in psi.iter().enumerate() {
@@ -234,6 +251,7 @@ impl<'a> SettlingObserver<'a> {
             steps: report.stats.steps,
             rhs_calls: report.stats.rhs_calls,
             method: String::new(),
+            fidelity: String::new(),
         };
         (metrics, self.series)
     }

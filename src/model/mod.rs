@@ -12,7 +12,9 @@
 pub mod balancer;
 pub mod cargo;
 pub mod effect;
+pub mod frame;
 pub mod invariants;
+pub mod quasi_static;
 pub mod rotor;
 pub mod scene;
 pub mod speed;

@@ -103,6 +103,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("steps", |r: &RunRecord| r.metrics.steps),
         col!("rhs_calls", |r: &RunRecord| r.metrics.rhs_calls),
         col!("method", |r: &RunRecord| r.method.clone()),
+        col!("fidelity", |r: &RunRecord| r.metrics.fidelity.clone()),
         col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
     ];
     DataFrame::new(rows.len(), columns)
@@ -211,6 +212,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
         req("t_final")?,
     );
     let (steps, rhs, wall) = (u64s("steps")?, u64s("rhs_calls")?, req("wall_time_s")?);
+    let fidelity = strs("fidelity")?;
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -248,6 +250,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 steps: steps[i],
                 rhs_calls: rhs[i],
                 method: method[i].clone(),
+                fidelity: fidelity[i].clone(),
             },
             method: method[i].clone(),
             wall_time_s: wall[i],

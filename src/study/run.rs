@@ -251,6 +251,7 @@ fn failed(reason: String) -> RunMetrics {
         steps: 0,
         rhs_calls: 0,
         method: String::new(),
+        fidelity: String::new(),
     }
 }
 

@@ -68,6 +68,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             steps: 100,
             rhs_calls: 600,
             method: "dp5".into(),
+            fidelity: "full".into(),
         },
         method: "dp5".into(),
         wall_time_s: 0.001,

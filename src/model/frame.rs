@@ -1,0 +1,190 @@
+//! The exact nonlinear equations of the plane rotor written in the frame that
+//! turns with the rotor (the `rotating` fidelity).
+//!
+//! With isotropic supports (k_x = k_y = k, b_x = b_y = b), constant speed ω and
+//! no gravity in the plane, these equations are autonomous: the balanced state
+//! is a fixed point and, once the transient has died, the integrator's step is
+//! no longer tied to the revolution. With w = u + i v = (x + i y) e^{−iωt}:
+//!
+//!   M_Σ (ẅ + 2iωẇ − ω²w) + b (ẇ + iωw) + k w + Σ̂'' + 2iωΣ̂' − ω²Σ̂ = 0,
+//!   κ_j m_j l_j² ψ̈_j + β_j l_j² ψ̇_j + m_j l_j Im[(ẅ + 2iωẇ − ω²w) e^{−iψ_j}] = 0,
+//!
+//! where Σ̂ = M e e^{iψ₀} + Σ m_j l_j e^{iψ_j} is the total unbalance seen from
+//! the rotor. These are the inertial equations of [`super::system`] with
+//! z̈ = e^{iωt}(ẅ + 2iωẇ − ω²w): the same arrowhead, the same O(n) elimination.
+//! r = |w| and ε are frame-independent, so metrics compare directly.
+
+use super::cargo::Cargo;
+use super::effect::{Effect, EffectContext, Forces};
+use super::rotor::PlaneRotor;
+use super::scene::{Scene, SceneError};
+use super::speed::SpeedLaw;
+use crate::integrate::OdeSystem;
+
+/// Why a scene cannot use the rotating frame.
+pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
+    let r = &scene.rotor;
+    if r.kx != r.ky || r.bx != r.by {
+        return Some("anisotropic supports make the rotating-frame equations time-dependent");
+    }
+    if !matches!(scene.speed, SpeedLaw::Constant { .. }) {
+        return Some("the speed is not constant");
+    }
+    if scene
+        .effects
+        .gravity
+        .as_ref()
+        .is_some_and(|g| g.in_plane() != 0.0)
+    {
+        return Some("gravity in the plane turns in the rotating frame");
+    }
+    None
+}
+
+/// The plane rotor with cargoes in the rotor-fixed frame, as an [`OdeSystem`].
+///
+/// State: [u, v, ψ_1..ψ_n, u̇, v̇, ψ̇_1..ψ̇_n], the same layout as the inertial
+/// constant-speed system with (x, y) replaced by (u, v).
+#[derive(Debug)]
+pub struct RotatingSystem {
+    omega: f64,
+    m_total: f64,
+    k: f64,
+    b: f64,
+    /// M e ω² e^{iψ₀}: the rotor's centrifugal force, constant in this frame.
+    unbalance_force: (f64, f64),
+    cargo: Vec<Cargo>,
+    inertia: Vec<f64>,
+    effects: Vec<Box<dyn Effect>>,
+    rotor_unbalance: (f64, f64),
+}
+
+impl RotatingSystem {
+    /// Build from a scene; errors when the scene cannot use this frame.
+    pub fn new(scene: &Scene) -> Result<Self, SceneError> {
+        scene.validate()?;
+        if let Some(why) = rotating_frame_obstacle(scene) {
+            return Err(SceneError::Invalid {
+                field: "solver.fidelity".into(),
+                value: "rotating".into(),
+                reason: why.into(),
+            });
+        }
+        let SpeedLaw::Constant { omega } = scene.speed else {
+            unreachable!("checked above")
+        };
+        let cargo = scene.cargoes()?;
+        let r: &PlaneRotor = &scene.rotor;
+        let me = r.mass * r.eccentricity;
+        let (s, c) = r.unbalance_angle.sin_cos();
+        let effects = scene.effects.build(&cargo, omega);
+        Ok(RotatingSystem {
+            omega,
+            m_total: r.mass + cargo.iter().map(|c| c.mass).sum::<f64>(),
+            k: r.kx,
+            b: r.bx,
+            unbalance_force: (me * omega * omega * c, me * omega * omega * s),
+            inertia: cargo.iter().map(Cargo::inertia).collect(),
+            cargo,
+            effects,
+            rotor_unbalance: (me, r.unbalance_angle),
+        })
+    }
+
+    /// The constant spin speed ω.
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// Rotating-frame state (u, u̇, v, v̇) from the inertial (x, ẋ, y, ẏ) at time t.
+    pub fn from_inertial(&self, t: f64, x: f64, xd: f64, y: f64, yd: f64) -> [f64; 4] {
+        let (s, c) = (self.omega * t).sin_cos();
+        // ẇ = (ż − iω z) e^{−iωt}
+        let (zr, zi) = (xd + self.omega * y, yd - self.omega * x);
+        [
+            x * c + y * s,
+            zr * c + zi * s,
+            -x * s + y * c,
+            -zr * s + zi * c,
+        ]
+    }
+}
+
+impl OdeSystem for RotatingSystem {
+    fn dim(&self) -> usize {
+        2 * (2 + self.cargo.len())
+    }
+
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let n = self.cargo.len();
+        let nq = 2 + n;
+        let (q, qd) = y.split_at(nq);
+        dydt[..nq].copy_from_slice(qd);
+        let (u, v, ud, vd) = (q[0], q[1], qd[0], qd[1]);
+        let w = self.omega;
+        // Frame acceleration of the plane without ẅ: 2iωẇ − ω²w.
+        let (fr, fi) = (-2.0 * w * vd - w * w * u, 2.0 * w * ud - w * w * v);
+        // Head right-hand side G (see the module docs).
+        let mut gr =
+            -self.m_total * fr - self.b * (ud - w * v) - self.k * u + self.unbalance_force.0;
+        let mut gi =
+            -self.m_total * fi - self.b * (vd + w * u) - self.k * v + self.unbalance_force.1;
+        let psi = &q[2..];
+        let psi_rate = &qd[2..];
+        let cargo_f = &mut dydt[nq + 2..];
+        for (j, c) in self.cargo.iter().enumerate() {
+            cargo_f[j] = -c.drag * c.track_radius * c.track_radius * psi_rate[j];
+        }
+        if !self.effects.is_empty() {
+            let ctx = EffectContext {
+                t,
+                phi: 0.0,
+                spin_rate: w,
+                spin_free: false,
+                cargo: &self.cargo,
+                psi,
+                psi_rate,
+                rotor_unbalance: self.rotor_unbalance,
+            };
+            let (mut rotor_f, mut spin_f) = ([0.0; super::rotor::MAX_DOF], 0.0);
+            let mut forces = Forces {
+                rotor: &mut rotor_f,
+                spin: &mut spin_f,
+                cargo: cargo_f,
+            };
+            for e in &self.effects {
+                e.apply(&ctx, &mut forces);
+            }
+            gr += rotor_f[0];
+            gi += rotor_f[1];
+        }
+        let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = psi[j].sin_cos();
+            let ml = c.mass * c.track_radius;
+            let rate = w + psi_rate[j];
+            gr += ml * rate * rate * co;
+            gi += ml * rate * rate * s;
+            // Cargo row: I ψ̈ + (−ml s, ml co)·a = Q − ml Im[(fr + i fi) e^{−iψ}].
+            let q = cargo_f[j] - ml * (fi * co - fr * s);
+            cargo_f[j] = q;
+            let (wr, wi) = (-ml * s, ml * co);
+            let inv = 1.0 / self.inertia[j];
+            a11 -= wr * wr * inv;
+            a12 -= wr * wi * inv;
+            a22 -= wi * wi * inv;
+            gr -= wr * q * inv;
+            gi -= wi * q * inv;
+        }
+        let det = a11 * a22 - a12 * a12;
+        let ar = (gr * a22 - gi * a12) / det;
+        let ai = (gi * a11 - gr * a12) / det;
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = psi[j].sin_cos();
+            let ml = c.mass * c.track_radius;
+            cargo_f[j] = (cargo_f[j] - ml * (co * ai - s * ar)) / self.inertia[j];
+        }
+        dydt[nq] = ar;
+        dydt[nq + 1] = ai;
+    }
+}
