@@ -26,3 +26,4 @@ pub mod optimize;
 pub mod scene_file;
 pub mod simulation;
 pub mod study;
+pub mod tradeoff;

@@ -9,6 +9,7 @@ mod optimize_cmd;
 mod output;
 mod run_cmd;
 mod simulate_cmd;
+mod tradeoff_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -41,6 +42,9 @@ enum Command {
     /// Put seed 000's design claims to a virtual experiment and write a report.
     #[command(after_help = claims_cmd::EXAMPLES)]
     Claims(claims_cmd::ClaimsArgs),
+    /// Measure speed against accuracy for every fidelity and tolerance on a study's runs.
+    #[command(after_help = tradeoff_cmd::EXAMPLES)]
+    Tradeoff(tradeoff_cmd::TradeoffArgs),
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
@@ -71,6 +75,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Optimize(args) => optimize_cmd::run(&args),
         Command::Claims(args) => claims_cmd::run(&args),
+        Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
     };
     match result {

@@ -1,0 +1,86 @@
+//! `study tradeoff`: work-precision of every fidelity and tolerance.
+
+use crate::UserError;
+use crate::output::text_table;
+use autobal::study::config::load;
+use autobal::tradeoff::{measure, recommend, spread_runs, summarize, write};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study tradeoff --help`.
+pub const EXAMPLES: &str = "Examples:
+  study tradeoff studies/three_balls.toml --runs 12 --budget-revs 1
+  study tradeoff studies/gravity_horizontal.toml --runs 4";
+
+/// Arguments of `study tradeoff`.
+#[derive(Args)]
+pub struct TradeoffArgs {
+    /// Study file.
+    study: PathBuf,
+    /// How many of the study's runs to measure (spread evenly over designs).
+    #[arg(long, default_value_t = 12)]
+    runs: u64,
+    /// Error budget: largest acceptable settling-time error (revolutions).
+    #[arg(long, default_value_t = 1.0)]
+    budget_revs: f64,
+}
+
+/// Run `study tradeoff`.
+pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
+    if !(args.budget_revs.is_finite() && args.budget_revs > 0.0) {
+        return Err(UserError(
+            format!("--budget-revs {}: must be positive", args.budget_revs),
+            2,
+        ));
+    }
+    if args.runs == 0 {
+        return Err(UserError("--runs 0: need at least one run".into(), 2));
+    }
+    let plan = load(&args.study)?;
+    let rows = measure(&plan, &spread_runs(&plan, args.runs));
+    let path = write(&plan, &rows).map_err(|e| UserError::internal(e.to_string()))?;
+    let summary = summarize(&rows);
+    let f = |v: Option<f64>| v.map_or("–".into(), |x| format!("{x:.3}"));
+    let table: Vec<Vec<String>> = summary
+        .iter()
+        .map(|s| {
+            vec![
+                s.setting.label(),
+                f(s.median_error_revs),
+                f(s.max_error_revs),
+                format!("{:.0} %", 100.0 * s.outcome_agreement),
+                format!("{:.0}", s.mean_rhs_calls),
+                format!("{:.3}", 1e3 * s.mean_wall_time_s),
+            ]
+        })
+        .collect();
+    print!(
+        "{}",
+        text_table(
+            &[
+                "setting",
+                "median |Δt_s| rev",
+                "max |Δt_s| rev",
+                "outcome agrees",
+                "RHS calls",
+                "ms/run"
+            ],
+            &table
+        )
+    );
+    match recommend(&summary, args.budget_revs) {
+        Some(best) => println!(
+            "recommended within {} rev: {} ({:.3} ms/run, {:.0} RHS calls)",
+            args.budget_revs,
+            best.setting.label(),
+            1e3 * best.mean_wall_time_s,
+            best.mean_rhs_calls
+        ),
+        None => println!(
+            "no setting stays within {} rev on every measured run",
+            args.budget_revs
+        ),
+    }
+    eprintln!("reference: full/dop853/1e-11; wrote {}", path.display());
+    Ok(())
+}

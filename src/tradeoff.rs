@@ -1,0 +1,326 @@
+//! `study tradeoff`: what each fidelity and tolerance costs and how far its
+//! answers are from a reference, on a sample of a study's runs.
+//!
+//! Reference: the inertial (`full`) equations with DOP853 at rtol 1e-11. Each
+//! setting is measured on the same runs; errors are per run (settling time in
+//! revolutions, residual vibration in units of A_ref, final cargo angles,
+//! outcome class), costs are wall time and right-hand-side calls.
+
+use crate::integrate::Method;
+use crate::metrics::RunMetrics;
+use crate::model::frame::rotating_frame_obstacle;
+use crate::simulation::{Fidelity, MethodChoice, Simulation};
+use crate::study::config::StudyPlan;
+use crate::study::io::{Provenance, write_parquet};
+use crate::study::sample::draw_sample;
+use polars::prelude::*;
+use serde::Serialize;
+use std::time::Instant;
+
+/// One fidelity/method/tolerance combination.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Setting {
+    /// Formulation.
+    pub fidelity: Fidelity,
+    /// Integrator.
+    pub method: MethodChoice,
+    /// Relative tolerance (0 for the analytic estimate).
+    pub rtol: f64,
+}
+
+impl Setting {
+    /// "rotating/radau5/1e-6".
+    pub fn label(&self) -> String {
+        if self.fidelity == Fidelity::Analytic {
+            "analytic".into()
+        } else {
+            format!(
+                "{}/{}/{:.0e}",
+                self.fidelity.name(),
+                self.method.name(),
+                self.rtol
+            )
+        }
+    }
+}
+
+/// One run measured at one setting, against the reference.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TradeoffRow {
+    /// Run index in the study.
+    pub run_id: u64,
+    /// The setting.
+    pub setting: Setting,
+    /// Settling time (revolutions), if settled.
+    pub settling_revs: Option<f64>,
+    /// |t_s − t_s,ref| in revolutions, when both settled.
+    pub settling_error_revs: Option<f64>,
+    /// |residual − residual_ref| in units of A_ref.
+    pub residual_error: f64,
+    /// Largest difference of the sorted final cargo angles (degrees).
+    pub angle_error_deg: Option<f64>,
+    /// True when the outcome class equals the reference's.
+    pub outcome_agrees: bool,
+    /// Right-hand-side calls.
+    pub rhs_calls: u64,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+    /// Integrator actually used (after any automatic switch).
+    pub method_used: String,
+}
+
+/// One line of the work-precision table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SettingSummary {
+    /// The setting.
+    pub setting: Setting,
+    /// Median |Δt_s| over the runs where both settled (revolutions).
+    pub median_error_revs: Option<f64>,
+    /// Largest |Δt_s| (revolutions).
+    pub max_error_revs: Option<f64>,
+    /// Fraction of runs whose outcome class matches the reference.
+    pub outcome_agreement: f64,
+    /// Mean right-hand-side calls per run.
+    pub mean_rhs_calls: f64,
+    /// Mean wall time per run (s).
+    pub mean_wall_time_s: f64,
+}
+
+/// The settings swept: analytic; each applicable frame with its default
+/// method at rtol 1e-3 … 1e-10; and DOP853 in the inertial frame.
+pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
+    let mut v = vec![Setting {
+        fidelity: Fidelity::Analytic,
+        method: MethodChoice::Auto,
+        rtol: 0.0,
+    }];
+    let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
+    let mut frames = vec![
+        (Fidelity::Full, MethodChoice::Dp5),
+        (Fidelity::Full, MethodChoice::Dop853),
+    ];
+    if rotating_frame_obstacle(&probe).is_none() {
+        frames.push((Fidelity::Rotating, MethodChoice::Radau5));
+        frames.push((Fidelity::Rotating, MethodChoice::Dp5));
+    }
+    for (fidelity, method) in frames {
+        for e in 3..=10 {
+            v.push(Setting {
+                fidelity,
+                method,
+                rtol: 10f64.powi(-e),
+            });
+        }
+    }
+    v
+}
+
+/// Run `run_id` of the plan at a setting (early stop as the study says).
+fn simulate(plan: &StudyPlan, run_id: u64, setting: Setting) -> (RunMetrics, f64) {
+    let samples = u64::from(plan.file.sampling.samples);
+    let design = &plan.designs[(run_id / samples) as usize];
+    let sample = draw_sample(plan, design, run_id % samples);
+    let mut solver = plan.file.solver.clone();
+    solver.fidelity = setting.fidelity;
+    solver.method = setting.method;
+    if setting.rtol > 0.0 {
+        solver.rtol = setting.rtol;
+        solver.atol = setting.rtol * 1e-2;
+    }
+    let sim = Simulation {
+        scene: plan.scene(design, sample.unbalance, sample.direction),
+        start: plan.file.scene.start,
+        initial_angles: sample.initial_angles,
+        solver,
+        metrics: plan.file.metrics.clone(),
+    };
+    let clock = Instant::now();
+    let metrics = match sim.run(false) {
+        Ok(r) => r.metrics,
+        Err(e) => panic!("the plan validated every scene: {e}"),
+    };
+    (metrics, clock.elapsed().as_secs_f64())
+}
+
+fn sorted_angles(m: &RunMetrics) -> Vec<f64> {
+    let mut v = m.final_rel_angles_deg.clone();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// Measure every setting on `runs` of the plan (run indices), serially so
+/// that wall times are comparable.
+pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
+    let reference = Setting {
+        fidelity: Fidelity::Full,
+        method: MethodChoice::Dop853,
+        rtol: 1e-11,
+    };
+    let mut rows = Vec::new();
+    for &run_id in runs {
+        let (reference, _) = simulate(plan, run_id, reference);
+        let ref_angles = sorted_angles(&reference);
+        for setting in settings(plan) {
+            let (m, wall) = simulate(plan, run_id, setting);
+            let settling_error_revs = match (m.settling_revs, reference.settling_revs) {
+                (Some(a), Some(b)) => Some((a - b).abs()),
+                _ => None,
+            };
+            let angles = sorted_angles(&m);
+            let angle_error_deg =
+                (angles.len() == ref_angles.len() && !angles.is_empty()).then(|| {
+                    angles
+                        .iter()
+                        .zip(&ref_angles)
+                        .map(|(a, b)| {
+                            let d = (a - b).rem_euclid(360.0);
+                            d.min(360.0 - d)
+                        })
+                        .fold(0.0, f64::max)
+                });
+            rows.push(TradeoffRow {
+                run_id,
+                setting,
+                settling_revs: m.settling_revs,
+                settling_error_revs,
+                residual_error: (m.residual_rel - reference.residual_rel).abs(),
+                angle_error_deg,
+                outcome_agrees: m.outcome == reference.outcome,
+                rhs_calls: m.rhs_calls,
+                wall_time_s: wall,
+                method_used: if m.method.is_empty() {
+                    Method::Dp5.name().into()
+                } else {
+                    m.method.clone()
+                },
+            });
+        }
+    }
+    rows
+}
+
+/// Aggregate rows per setting, in sweep order.
+pub fn summarize(rows: &[TradeoffRow]) -> Vec<SettingSummary> {
+    let mut out: Vec<SettingSummary> = Vec::new();
+    let mut seen: Vec<Setting> = Vec::new();
+    for r in rows {
+        if !seen.contains(&r.setting) {
+            seen.push(r.setting);
+        }
+    }
+    for s in seen {
+        let mine: Vec<&TradeoffRow> = rows.iter().filter(|r| r.setting == s).collect();
+        let mut errs: Vec<f64> = mine.iter().filter_map(|r| r.settling_error_revs).collect();
+        errs.sort_by(f64::total_cmp);
+        let n = mine.len() as f64;
+        out.push(SettingSummary {
+            setting: s,
+            median_error_revs: (!errs.is_empty()).then(|| errs[errs.len() / 2]),
+            max_error_revs: errs.last().copied(),
+            outcome_agreement: mine.iter().filter(|r| r.outcome_agrees).count() as f64 / n,
+            mean_rhs_calls: mine.iter().map(|r| r.rhs_calls as f64).sum::<f64>() / n,
+            mean_wall_time_s: mine.iter().map(|r| r.wall_time_s).sum::<f64>() / n,
+        });
+    }
+    out
+}
+
+/// The cheapest setting (by mean wall time) whose largest settling error is
+/// within `budget_revs` and whose outcomes all agree with the reference.
+pub fn recommend(summary: &[SettingSummary], budget_revs: f64) -> Option<&SettingSummary> {
+    summary
+        .iter()
+        .filter(|s| {
+            s.outcome_agreement == 1.0 && s.max_error_revs.is_some_and(|e| e <= budget_revs)
+        })
+        .min_by(|a, b| a.mean_wall_time_s.total_cmp(&b.mean_wall_time_s))
+}
+
+/// The rows as a DataFrame (the columns `study plot tradeoff` reads).
+pub fn rows_frame(rows: &[TradeoffRow]) -> PolarsResult<DataFrame> {
+    DataFrame::new(
+        rows.len(),
+        vec![
+            Column::new(
+                "run_id".into(),
+                rows.iter().map(|r| r.run_id).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "fidelity".into(),
+                rows.iter()
+                    .map(|r| r.setting.fidelity.name().to_string())
+                    .collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "method".into(),
+                rows.iter()
+                    .map(|r| r.setting.method.name().to_string())
+                    .collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "method_used".into(),
+                rows.iter()
+                    .map(|r| r.method_used.clone())
+                    .collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "rtol".into(),
+                rows.iter().map(|r| r.setting.rtol).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "settling_revs".into(),
+                rows.iter().map(|r| r.settling_revs).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "settling_error_revs".into(),
+                rows.iter()
+                    .map(|r| r.settling_error_revs)
+                    .collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "residual_error".into(),
+                rows.iter().map(|r| r.residual_error).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "angle_error_deg".into(),
+                rows.iter().map(|r| r.angle_error_deg).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "outcome_agrees".into(),
+                rows.iter().map(|r| r.outcome_agrees).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "rhs_calls".into(),
+                rows.iter().map(|r| r.rhs_calls).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "wall_time_s".into(),
+                rows.iter().map(|r| r.wall_time_s).collect::<Vec<_>>(),
+            ),
+        ],
+    )
+}
+
+/// Write `tradeoff.parquet` under the study's output folder; returns its path.
+pub fn write(
+    plan: &StudyPlan,
+    rows: &[TradeoffRow],
+) -> Result<std::path::PathBuf, Box<dyn std::error::Error>> {
+    let dir = crate::study::run::output_dir(plan, None);
+    std::fs::create_dir_all(&dir)?;
+    let path = dir.join("tradeoff.parquet");
+    let mut df = rows_frame(rows)?;
+    write_parquet(
+        &path,
+        &mut df,
+        &Provenance::new(&plan.text, plan.file.seed, "tradeoff"),
+    )?;
+    Ok(path)
+}
+
+/// Run indices spread evenly over the plan: `count` of them.
+pub fn spread_runs(plan: &StudyPlan, count: u64) -> Vec<u64> {
+    let total = plan.total_runs();
+    let count = count.clamp(1, total);
+    (0..count).map(|i| i * total / count).collect()
+}
