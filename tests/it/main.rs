@@ -4,6 +4,7 @@ mod bench;
 mod cli_design;
 mod cli_simulate;
 mod design_capacity;
+mod design_criterion;
 mod design_transient;
 mod integrate;
 mod model_conservation;
