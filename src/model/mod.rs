@@ -6,12 +6,14 @@
 //! - [`balancer`]: ball, roller and pendulum kinds (one file each).
 //! - [`effect`]: optional effects such as gravity (one file each).
 //! - [`system::RotorSystem`]: the assembled equations (O(n) per call).
+//! - [`forced`]: steady forced response with the cargoes locked.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
 
 pub mod balancer;
 pub mod cargo;
 pub mod effect;
+pub mod forced;
 pub mod invariants;
 pub mod rotor;
 pub mod scene;

@@ -9,6 +9,7 @@ mod design_transient;
 mod integrate;
 mod model_conservation;
 mod model_physics;
+mod model_two_support;
 mod study_input;
 mod study_runner;
 mod study_summary;
