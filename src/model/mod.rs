@@ -9,12 +9,14 @@
 //! - [`forced`]: steady forced response with the cargoes locked.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
+//! - [`linear`]: linear stability of the balanced state (rotating frame).
 
 pub mod balancer;
 pub mod cargo;
 pub mod effect;
 pub mod forced;
 pub mod invariants;
+pub mod linear;
 pub mod rotor;
 pub mod scene;
 pub mod speed;

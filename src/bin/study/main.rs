@@ -4,6 +4,7 @@
 
 mod bench_cmd;
 mod design_cmd;
+mod linear_cmd;
 mod output;
 mod run_cmd;
 mod simulate_cmd;
@@ -27,6 +28,9 @@ enum Command {
     /// Simulate one scene and print settling time, residual vibration and more.
     #[command(after_help = simulate_cmd::EXAMPLES)]
     Simulate(simulate_cmd::SimulateArgs),
+    /// Linear stability of a scene's balanced state: eigenvalues, slowest decay rate.
+    #[command(after_help = linear_cmd::EXAMPLES)]
+    Linear(linear_cmd::LinearArgs),
     /// Run a Monte Carlo study: every design × sample, statistics, Parquet files.
     #[command(after_help = run_cmd::RUN_EXAMPLES)]
     Run(run_cmd::RunArgs),
@@ -59,6 +63,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
         Command::Simulate(args) => simulate_cmd::run(&args),
+        Command::Linear(args) => linear_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Bench(args) => bench_cmd::run(&args),
