@@ -76,9 +76,19 @@ pub fn harmonic_response(
     fs: &DofVec,
     omega: f64,
 ) -> Option<Harmonic> {
+    harmonic_response_with(system, system.head_mass(), fc, fs, omega)
+}
+
+/// [`harmonic_response`] with a given mass matrix (e.g. the rotor's alone).
+pub fn harmonic_response_with(
+    system: &RotorSystem,
+    mass: &[DofVec; MAX_DOF],
+    fc: &DofVec,
+    fs: &DofVec,
+    omega: f64,
+) -> Option<Harmonic> {
     let k = system.rotor().dof();
     let (km, cm) = stiffness_and_damping(system, omega);
-    let mass = system.head_mass();
     let w2 = omega * omega;
     let n = 2 * k;
     let mut a = vec![vec![0.0; n + 1]; n];

@@ -10,6 +10,7 @@
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
 //! - [`linear`]: linear stability of the balanced state (rotating frame).
+//! - [`zero_approx`]: seed 003's empirical criterion for any rotor model.
 
 pub mod balancer;
 pub mod cargo;
@@ -22,3 +23,4 @@ pub mod scene;
 pub mod speed;
 pub mod start;
 pub mod system;
+pub mod zero_approx;

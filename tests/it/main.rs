@@ -14,3 +14,4 @@ mod model_two_support;
 mod study_input;
 mod study_runner;
 mod study_summary;
+mod study_sweep;

@@ -8,6 +8,7 @@ mod linear_cmd;
 mod output;
 mod run_cmd;
 mod simulate_cmd;
+mod sweep_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -31,6 +32,9 @@ enum Command {
     /// Linear stability of a scene's balanced state: eigenvalues, slowest decay rate.
     #[command(after_help = linear_cmd::EXAMPLES)]
     Linear(linear_cmd::LinearArgs),
+    /// Simulate one scene over a grid of speeds next to the criterion and linear stability.
+    #[command(after_help = sweep_cmd::EXAMPLES)]
+    Sweep(sweep_cmd::SweepArgs),
     /// Run a Monte Carlo study: every design × sample, statistics, Parquet files.
     #[command(after_help = run_cmd::RUN_EXAMPLES)]
     Run(run_cmd::RunArgs),
@@ -64,6 +68,7 @@ fn main() -> ExitCode {
         Command::Design(args) => design_cmd::run(&args),
         Command::Simulate(args) => simulate_cmd::run(&args),
         Command::Linear(args) => linear_cmd::run(&args),
+        Command::Sweep(args) => sweep_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Bench(args) => bench_cmd::run(&args),
