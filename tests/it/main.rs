@@ -8,6 +8,7 @@ mod design_criterion;
 mod design_transient;
 mod integrate;
 mod model_conservation;
+mod model_flexible;
 mod model_linear;
 mod model_physics;
 mod model_two_support;

@@ -291,3 +291,12 @@ fn study_linear_reports_the_scene_file() {
     assert_eq!(v["eigenvalues"].as_array().unwrap().len(), 16);
     assert!(v["slowest_decay"].as_f64().unwrap() > 0.0);
 }
+
+#[test]
+fn decay_rate_predicts_the_settling_time_of_the_flexible_shaft() {
+    // Seed 002's shaft with stronger damping (ζt = ζr = 0.05) and ball drag,
+    // so that the run stays short.
+    let shaft = autobal::model::rotor::FlexibleShaft::dimensionless(2.0, 0.05, 0.05, 0.01);
+    let cargo = vec![Cargo::point(0.01, 1.0, 0.002, 1.0); 2];
+    compare_with_settling(scene(shaft.into(), cargo, 1.5), &[0.04, -0.02]);
+}

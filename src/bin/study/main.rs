@@ -5,6 +5,7 @@
 mod bench_cmd;
 mod design_cmd;
 mod linear_cmd;
+mod map_cmd;
 mod output;
 mod run_cmd;
 mod simulate_cmd;
@@ -35,6 +36,9 @@ enum Command {
     /// Simulate one scene over a grid of speeds next to the criterion and linear stability.
     #[command(after_help = sweep_cmd::EXAMPLES)]
     Sweep(sweep_cmd::SweepArgs),
+    /// Stability map of the balanced state over speed and unbalance (Parquet and a character picture).
+    #[command(after_help = map_cmd::EXAMPLES)]
+    Map(map_cmd::MapArgs),
     /// Run a Monte Carlo study: every design × sample, statistics, Parquet files.
     #[command(after_help = run_cmd::RUN_EXAMPLES)]
     Run(run_cmd::RunArgs),
@@ -69,6 +73,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate_cmd::run(&args),
         Command::Linear(args) => linear_cmd::run(&args),
         Command::Sweep(args) => sweep_cmd::run(&args),
+        Command::Map(args) => map_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Bench(args) => bench_cmd::run(&args),

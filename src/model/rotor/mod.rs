@@ -8,9 +8,11 @@
 //! cargo rows and solves the head block, so a rotor model only has to say
 //! what its own mass, forces, unbalance and balancer planes are.
 
+pub mod flexible;
 pub mod plane;
 pub mod two_support;
 
+pub use flexible::FlexibleShaft;
 pub use plane::PlaneRotor;
 pub use two_support::TwoSupportRotor;
 
@@ -72,6 +74,8 @@ pub enum RotorModel {
     Plane(PlaneRotor),
     /// The rigid rotor on two elastic supports of seed 003 ([`two_support`]).
     TwoSupport(TwoSupportRotor),
+    /// The flexible (Stodola–Green) shaft of seed 002 ([`flexible`]).
+    Flexible(FlexibleShaft),
 }
 
 impl RotorModel {
@@ -85,6 +89,7 @@ impl RotorModel {
         match self {
             RotorModel::Plane(r) => r,
             RotorModel::TwoSupport(r) => r,
+            RotorModel::Flexible(r) => r,
         }
     }
 
@@ -93,6 +98,7 @@ impl RotorModel {
         match self {
             RotorModel::Plane(r) => Box::new(r.clone()),
             RotorModel::TwoSupport(r) => Box::new(r.clone()),
+            RotorModel::Flexible(r) => Box::new(r.clone()),
         }
     }
 
@@ -101,6 +107,7 @@ impl RotorModel {
         match self {
             RotorModel::Plane(r) => r.validate(),
             RotorModel::TwoSupport(r) => r.validate(),
+            RotorModel::Flexible(r) => r.validate(),
         }
     }
 
@@ -110,6 +117,10 @@ impl RotorModel {
     pub fn set_unbalance(&mut self, unbalance: f64, direction: f64) {
         match self {
             RotorModel::Plane(r) => {
+                r.eccentricity = unbalance / r.mass;
+                r.unbalance_angle = direction;
+            }
+            RotorModel::Flexible(r) => {
                 r.eccentricity = unbalance / r.mass;
                 r.unbalance_angle = direction;
             }
@@ -134,6 +145,7 @@ impl RotorModel {
         let mut r = self.clone();
         match &mut r {
             RotorModel::Plane(p) => p.eccentricity = 0.0,
+            RotorModel::Flexible(f) => f.eccentricity = 0.0,
             RotorModel::TwoSupport(t) => {
                 t.static_unbalance = 0.0;
                 t.moment_unbalance = 0.0;
@@ -150,6 +162,12 @@ impl From<PlaneRotor> for RotorModel {
     }
 }
 
+impl From<FlexibleShaft> for RotorModel {
+    fn from(r: FlexibleShaft) -> Self {
+        RotorModel::Flexible(r)
+    }
+}
+
 impl From<TwoSupportRotor> for RotorModel {
     fn from(r: TwoSupportRotor) -> Self {
         RotorModel::TwoSupport(r)
@@ -162,6 +180,7 @@ impl From<TwoSupportRotor> for RotorModel {
 enum Tagged<'a> {
     Plane(&'a PlaneRotor),
     TwoSupport(&'a TwoSupportRotor),
+    Flexible(&'a FlexibleShaft),
 }
 
 impl Serialize for RotorModel {
@@ -169,6 +188,7 @@ impl Serialize for RotorModel {
         match self {
             RotorModel::Plane(r) => Tagged::Plane(r),
             RotorModel::TwoSupport(r) => Tagged::TwoSupport(r),
+            RotorModel::Flexible(r) => Tagged::Flexible(r),
         }
         .serialize(serializer)
     }
@@ -185,7 +205,7 @@ impl<'de> Deserialize<'de> for RotorModel {
             Some(toml::Value::String(s)) => s,
             Some(other) => {
                 return Err(D::Error::custom(format!(
-                    "rotor.model = {other}: expected a name such as \"plane\" or \"two_support\""
+                    "rotor.model = {other}: expected a name such as \"plane\", \"two_support\" or \"flexible\""
                 )));
             }
         };
@@ -193,9 +213,10 @@ impl<'de> Deserialize<'de> for RotorModel {
         match model.as_str() {
             "plane" => value.try_into().map(RotorModel::Plane),
             "two_support" => value.try_into().map(RotorModel::TwoSupport),
+            "flexible" => value.try_into().map(RotorModel::Flexible),
             other => {
                 return Err(D::Error::custom(format!(
-                    "rotor.model = \"{other}\": expected \"plane\" or \"two_support\""
+                    "rotor.model = \"{other}\": expected \"plane\", \"two_support\" or \"flexible\""
                 )));
             }
         }
