@@ -325,3 +325,27 @@ fn invalid_parameters_are_typed_errors() {
         Err(CriterionError::NotFinite { name: "z", .. })
     ));
 }
+
+#[test]
+fn study_criterion_prints_the_ranges_of_a_scene() {
+    let run = |scene: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+            .args([
+                "criterion",
+                &format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR")),
+            ])
+            .output()
+            .unwrap()
+    };
+    let out = run("two_support_single.toml");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("(1.4142, 2.3570) ∪ (3.1623, ∞)"), "{text}");
+    let out = run("flexible_meraz.toml");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("study sweep"));
+}

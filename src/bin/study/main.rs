@@ -3,6 +3,7 @@
 //! bad input).
 
 mod bench_cmd;
+mod criterion_cmd;
 mod design_cmd;
 mod linear_cmd;
 mod map_cmd;
@@ -27,6 +28,9 @@ enum Command {
     /// Analytic design table (Table 1 of seed 000): optimal radius, capacity, p_max, ã.
     #[command(after_help = design_cmd::EXAMPLES)]
     Design(design_cmd::DesignArgs),
+    /// Seed 003's criterion for a rotor on two supports: resonances, extra speeds, balancing ranges.
+    #[command(after_help = criterion_cmd::EXAMPLES)]
+    Criterion(criterion_cmd::CriterionArgs),
     /// Simulate one scene and print settling time, residual vibration and more.
     #[command(after_help = simulate_cmd::EXAMPLES)]
     Simulate(simulate_cmd::SimulateArgs),
@@ -70,6 +74,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
+        Command::Criterion(args) => criterion_cmd::run(&args),
         Command::Simulate(args) => simulate_cmd::run(&args),
         Command::Linear(args) => linear_cmd::run(&args),
         Command::Sweep(args) => sweep_cmd::run(&args),
