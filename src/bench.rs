@@ -100,7 +100,8 @@ impl BenchConfig {
 /// The reference scene with `n` identical point cargoes (`scenes/three_balls.toml` for n = 3).
 pub fn reference_scene(n: usize) -> Scene {
     Scene {
-        rotor: PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1),
+        rotor: PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1).into(),
+        balancers: Vec::new(),
         balancer: None,
         cargo: vec![Cargo::point(0.01, 1.0, 0.01, 1.4); n],
         speed: SpeedLaw::Constant { omega: OMEGA },

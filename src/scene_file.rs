@@ -4,7 +4,7 @@
 use crate::metrics::MetricOptions;
 use crate::model::cargo::Cargo;
 use crate::model::effect::Effects;
-use crate::model::rotor::PlaneRotor;
+use crate::model::rotor::RotorModel;
 use crate::model::scene::{DesignSpec, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
@@ -15,11 +15,14 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    /// Rotor and supports.
-    pub rotor: PlaneRotor,
+    /// Rotor and supports (`model = "plane"` by default).
+    pub rotor: RotorModel,
     /// The auto-balancer as a design (or give `cargo`).
     #[serde(default)]
     pub balancer: Option<DesignSpec>,
+    /// Further auto-balancers, each in its own plane.
+    #[serde(default)]
+    pub balancers: Vec<DesignSpec>,
     /// The auto-balancer as explicit cargoes (or give `balancer`).
     #[serde(default)]
     pub cargo: Vec<Cargo>,
@@ -104,6 +107,7 @@ impl SceneFile {
         Scene {
             rotor: self.rotor.clone(),
             balancer: self.balancer.clone(),
+            balancers: self.balancers.clone(),
             cargo: self.cargo.clone(),
             speed: self.speed.clone(),
             effects: self.effects.clone(),

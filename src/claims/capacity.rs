@@ -69,6 +69,7 @@ pub fn capacity_experiment(base: &StudyPlan, ns: &[u32]) -> Vec<CapacityPoint> {
                 density: g.density,
                 roller_height: g.roller_height,
                 drag,
+                plane: 0,
             };
             let design = base.file.resolve_design(0, spec).ok()?;
             let ml = design.weight_mass * design.track_radius;

@@ -122,6 +122,7 @@ fn variant(
                 density: g.density,
                 roller_height: g.roller_height,
                 drag,
+                plane: 0,
             };
             if let Ok(d) = file.resolve_design(designs.len() as u32, spec) {
                 reference =

@@ -5,11 +5,15 @@
 //! the race radius R and the roller height h. Angles are in radians unless a
 //! name says `_deg`.
 //!
+//! [`criterion`] holds seed 003's empirical criterion for the rigid rotor on
+//! two elastic supports (resonances, extra speed, balancing speed ranges).
+//!
 //! Where to start: [`capacity::dimensionless_capacity`] (eq 9),
 //! [`optimum::optimal_rho`] (Table 1) and [`transient`] (eqs 1, 2, 10–16).
 
 pub mod capacity;
 pub mod complete;
+pub mod criterion;
 pub mod error;
 pub mod geometry;
 pub mod optimum;

@@ -3,8 +3,12 @@
 //! Definitions (also in `docs/metrics.md`):
 //! - A_ref = U ω² / |k_x − M_Σ ω² + i b_x ω|: the vibration amplitude the
 //!   rotor's own unbalance U = M e would cause with the balancer locked
-//!   (U = Σ m_j l_j when e = 0, so that the scale stays meaningful).
-//! - r(t) = sqrt(x² + y²); ε(t) = |Σ m_j l_j e^{iψ_j} + M e e^{iψ₀}| / U.
+//!   (U = Σ m_j l_j when e = 0, so that the scale stays meaningful). For a
+//!   rotor with several coordinates: the largest balancer-plane orbit radius
+//!   of that locked response (`reference::a_ref`).
+//! - r(t) = sqrt(x² + y²) (the largest balancer-plane displacement for other
+//!   rotors); ε(t) = |Σ m_j l_j e^{iψ_j} + M e e^{iψ₀}| / U (the size of the
+//!   total unbalance, e.g. the largest bearing-equivalent one, over U).
 //! - Settling time t_s: the start of the first stretch during which
 //!   r ≤ δ·A_ref holds continuously for W revolutions or until the end of the
 //!   run, checked on dense output at `samples_per_rev` points per revolution

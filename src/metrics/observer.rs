@@ -1,7 +1,7 @@
 //! The step observer that measures a run: samples r and ε on dense output,
 //! detects settling, watches for divergence, and optionally records a series.
 
-use super::reference::{a_ref, balancing_error, reference_unbalance};
+use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, SolveReport, Status, Step, StepObserver};
@@ -13,11 +13,11 @@ use std::f64::consts::PI;
 pub struct Series {
     /// Sample times (s).
     pub t: Vec<f64>,
-    /// Shaft displacement x.
+    /// Rotor coordinate x (shaft centre, or centre of mass on two supports).
     pub x: Vec<f64>,
-    /// Shaft displacement y.
+    /// Rotor coordinate y.
     pub y: Vec<f64>,
-    /// r = sqrt(x² + y²).
+    /// Vibration r (sqrt(x² + y²) for the plane rotor; see `reference::vibration`).
     pub r: Vec<f64>,
     /// Balancing error ε.
     pub eps: Vec<f64>,
@@ -128,7 +128,7 @@ impl<'a> SettlingObserver<'a> {
     fn sample(&mut self, t: f64) -> Flow {
         let lay = self.system.layout();
         let y = &self.scratch;
-        let r = y[0].hypot(y[1]);
+        let r = vibration(self.system, y);
         let psi = &y[lay.head()..lay.nq()];
         let eps = balancing_error(self.system, psi, self.u_ref);
         if !r.is_finite() || !eps.is_finite() {
@@ -216,7 +216,7 @@ impl<'a> SettlingObserver<'a> {
                     Outcome::NotSettled,
                     format!(
                         "r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
-                        report.y[0].hypot(report.y[1]) / self.a_ref,
+                        vibration(self.system, &report.y) / self.a_ref,
                         self.options.delta,
                         rms / self.a_ref
                     ),

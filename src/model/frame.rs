@@ -16,14 +16,16 @@
 
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
-use super::rotor::PlaneRotor;
+use super::rotor::RotorModel;
 use super::scene::{Scene, SceneError};
 use super::speed::SpeedLaw;
 use crate::integrate::OdeSystem;
 
 /// Why a scene cannot use the rotating frame.
 pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
-    let r = &scene.rotor;
+    let RotorModel::Plane(r) = &scene.rotor else {
+        return Some("only the plane rotor has a rotating-frame formulation");
+    };
     if r.kx != r.ky || r.bx != r.by {
         return Some("anisotropic supports make the rotating-frame equations time-dependent");
     }
@@ -74,7 +76,9 @@ impl RotatingSystem {
             unreachable!("checked above")
         };
         let cargo = scene.cargoes()?;
-        let r: &PlaneRotor = &scene.rotor;
+        let RotorModel::Plane(r) = &scene.rotor else {
+            unreachable!("checked above")
+        };
         let me = r.mass * r.eccentricity;
         let (s, c) = r.unbalance_angle.sin_cos();
         let effects = scene.effects.build(&cargo, omega);

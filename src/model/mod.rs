@@ -6,17 +6,23 @@
 //! - [`balancer`]: ball, roller and pendulum kinds (one file each).
 //! - [`effect`]: optional effects such as gravity (one file each).
 //! - [`system::RotorSystem`]: the assembled equations (O(n) per call).
+//! - [`forced`]: steady forced response with the cargoes locked.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
+//! - [`linear`]: linear stability of the balanced state (rotating frame).
+//! - [`zero_approx`]: seed 003's empirical criterion for any rotor model.
 
 pub mod balancer;
 pub mod cargo;
 pub mod effect;
+pub mod forced;
 pub mod frame;
 pub mod invariants;
+pub mod linear;
 pub mod quasi_static;
 pub mod rotor;
 pub mod scene;
 pub mod speed;
 pub mod start;
 pub mod system;
+pub mod zero_approx;

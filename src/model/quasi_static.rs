@@ -13,6 +13,7 @@
 //! overdamped limit, λ ≈ −(1 − p) m n b_cr²/(4 b̃). The n − 2 zero roots are
 //! the neutral family of balanced positions.
 
+use super::rotor::RotorModel;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::start::balanced_fan;
@@ -41,6 +42,9 @@ pub enum AnalyticError {
     /// The cargoes cannot cancel the unbalance.
     #[error("the unbalance exceeds what the cargoes can cancel")]
     NotBalanceable,
+    /// The closed form is derived for the plane rotor.
+    #[error("the analytic estimate is derived for the plane rotor")]
+    NotPlane,
     /// The closed form needs drag.
     #[error("the analytic estimate needs a positive drag")]
     NoDrag,
@@ -61,7 +65,9 @@ pub fn slow_mode(scene: &Scene) -> Result<SlowMode, AnalyticError> {
     if first.drag <= 0.0 {
         return Err(AnalyticError::NoDrag);
     }
-    let r = &scene.rotor;
+    let RotorModel::Plane(r) = &scene.rotor else {
+        return Err(AnalyticError::NotPlane);
+    };
     let m_total = r.mass + cargo.iter().map(|c| c.mass).sum::<f64>();
     let unbalance = r.mass * r.eccentricity;
     let angles = balanced_fan(cargo.len(), first.unbalance(), unbalance, r.unbalance_angle)

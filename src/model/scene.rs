@@ -4,7 +4,7 @@
 use super::balancer::{self, Geometry, Kind};
 use super::cargo::Cargo;
 use super::effect::Effects;
-use super::rotor::PlaneRotor;
+use super::rotor::RotorModel;
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
 use crate::design::optimum::optimal_rho;
@@ -15,11 +15,14 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
-    /// The rotor and its supports.
-    pub rotor: PlaneRotor,
-    /// The auto-balancer as a design (give this or `cargo`).
+    /// The rotor and its supports (`model = "plane"` by default).
+    pub rotor: RotorModel,
+    /// The auto-balancer as a design (give this and/or `balancers`, or `cargo`).
     #[serde(default)]
     pub balancer: Option<DesignSpec>,
+    /// Further auto-balancers, each in its own plane (`[[balancers]]`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub balancers: Vec<DesignSpec>,
     /// The auto-balancer as explicit cargoes (give this or `balancer`).
     #[serde(default)]
     pub cargo: Vec<Cargo>,
@@ -50,6 +53,9 @@ pub struct DesignSpec {
     pub roller_height: f64,
     /// Viscous coefficient β of each weight (N·s/m).
     pub drag: f64,
+    /// Balancer plane the weights run in (index into the rotor's planes).
+    #[serde(default)]
+    pub plane: usize,
 }
 
 fn steel() -> f64 {
@@ -111,7 +117,8 @@ pub enum SceneError {
     Design(#[from] DesignError),
 }
 
-fn invalid(field: &str, value: f64, reason: &str) -> SceneError {
+/// A [`SceneError::Invalid`] for a numeric field.
+pub(crate) fn invalid(field: &str, value: f64, reason: &str) -> SceneError {
     SceneError::Invalid {
         field: field.to_string(),
         value: value.to_string(),
@@ -119,7 +126,8 @@ fn invalid(field: &str, value: f64, reason: &str) -> SceneError {
     }
 }
 
-fn positive(field: &str, value: f64) -> Result<(), SceneError> {
+/// Require a positive, finite value.
+pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
@@ -127,7 +135,17 @@ fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     }
 }
 
-fn non_negative(field: &str, value: f64) -> Result<(), SceneError> {
+/// Require a finite value.
+pub(crate) fn finite(field: &str, value: f64) -> Result<(), SceneError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(field, value, "must be finite"))
+    }
+}
+
+/// Require a non-negative, finite value.
+pub(crate) fn non_negative(field: &str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
@@ -135,24 +153,32 @@ fn non_negative(field: &str, value: f64) -> Result<(), SceneError> {
     }
 }
 
+/// A balancer plane index must name one of the rotor's planes.
+fn check_plane(field: &str, plane: usize, rotor: &RotorModel) -> Result<(), SceneError> {
+    let planes = rotor.as_rotor().planes();
+    if plane < planes {
+        return Ok(());
+    }
+    let reason = if planes == 1 {
+        format!("the {} rotor has one balancer plane (0)", rotor.name())
+    } else {
+        format!(
+            "the {} rotor has {planes} balancer planes (0..{})",
+            rotor.name(),
+            planes - 1
+        )
+    };
+    Err(SceneError::Invalid {
+        field: field.to_string(),
+        value: plane.to_string(),
+        reason,
+    })
+}
+
 impl Scene {
     /// Check every field; the first problem found is returned.
     pub fn validate(&self) -> Result<(), SceneError> {
-        let r = &self.rotor;
-        positive("rotor.mass", r.mass)?;
-        non_negative("rotor.eccentricity", r.eccentricity)?;
-        positive("rotor.inertia", r.inertia)?;
-        positive("rotor.kx", r.kx)?;
-        positive("rotor.ky", r.ky)?;
-        non_negative("rotor.bx", r.bx)?;
-        non_negative("rotor.by", r.by)?;
-        if !r.unbalance_angle.is_finite() {
-            return Err(invalid(
-                "rotor.unbalance_angle",
-                r.unbalance_angle,
-                "must be finite",
-            ));
-        }
+        self.rotor.validate()?;
         match &self.speed {
             SpeedLaw::Constant { omega } => positive("speed.omega", *omega)?,
             SpeedLaw::Ramp {
@@ -185,35 +211,53 @@ impl Scene {
                 ));
             }
         }
-        match (&self.balancer, self.cargo.is_empty()) {
-            (None, true) => {
+        let designs: Vec<(String, &DesignSpec)> = self
+            .balancer
+            .iter()
+            .map(|d| ("balancer".to_string(), d))
+            .chain(
+                self.balancers
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (format!("balancers[{i}]"), d)),
+            )
+            .collect();
+        match (designs.is_empty(), self.cargo.is_empty()) {
+            (true, true) => {
                 return Err(SceneError::Invalid {
                     field: "balancer".into(),
                     value: "missing".into(),
                     reason: "give a [balancer] design or a [[cargo]] list".into(),
                 });
             }
-            (Some(_), false) => {
+            (false, false) => {
                 return Err(SceneError::Invalid {
                     field: "balancer".into(),
                     value: "both [balancer] and [[cargo]]".into(),
                     reason: "give one of them, not both".into(),
                 });
             }
-            (Some(d), true) => {
-                if d.n == 0 {
-                    return Err(invalid("balancer.n", 0.0, "needs at least one weight"));
+            (false, true) => {
+                for (key, d) in designs {
+                    if d.n == 0 {
+                        return Err(invalid(
+                            &format!("{key}.n"),
+                            0.0,
+                            "needs at least one weight",
+                        ));
+                    }
+                    positive(&format!("{key}.race_radius"), d.race_radius)?;
+                    positive(&format!("{key}.density"), d.density)?;
+                    non_negative(&format!("{key}.drag"), d.drag)?;
+                    if d.kind == Kind::Roller {
+                        positive(&format!("{key}.roller_height"), d.roller_height)?;
+                    }
+                    check_plane(&format!("{key}.plane"), d.plane, &self.rotor)?;
+                    let rho = d.resolved_rho()?;
+                    crate::design::geometry::check_fits(d.n, rho)?;
                 }
-                positive("balancer.race_radius", d.race_radius)?;
-                positive("balancer.density", d.density)?;
-                non_negative("balancer.drag", d.drag)?;
-                if d.kind == Kind::Roller {
-                    positive("balancer.roller_height", d.roller_height)?;
-                }
-                let rho = d.resolved_rho()?;
-                crate::design::geometry::check_fits(d.n, rho)?;
             }
-            (None, false) => {
+            (true, false) => {
                 for (j, c) in self.cargo.iter().enumerate() {
                     positive(&format!("cargo[{j}].mass"), c.mass)?;
                     positive(&format!("cargo[{j}].track_radius"), c.track_radius)?;
@@ -227,25 +271,28 @@ impl Scene {
                             "must be ≥ 1",
                         ));
                     }
-                    if c.plane != 0 {
-                        return Err(invalid(
-                            &format!("cargo[{j}].plane"),
-                            c.plane as f64,
-                            "the plane rotor has one balancer plane (0)",
-                        ));
-                    }
+                    check_plane(&format!("cargo[{j}].plane"), c.plane, &self.rotor)?;
                 }
             }
         }
         Ok(())
     }
 
-    /// The cargoes this scene's balancer resolves to.
+    /// The cargoes this scene's balancers resolve to, in file order, each
+    /// tagged with its plane.
     pub fn cargoes(&self) -> Result<Vec<Cargo>, SceneError> {
-        Ok(match &self.balancer {
-            Some(d) => balancer::cargoes(d.kind, d.n, &d.geometry()?)?,
-            None => self.cargo.clone(),
-        })
+        if self.balancer.is_none() && self.balancers.is_empty() {
+            return Ok(self.cargo.clone());
+        }
+        let mut all = Vec::new();
+        for d in self.balancer.iter().chain(&self.balancers) {
+            let mut c = balancer::cargoes(d.kind, d.n, &d.geometry()?)?;
+            for cargo in &mut c {
+                cargo.plane = d.plane;
+            }
+            all.extend(c);
+        }
+        Ok(all)
     }
 
     /// Validate and assemble the ODE system.
@@ -254,7 +301,7 @@ impl Scene {
         let cargo = self.cargoes()?;
         let effects = self.effects.build(&cargo, self.speed.nominal_speed());
         Ok(RotorSystem::new(
-            Box::new(self.rotor.clone()),
+            self.rotor.build(),
             cargo,
             self.speed.clone(),
             effects,

@@ -1,11 +1,13 @@
 //! Initial states of a run.
 //!
 //! The default, `locked_steady`, starts the rotor in the forced steady state
-//! it would have with the cargoes locked at their initial positions and
+//! it would have with the cargoes locked at their initial positions (any
+//! rotor model: [`crate::model::forced`]) and
 //! releases the cargoes with zero relative speed: settling time then measures
 //! the balancer, not the decay of the start-up whirl through the support
 //! damping (which is what starting from rest at full speed measures).
 
+use super::forced::{harmonic_response, unbalance_forcing};
 use super::system::RotorSystem;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -42,16 +44,35 @@ pub fn initial_state(system: &RotorSystem, mode: StartMode, psi0: &[f64]) -> Vec
         y[nq + lay.phi()] = rate;
     }
     if mode == StartMode::LockedSteady {
-        let [x, xd, yy, yd] = locked_response(system, psi0, rate);
-        y[0] = x;
-        y[1] = yy;
-        y[nq] = xd;
-        y[nq + 1] = yd;
+        if is_plane_translation(system) {
+            let [x, xd, yy, yd] = locked_response(system, psi0, rate);
+            y[0] = x;
+            y[1] = yy;
+            y[nq] = xd;
+            y[nq + 1] = yd;
+        } else {
+            let (fc, fs) = unbalance_forcing(system, psi0, true);
+            if let Some(h) = harmonic_response(system, &fc, &fs, rate) {
+                // At t = 0: q = a, q̇ = ω b.
+                for i in 0..lay.rotor_dof {
+                    y[i] = h.cos[i];
+                    y[nq + i] = rate * h.sin[i];
+                }
+            }
+        }
     }
     y
 }
 
+/// True for a rotor whose two coordinates are its single plane's (x, y):
+/// the plane rotor, whose locked response has a closed form per axis.
+pub fn is_plane_translation(system: &RotorSystem) -> bool {
+    let rotor = system.rotor();
+    rotor.dof() == 2 && rotor.planes() == 1
+}
+
 /// Forced steady state (x, ẋ, y, ẏ) at t = 0 of the plane rotor spinning at ω
+/// (the closed form of [`harmonic_response`] for two uncoupled axes)
 /// with the cargoes locked at `psi0`: each axis answers the rotating total
 /// unbalance U e^{i(ωt+θ)} as M_Σ ẍ + b ẋ + k x = ω² U cos(ωt + θ).
 pub fn locked_response(system: &RotorSystem, psi0: &[f64], omega: f64) -> [f64; 4] {

@@ -126,6 +126,16 @@ impl RotorSystem {
         &self.cargo
     }
 
+    /// Mass matrix of the rotor coordinates with the cargoes' masses (constant).
+    pub fn head_mass(&self) -> &[DofVec; MAX_DOF] {
+        &self.head_mass
+    }
+
+    /// Map (G_u, G_v) of the plane cargo j runs in.
+    pub fn cargo_plane_map(&self, j: usize) -> [DofVec; 2] {
+        self.plane_maps[self.cargo[j].plane]
+    }
+
     /// The speed law.
     pub fn speed(&self) -> &SpeedLaw {
         &self.speed
@@ -203,7 +213,7 @@ impl OdeSystem for RotorSystem {
         g[..k].copy_from_slice(&rotor_f[..k]);
 
         // Head block before elimination.
-        let coupling = self.rotor.spin_coupling(phi);
+        let coupling = self.rotor.spin_coupling(phi, &q[..k]);
         let mut a = [[0.0; MAX_HEAD]; MAX_HEAD];
         for r in 0..k {
             a[r][..k].copy_from_slice(&self.head_mass[r][..k]);

@@ -69,6 +69,7 @@ impl Evaluator<'_> {
             density: g.density,
             roller_height: g.roller_height,
             drag: c.drag,
+            plane: 0,
         };
         let design = self
             .plan

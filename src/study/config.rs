@@ -10,7 +10,7 @@ use crate::design::geometry::check_fits;
 use crate::metrics::MetricOptions;
 use crate::model::balancer::Kind;
 use crate::model::effect::Effects;
-use crate::model::rotor::PlaneRotor;
+use crate::model::rotor::RotorModel;
 use crate::model::scene::{DesignSpec, RhoChoice, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
@@ -62,8 +62,9 @@ fn default_output() -> String {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneTemplate {
-    /// Rotor and supports; `eccentricity` is set per run from the sampled unbalance.
-    pub rotor: PlaneRotor,
+    /// Rotor and supports; its unbalance is set per run from the sampled one
+    /// ([`RotorModel::set_unbalance`]).
+    pub rotor: RotorModel,
     /// Speed law.
     pub speed: SpeedLaw,
     /// Optional effects.
@@ -285,15 +286,22 @@ impl StudyPlan {
         self.designs.len() as u64 * u64::from(self.file.sampling.samples)
     }
 
-    /// The scene of one design with rotor unbalance (U, direction) applied.
+    /// The scene of one design with rotor unbalance (U, direction) applied;
+    /// a rotor with several balancer planes gets the design in every plane.
     pub fn scene(&self, design: &Design, unbalance: f64, direction: f64) -> Scene {
         let t = &self.file.scene;
         let mut rotor = t.rotor.clone();
-        rotor.eccentricity = unbalance / rotor.mass;
-        rotor.unbalance_angle = direction;
+        rotor.set_unbalance(unbalance, direction);
+        let planes = rotor.as_rotor().planes();
         Scene {
             rotor,
             balancer: Some(design.spec.clone()),
+            balancers: (1..planes)
+                .map(|plane| DesignSpec {
+                    plane,
+                    ..design.spec.clone()
+                })
+                .collect(),
             cargo: Vec::new(),
             speed: t.speed.clone(),
             effects: t.effects.clone(),
@@ -447,11 +455,9 @@ impl StudyFile {
     ) -> Result<Design, (String, String, String)> {
         let (kind, n) = (spec.kind, spec.n);
         let scene = Scene {
-            rotor: PlaneRotor {
-                eccentricity: 0.0,
-                ..self.scene.rotor.clone()
-            },
+            rotor: self.scene.rotor.without_unbalance(),
             balancer: Some(spec.clone()),
+            balancers: Vec::new(),
             cargo: Vec::new(),
             speed: self.scene.speed.clone(),
             effects: self.scene.effects.clone(),
@@ -526,6 +532,7 @@ impl StudyFile {
                             density: g.density,
                             roller_height: g.roller_height,
                             drag,
+                            plane: 0,
                         };
                         designs.push(self.resolve_design(designs.len() as u32, spec)?);
                     }

@@ -8,6 +8,8 @@
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
 //! - [`merge`]: combining shard outputs.
 //! - [`io`]: Parquet with provenance, atomic writes.
+//! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
+//! - [`stability_map`]: linear stability over (speed, unbalance).
 
 pub mod aggregate;
 pub mod config;
@@ -16,3 +18,5 @@ pub mod merge;
 pub mod record;
 pub mod run;
 pub mod sample;
+pub mod stability_map;
+pub mod sweep;

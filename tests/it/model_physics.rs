@@ -25,8 +25,9 @@ fn balls(n: usize, mass: f64, drag: f64) -> Vec<Cargo> {
 fn simulation(rotor: PlaneRotor, cargo: Vec<Cargo>, omega: f64, angles_deg: &[f64]) -> Simulation {
     Simulation {
         scene: Scene {
-            rotor,
+            rotor: rotor.into(),
             balancer: None,
+            balancers: Vec::new(),
             cargo,
             speed: SpeedLaw::Constant { omega },
             effects: Effects::default(),
@@ -58,8 +59,9 @@ fn negligible_cargo_leaves_the_closed_form_forced_response() {
     let cargo = balls(2, 1e-12, 1e-12);
     let omega = 1.7;
     let scene = Scene {
-        rotor: r.clone(),
+        rotor: r.clone().into(),
         balancer: None,
+        balancers: Vec::new(),
         cargo,
         speed: SpeedLaw::Constant { omega },
         effects: Effects::default(),
@@ -320,8 +322,9 @@ fn vertical_axis_gravity_adds_no_term() {
         1
     );
     let system = Scene {
-        rotor: rotor(),
+        rotor: rotor().into(),
         balancer: None,
+        balancers: Vec::new(),
         cargo: balls(2, 0.01, 0.01),
         speed: SpeedLaw::Constant { omega: 2.0 },
         effects: Effects::default(),

@@ -4,11 +4,15 @@
 
 mod bench_cmd;
 mod claims_cmd;
+mod criterion_cmd;
 mod design_cmd;
+mod linear_cmd;
+mod map_cmd;
 mod optimize_cmd;
 mod output;
 mod run_cmd;
 mod simulate_cmd;
+mod sweep_cmd;
 mod tradeoff_cmd;
 
 use clap::{Parser, Subcommand};
@@ -27,9 +31,21 @@ enum Command {
     /// Analytic design table (Table 1 of seed 000): optimal radius, capacity, p_max, ã.
     #[command(after_help = design_cmd::EXAMPLES)]
     Design(design_cmd::DesignArgs),
+    /// Seed 003's criterion for a rotor on two supports: resonances, extra speeds, balancing ranges.
+    #[command(after_help = criterion_cmd::EXAMPLES)]
+    Criterion(criterion_cmd::CriterionArgs),
     /// Simulate one scene and print settling time, residual vibration and more.
     #[command(after_help = simulate_cmd::EXAMPLES)]
     Simulate(simulate_cmd::SimulateArgs),
+    /// Linear stability of a scene's balanced state: eigenvalues, slowest decay rate.
+    #[command(after_help = linear_cmd::EXAMPLES)]
+    Linear(linear_cmd::LinearArgs),
+    /// Simulate one scene over a grid of speeds next to the criterion and linear stability.
+    #[command(after_help = sweep_cmd::EXAMPLES)]
+    Sweep(sweep_cmd::SweepArgs),
+    /// Stability map of the balanced state over speed and unbalance (Parquet and a character picture).
+    #[command(after_help = map_cmd::EXAMPLES)]
+    Map(map_cmd::MapArgs),
     /// Run a Monte Carlo study: every design × sample, statistics, Parquet files.
     #[command(after_help = run_cmd::RUN_EXAMPLES)]
     Run(run_cmd::RunArgs),
@@ -70,7 +86,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
+        Command::Criterion(args) => criterion_cmd::run(&args),
         Command::Simulate(args) => simulate_cmd::run(&args),
+        Command::Linear(args) => linear_cmd::run(&args),
+        Command::Sweep(args) => sweep_cmd::run(&args),
+        Command::Map(args) => map_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Optimize(args) => optimize_cmd::run(&args),

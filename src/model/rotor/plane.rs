@@ -3,6 +3,7 @@
 //! shaft centre. Coordinates x, y of the shaft centre from static equilibrium.
 
 use super::{DofVec, MAX_DOF, Rotor};
+use crate::model::scene::{SceneError, invalid, non_negative, positive};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the plane rotor (any consistent units, SI in study files).
@@ -52,6 +53,27 @@ impl PlaneRotor {
     }
 }
 
+impl PlaneRotor {
+    /// Check every parameter (field names prefixed `rotor.`).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        positive("rotor.mass", self.mass)?;
+        non_negative("rotor.eccentricity", self.eccentricity)?;
+        positive("rotor.inertia", self.inertia)?;
+        positive("rotor.kx", self.kx)?;
+        positive("rotor.ky", self.ky)?;
+        non_negative("rotor.bx", self.bx)?;
+        non_negative("rotor.by", self.by)?;
+        if !self.unbalance_angle.is_finite() {
+            return Err(invalid(
+                "rotor.unbalance_angle",
+                self.unbalance_angle,
+                "must be finite",
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Rotor for PlaneRotor {
     fn name(&self) -> &'static str {
         "plane"
@@ -85,7 +107,7 @@ impl Rotor for PlaneRotor {
         f[1] -= self.ky * q[1] + self.by * qd[1];
     }
 
-    fn spin_coupling(&self, phi: f64) -> DofVec {
+    fn spin_coupling(&self, phi: f64, _q: &[f64]) -> DofVec {
         let me = self.mass * self.eccentricity;
         let (s, c) = (phi + self.unbalance_angle).sin_cos();
         [-me * s, me * c, 0.0, 0.0]
@@ -100,5 +122,13 @@ impl Rotor for PlaneRotor {
 
     fn static_unbalance(&self) -> (f64, f64) {
         (self.mass * self.eccentricity, self.unbalance_angle)
+    }
+
+    fn own_unbalance(&self) -> f64 {
+        self.mass * self.eccentricity
+    }
+
+    fn unbalance_size(&self, f: &DofVec) -> f64 {
+        f[0].hypot(f[1])
     }
 }

@@ -1,0 +1,127 @@
+//! `study sweep`: one scene over a grid of constant speeds, simulated and
+//! compared with the criterion's prediction and linear stability.
+
+use crate::UserError;
+use autobal::scene_file::SceneFile;
+use autobal::study::io::{Provenance, write_parquet};
+use autobal::study::sweep::{SweepPoint, ranges, run_sweep, speed_grid, to_dataframe};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study sweep --help`.
+pub const EXAMPLES: &str = "Examples:
+  study sweep scenes/two_support_single.toml --omega 0.5..8 --points 61
+  study sweep scenes/two_support_long.toml --omega 1..8 --points 29 --out sweep.parquet";
+
+/// Arguments of `study sweep`.
+#[derive(Args)]
+pub struct SweepArgs {
+    /// Scene file (TOML); its speed law is replaced by each constant speed.
+    scene: PathBuf,
+    /// Speed range `lo..hi` (rad/s).
+    #[arg(long)]
+    omega: String,
+    /// Number of speeds, evenly spaced, ends included.
+    #[arg(long, default_value_t = 41)]
+    points: usize,
+    /// Write one row per speed to this Parquet file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print the points as JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_range(text: &str) -> Result<(f64, f64), UserError> {
+    let bad = || {
+        UserError(
+            format!("--omega {text}: expected lo..hi with 0 < lo < hi, e.g. 0.5..8"),
+            2,
+        )
+    };
+    let (a, b) = text.split_once("..").ok_or_else(bad)?;
+    let (lo, hi): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if lo > 0.0 && hi > lo && hi.is_finite() {
+        Ok((lo, hi))
+    } else {
+        Err(bad())
+    }
+}
+
+/// Run `study sweep`.
+pub fn run(args: &SweepArgs) -> Result<(), UserError> {
+    let (lo, hi) = parse_range(&args.omega)?;
+    if args.points < 2 {
+        return Err(UserError("--points: need at least 2 speeds".into(), 2));
+    }
+    let shown = args.scene.display().to_string();
+    let file = SceneFile::read(&args.scene)?;
+    let simulation = file.simulation(&shown)?;
+    let points = run_sweep(&simulation, &speed_grid(lo, hi, args.points))?;
+    if let Some(path) = &args.out {
+        let text = std::fs::read_to_string(&args.scene)?;
+        let provenance = Provenance::new(&text, 0, "sweep");
+        let mut df = to_dataframe(&points).map_err(|e| UserError::internal(e.to_string()))?;
+        write_parquet(path, &mut df, &provenance)
+            .map_err(|e| UserError(format!("--out {}: {e}", path.display()), 2))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&points)?);
+    } else {
+        print!("{}", describe(&points));
+    }
+    Ok(())
+}
+
+fn describe(points: &[SweepPoint]) -> String {
+    let yn = |b: Option<bool>| match b {
+        Some(true) => "yes",
+        Some(false) => "no",
+        None => "–",
+    };
+    let mut s = String::from(
+        "   omega  criterion  closed form  linear   sigma       outcome      t_s        eps\n",
+    );
+    for p in points {
+        s += &format!(
+            "{:8.4}  {:9}  {:11}  {:6}  {:>10}  {:11}  {:>9}  {:.2e}\n",
+            p.omega,
+            yn(Some(p.criterion)),
+            yn(p.closed_form),
+            yn(p.linear_stable),
+            p.slowest_decay.map_or("–".into(), |v| format!("{v:.3e}")),
+            p.outcome.name(),
+            p.settling_time.map_or("–".into(), |v| format!("{v:.2}")),
+            p.balancing_error
+        );
+    }
+    let show = |r: Vec<(f64, f64)>| {
+        if r.is_empty() {
+            "none".to_string()
+        } else {
+            r.iter()
+                .map(|(a, b)| format!("[{a:.3}, {b:.3}]"))
+                .collect::<Vec<_>>()
+                .join(" ∪ ")
+        }
+    };
+    s += &format!(
+        "\nbalancing predicted by the criterion   {}\n",
+        show(ranges(points, |p| p.criterion))
+    );
+    if points.iter().any(|p| p.closed_form.is_some()) {
+        s += &format!(
+            "closed form of seed 003                {}\n",
+            show(ranges(points, |p| p.closed_form == Some(true)))
+        );
+    }
+    s += &format!(
+        "balanced state linearly stable         {}\nbalancing simulated (settled)          {}\n",
+        show(ranges(points, |p| p.linear_stable == Some(true))),
+        show(ranges(points, |p| p.settled))
+    );
+    s
+}

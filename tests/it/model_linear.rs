@@ -1,0 +1,302 @@
+//! Linear stability of the balanced state: agreement with known results, with
+//! seed 003's criterion, and with nonlinear settling times.
+
+use autobal::metrics::{MetricOptions, Outcome};
+use autobal::model::cargo::Cargo;
+use autobal::model::effect::Effects;
+use autobal::model::linear::{LinearError, analyse, balancing_angles};
+use autobal::model::rotor::two_support::PointUnbalance;
+use autobal::model::rotor::{PlaneRotor, RotorModel, TwoSupportRotor};
+use autobal::model::scene::Scene;
+use autobal::model::speed::SpeedLaw;
+use autobal::model::start::StartMode;
+use autobal::simulation::{Simulation, SolverSettings};
+
+fn balls(n: usize, mass: f64, drag: f64, plane: usize) -> Vec<Cargo> {
+    (0..n)
+        .map(|_| Cargo {
+            plane,
+            ..Cargo::point(mass, 1.0, drag, 1.4)
+        })
+        .collect()
+}
+
+fn scene(rotor: RotorModel, cargo: Vec<Cargo>, omega: f64) -> Scene {
+    Scene {
+        rotor,
+        balancer: None,
+        balancers: Vec::new(),
+        cargo,
+        speed: SpeedLaw::Constant { omega },
+        effects: Effects::default(),
+    }
+}
+
+fn plane_rotor() -> RotorModel {
+    PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1).into()
+}
+
+fn long_rotor(planes: Vec<f64>, unbalances: Vec<PointUnbalance>) -> RotorModel {
+    TwoSupportRotor {
+        mass: 1.0,
+        transverse_inertia: 1.0,
+        polar_inertia: 0.2,
+        k1: 1.0,
+        l1: 2.0,
+        k2: 1.0,
+        l2: 2.0,
+        b1: 0.05,
+        b2: 0.05,
+        planes,
+        static_unbalance: 0.0,
+        static_angle: 0.0,
+        moment_unbalance: 0.0,
+        moment_angle: 0.0,
+        unbalances,
+    }
+    .into()
+}
+
+fn point(s: f64, z: f64, angle: f64) -> PointUnbalance {
+    PointUnbalance { s, z, angle }
+}
+
+#[test]
+fn plane_rotor_is_stable_above_resonance_and_unstable_below() {
+    let fast = analyse(
+        &scene(plane_rotor(), balls(2, 0.01, 0.01, 0), 4.0)
+            .build()
+            .unwrap(),
+        None,
+    )
+    .unwrap();
+    assert!(fast.stable, "{fast:?}");
+    assert!(fast.balancing_error < 1e-9);
+    assert_eq!(fast.neutral, 0);
+    // The steady state is the textbook balance: cos ψ = −M e/(2 m l) about the unbalance.
+    let lay_psi = &fast.state[2..4];
+    for p in lay_psi {
+        let c = p.cos();
+        assert!((c + 0.5).abs() < 1e-9, "cos ψ = {c}");
+    }
+    let slow = analyse(
+        &scene(plane_rotor(), balls(2, 0.01, 0.01, 0), 0.7)
+            .build()
+            .unwrap(),
+        None,
+    )
+    .unwrap();
+    assert!(!slow.stable && slow.slowest_decay < 0.0, "{slow:?}");
+}
+
+#[test]
+fn three_weights_have_one_neutral_direction() {
+    let r = analyse(
+        &scene(plane_rotor(), balls(3, 0.01, 0.01, 0), 4.0)
+            .build()
+            .unwrap(),
+        None,
+    )
+    .unwrap();
+    assert_eq!(r.neutral, 1);
+    assert!(r.stable);
+    let zeros = r
+        .eigenvalues
+        .iter()
+        .filter(|e| e.0.hypot(e.1) < 1e-6)
+        .count();
+    assert_eq!(zeros, 1, "{:?}", r.eigenvalues);
+}
+
+#[test]
+fn two_support_stability_agrees_with_the_criterion() {
+    // One plane at z = 1 with its elementary unbalance there: the criterion
+    // predicts balancing on (ω1, ω̃) ∪ (ω2, ∞) = (1.414, 2.357) ∪ (3.162, ∞).
+    let single = |omega: f64| {
+        let rotor = long_rotor(vec![1.0], vec![point(0.01, 1.0, 0.0)]);
+        analyse(
+            &scene(rotor, balls(2, 0.01, 0.01, 0), omega)
+                .build()
+                .unwrap(),
+            None,
+        )
+        .unwrap()
+    };
+    for (omega, stable) in [(1.0, false), (1.9, true), (2.75, false), (6.0, true)] {
+        let r = single(omega);
+        assert_eq!(r.stable, stable, "ω = {omega}: σ = {}", r.slowest_decay);
+    }
+    // Two planes: dynamic balancing only above ω2 = √10 (eq 31).
+    let double = |omega: f64| {
+        let rotor = long_rotor(
+            vec![-1.0, 1.0],
+            vec![point(0.012, -1.0, 0.0), point(0.008, 1.0, 2.0)],
+        );
+        let mut cargo = balls(2, 0.01, 0.01, 0);
+        cargo.extend(balls(2, 0.01, 0.01, 1));
+        analyse(&scene(rotor, cargo, omega).build().unwrap(), None).unwrap()
+    };
+    // With real balancers (4 % of the rotor's mass) the stable range begins
+    // near ω ≈ 4.4 rather than at ω2: the balancers' mass shifts it upwards.
+    for (omega, stable) in [
+        (1.0, false),
+        (2.0, false),
+        (2.8, false),
+        (3.5, false),
+        (6.0, true),
+        (8.0, true),
+    ] {
+        let r = double(omega);
+        assert_eq!(r.stable, stable, "ω = {omega}: σ = {}", r.slowest_decay);
+        assert!(r.balancing_error < 1e-9);
+    }
+}
+
+/// Nonlinear settling from near the balanced state against ln(r0/(δ A_ref))/σ.
+///
+/// The run starts with the rotor at rest and the cargoes slightly off their
+/// balanced positions, which excites every mode, the slowest included (a
+/// locked-steady start barely excites the rotor's free whirl); r0 is the
+/// peak vibration of the run.
+fn compare_with_settling(s: Scene, perturb: &[f64]) {
+    let system = s.build().unwrap();
+    let lin = analyse(&system, None).unwrap();
+    assert!(lin.stable);
+    let angles: Vec<f64> = balancing_angles(&system)
+        .iter()
+        .zip(perturb)
+        .map(|(a, d)| a + d)
+        .collect();
+    let delta = 1e-3;
+    let sim = Simulation {
+        scene: s,
+        start: StartMode::Rest,
+        initial_angles: angles,
+        solver: SolverSettings {
+            rtol: 1e-9,
+            atol: 1e-11,
+            ..SolverSettings::default()
+        },
+        metrics: MetricOptions {
+            delta,
+            hold_revs: 20.0,
+            t_end_revs: 3000.0,
+            ..MetricOptions::default()
+        },
+    };
+    let run = sim.run(true).unwrap();
+    assert_eq!(
+        run.metrics.outcome,
+        Outcome::Settled,
+        "{}",
+        run.metrics.reason
+    );
+    let r0 = run.metrics.peak_r / run.metrics.a_ref;
+    // The decay rate itself: slope of ln(per-revolution maximum of r) once
+    // the start-up transient is over, down to the band.
+    let series = run.series.unwrap();
+    let per_rev = 32;
+    let (mut ts_fit, mut ls_fit) = (Vec::new(), Vec::new());
+    for chunk in (0..series.r.len() / per_rev).map(|k| k * per_rev..(k + 1) * per_rev) {
+        let m = series.r[chunk.clone()].iter().cloned().fold(0.0, f64::max);
+        if m < 0.3 * run.metrics.peak_r && m > 3.0 * delta * run.metrics.a_ref {
+            ts_fit.push(series.t[chunk.start]);
+            ls_fit.push(m.ln());
+        }
+    }
+    assert!(ts_fit.len() > 10);
+    let n = ts_fit.len() as f64;
+    let (mt, ml) = (
+        ts_fit.iter().sum::<f64>() / n,
+        ls_fit.iter().sum::<f64>() / n,
+    );
+    let slope = ts_fit
+        .iter()
+        .zip(&ls_fit)
+        .map(|(t, l)| (t - mt) * (l - ml))
+        .sum::<f64>()
+        / ts_fit.iter().map(|t| (t - mt).powi(2)).sum::<f64>();
+    assert!(
+        (-slope / lin.slowest_decay - 1.0).abs() < 0.1,
+        "fitted decay {} vs linear σ = {}",
+        -slope,
+        lin.slowest_decay
+    );
+    let predicted = lin.settling_time(r0, delta);
+    let ts = run.metrics.settling_time.unwrap();
+    let ratio = ts / predicted;
+    assert!(
+        (0.7..1.3).contains(&ratio),
+        "t_s = {ts:.2}, ln(r0/δ)/σ = {predicted:.2} (σ = {:.4}, r0 = {r0:.3} A_ref)",
+        lin.slowest_decay
+    );
+}
+
+#[test]
+fn decay_rate_predicts_the_settling_time_of_the_plane_rotor() {
+    compare_with_settling(
+        scene(plane_rotor(), balls(2, 0.01, 0.01, 0), 4.0),
+        &[0.04, -0.02],
+    );
+}
+
+#[test]
+fn decay_rate_predicts_the_settling_time_of_the_two_support_rotor() {
+    let rotor = long_rotor(
+        vec![-1.0, 1.0],
+        vec![point(0.012, -1.0, 0.0), point(0.008, 1.0, 2.0)],
+    );
+    let mut cargo = balls(2, 0.01, 0.01, 0);
+    cargo.extend(balls(2, 0.01, 0.01, 1));
+    compare_with_settling(scene(rotor, cargo, 6.0), &[0.04, -0.02, 0.03, 0.01]);
+}
+
+#[test]
+fn anisotropic_supports_and_variable_speed_are_refused() {
+    let mut r = PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1);
+    r.ky = 1.3;
+    let err = analyse(
+        &scene(r.into(), balls(2, 0.01, 0.01, 0), 4.0)
+            .build()
+            .unwrap(),
+        None,
+    )
+    .unwrap_err();
+    assert!(matches!(err, LinearError::NotAutonomous(_)), "{err}");
+    let mut s = scene(plane_rotor(), balls(2, 0.01, 0.01, 0), 4.0);
+    s.speed = SpeedLaw::Free { omega_start: 4.0 };
+    assert_eq!(
+        analyse(&s.build().unwrap(), None).unwrap_err(),
+        LinearError::NotConstantSpeed
+    );
+}
+
+#[test]
+fn study_linear_reports_the_scene_file() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .args([
+            "linear",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/two_support_long.toml"),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["stable"], true);
+    assert_eq!(v["eigenvalues"].as_array().unwrap().len(), 16);
+    assert!(v["slowest_decay"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn decay_rate_predicts_the_settling_time_of_the_flexible_shaft() {
+    // Seed 002's shaft with stronger damping (ζt = ζr = 0.05) and ball drag,
+    // so that the run stays short.
+    let shaft = autobal::model::rotor::FlexibleShaft::dimensionless(2.0, 0.05, 0.05, 0.01);
+    let cargo = vec![Cargo::point(0.01, 1.0, 0.002, 1.0); 2];
+    compare_with_settling(scene(shaft.into(), cargo, 1.5), &[0.04, -0.02]);
+}
