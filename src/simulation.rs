@@ -139,6 +139,10 @@ pub enum Fidelity {
     /// Closed-form slow mode (quasi-static, `model::quasi_static`): microseconds,
     /// a settling estimate ln(1/δ)/|Re λ| and nothing else.
     Analytic,
+    /// Eigenvalues of the linearisation about the balanced state
+    /// (`model::linear`): stability and the slowest decay rate σ; a settling
+    /// estimate ln((r₀/A_ref)/δ)/σ. Milliseconds.
+    Linear,
     /// Exact equations in the rotor-fixed frame: autonomous for isotropic
     /// supports at constant speed without in-plane gravity.
     Rotating,
@@ -154,6 +158,7 @@ impl Fidelity {
     pub fn name(self) -> &'static str {
         match self {
             Fidelity::Analytic => "analytic",
+            Fidelity::Linear => "linear",
             Fidelity::Rotating => "rotating",
             Fidelity::Full => "full",
             Fidelity::Auto => "auto",
@@ -187,6 +192,7 @@ impl Simulation {
         let fidelity = self.resolved_fidelity();
         let (mut metrics, series) = match fidelity {
             Fidelity::Analytic => (self.analytic(&system, omega), None),
+            Fidelity::Linear => (self.linear(&system, &y0, omega), None),
             Fidelity::Rotating => {
                 let rotating = RotatingSystem::new(&self.scene)?;
                 let nq = system.layout().nq();
@@ -267,12 +273,47 @@ impl Simulation {
         (metrics, series)
     }
 
-    /// The closed-form estimate: settled when the slow mode decays, with
-    /// t_s = ln(1/δ)/|Re λ|; no residual, no steps.
-    fn analytic(&self, system: &RotorSystem, omega: f64) -> RunMetrics {
-        let rev = 2.0 * PI / omega;
-        let a_ref = crate::metrics::reference::a_ref(system, omega);
-        let base = RunMetrics {
+    /// The linearised estimate: settled when the balanced state is stable,
+    /// with t_s = ln((r₀/A_ref)/δ)/σ from the run's initial amplitude r₀.
+    fn linear(&self, system: &RotorSystem, y0: &[f64], omega: f64) -> RunMetrics {
+        let mut m = self.analytic_base(system, omega);
+        m.method = "eigenvalues".into();
+        match crate::model::linear::analyse(system, None) {
+            Ok(report) if report.stable && report.slowest_decay > 0.0 => {
+                let r0 = y0[0].hypot(y0[1]) / m.a_ref;
+                let delta = self.metrics.delta;
+                let t = (r0.max(delta) / delta).ln() / report.slowest_decay;
+                let rev = 2.0 * PI / omega;
+                RunMetrics {
+                    settled: true,
+                    settling_time: Some(t),
+                    settling_revs: Some(t / rev),
+                    hold_complete: true,
+                    outcome: Outcome::Settled,
+                    reason: format!(
+                        "linear estimate ln((r0/A_ref)/δ)/σ with σ = {:.4e} 1/s ({} neutral directions set aside)",
+                        report.slowest_decay, report.neutral
+                    ),
+                    ..m
+                }
+            }
+            Ok(report) => RunMetrics {
+                reason: format!(
+                    "linear: the balanced state is unstable (σ = {:.3e} 1/s)",
+                    report.slowest_decay
+                ),
+                ..m
+            },
+            Err(e) => RunMetrics {
+                reason: format!("linear: {e}"),
+                ..m
+            },
+        }
+    }
+
+    /// Metrics of a run that was not integrated (estimates fill in what they know).
+    fn analytic_base(&self, system: &RotorSystem, omega: f64) -> RunMetrics {
+        RunMetrics {
             settled: false,
             settling_time: None,
             settling_revs: None,
@@ -281,7 +322,7 @@ impl Simulation {
             hold_complete: false,
             residual_abs: 0.0,
             residual_rel: 0.0,
-            a_ref,
+            a_ref: crate::metrics::reference::a_ref(system, omega),
             balancing_error: 0.0,
             peak_r: 0.0,
             final_rel_angles_deg: Vec::new(),
@@ -293,7 +334,14 @@ impl Simulation {
             rhs_calls: 0,
             method: "closed_form".into(),
             fidelity: String::new(),
-        };
+        }
+    }
+
+    /// The closed-form estimate: settled when the slow mode decays, with
+    /// t_s = ln(1/δ)/|Re λ|; no residual, no steps.
+    fn analytic(&self, system: &RotorSystem, omega: f64) -> RunMetrics {
+        let rev = 2.0 * PI / omega;
+        let base = self.analytic_base(system, omega);
         match slow_mode(&self.scene) {
             Ok(mode) if mode.decay_rate < 0.0 => {
                 let t = (1.0 / self.metrics.delta).ln() / -mode.decay_rate;

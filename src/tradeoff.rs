@@ -31,8 +31,8 @@ pub struct Setting {
 impl Setting {
     /// "rotating/radau5/1e-6".
     pub fn label(&self) -> String {
-        if self.fidelity == Fidelity::Analytic {
-            "analytic".into()
+        if matches!(self.fidelity, Fidelity::Analytic | Fidelity::Linear) {
+            self.fidelity.name().into()
         } else {
             format!(
                 "{}/{}/{:.0e}",
@@ -86,14 +86,15 @@ pub struct SettingSummary {
     pub mean_wall_time_s: f64,
 }
 
-/// The settings swept: analytic; each applicable frame with its default
+/// The settings swept: analytic; linear; each applicable frame with its default
 /// method at rtol 1e-3 … 1e-10; and DOP853 in the inertial frame.
 pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
-    let mut v = vec![Setting {
-        fidelity: Fidelity::Analytic,
+    let estimate = |fidelity| Setting {
+        fidelity,
         method: MethodChoice::Auto,
         rtol: 0.0,
-    }];
+    };
+    let mut v = vec![estimate(Fidelity::Analytic), estimate(Fidelity::Linear)];
     let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
     let mut frames = vec![
         (Fidelity::Full, MethodChoice::Dp5),
