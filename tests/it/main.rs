@@ -7,6 +7,7 @@ mod cli_simulate;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;
+mod extremes;
 mod integrate;
 mod model_conservation;
 mod model_flexible;
