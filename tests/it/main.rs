@@ -19,3 +19,4 @@ mod study_input;
 mod study_runner;
 mod study_summary;
 mod study_sweep;
+mod tradeoff;
