@@ -53,7 +53,7 @@ pub struct TradeoffRow {
     pub setting: Setting,
     /// Settling time (revolutions), if settled.
     pub settling_revs: Option<f64>,
-    /// |t_s − t_s,ref| in revolutions, when both settled.
+    /// |t_s − t_s,ref| in revolutions (0 when neither settles; None when only one does).
     pub settling_error_revs: Option<f64>,
     /// |residual − residual_ref| in units of A_ref.
     pub residual_error: f64,
@@ -78,6 +78,8 @@ pub struct SettingSummary {
     pub median_error_revs: Option<f64>,
     /// Largest |Δt_s| (revolutions).
     pub max_error_revs: Option<f64>,
+    /// Largest |residual − residual_ref| (units of A_ref).
+    pub max_residual_error: f64,
     /// Fraction of runs whose outcome class matches the reference.
     pub outcome_agreement: f64,
     /// Mean right-hand-side calls per run.
@@ -94,13 +96,17 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
         method: MethodChoice::Auto,
         rtol: 0.0,
     };
-    let mut v = vec![estimate(Fidelity::Analytic), estimate(Fidelity::Linear)];
+    let mut v = Vec::new();
     let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
     let mut frames = vec![
         (Fidelity::Full, MethodChoice::Dp5),
         (Fidelity::Full, MethodChoice::Dop853),
     ];
+    // The estimates hold where the rotating frame is exact (isotropic, constant
+    // speed, no in-plane gravity); elsewhere they do not apply at all.
     if rotating_frame_obstacle(&probe).is_none() {
+        v.push(estimate(Fidelity::Analytic));
+        v.push(estimate(Fidelity::Linear));
         frames.push((Fidelity::Rotating, MethodChoice::Radau5));
         frames.push((Fidelity::Rotating, MethodChoice::Dp5));
     }
@@ -165,6 +171,8 @@ pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
             let (m, wall) = simulate(plan, run_id, setting);
             let settling_error_revs = match (m.settling_revs, reference.settling_revs) {
                 (Some(a), Some(b)) => Some((a - b).abs()),
+                // Both agree that the run does not settle.
+                (None, None) => Some(0.0),
                 _ => None,
             };
             let angles = sorted_angles(&m);
@@ -218,6 +226,7 @@ pub fn summarize(rows: &[TradeoffRow]) -> Vec<SettingSummary> {
             setting: s,
             median_error_revs: (!errs.is_empty()).then(|| errs[errs.len() / 2]),
             max_error_revs: errs.last().copied(),
+            max_residual_error: mine.iter().map(|r| r.residual_error).fold(0.0, f64::max),
             outcome_agreement: mine.iter().filter(|r| r.outcome_agrees).count() as f64 / n,
             mean_rhs_calls: mine.iter().map(|r| r.rhs_calls as f64).sum::<f64>() / n,
             mean_wall_time_s: mine.iter().map(|r| r.wall_time_s).sum::<f64>() / n,
@@ -227,13 +236,20 @@ pub fn summarize(rows: &[TradeoffRow]) -> Vec<SettingSummary> {
 }
 
 /// The cheapest setting (by mean wall time) whose largest settling error is
-/// within `budget_revs` and whose outcomes all agree with the reference.
-pub fn recommend(summary: &[SettingSummary], budget_revs: f64) -> Option<&SettingSummary> {
+/// within `budget_revs`, whose residual error is within `budget_residual`
+/// (units of A_ref; estimates, which give no residual, are judged on settling
+/// only) and whose outcomes all agree with the reference.
+pub fn recommend(
+    summary: &[SettingSummary],
+    budget_revs: f64,
+    budget_residual: f64,
+) -> Option<&SettingSummary> {
     summary
         .iter()
         .filter(|s| {
             s.outcome_agreement == 1.0 && s.max_error_revs.is_some_and(|e| e <= budget_revs)
         })
+        .filter(|s| s.setting.rtol == 0.0 || s.max_residual_error <= budget_residual)
         .min_by(|a, b| a.mean_wall_time_s.total_cmp(&b.mean_wall_time_s))
 }
 

@@ -50,7 +50,7 @@ t_end_revs = 300
         );
         assert_eq!(s.outcome_agreement, 1.0);
     }
-    let best = recommend(&summary, 1.0).expect("some setting meets 1 rev");
+    let best = recommend(&summary, 1.0, 0.01).expect("some setting meets 1 rev");
     assert!(best.max_error_revs.unwrap() <= 1.0 && best.outcome_agreement == 1.0);
     let df = rows_frame(&rows).unwrap();
     for c in [

@@ -23,6 +23,9 @@ pub struct TradeoffArgs {
     /// Error budget: largest acceptable settling-time error (revolutions).
     #[arg(long, default_value_t = 1.0)]
     budget_revs: f64,
+    /// Error budget on the residual vibration (units of A_ref).
+    #[arg(long, default_value_t = 0.01)]
+    budget_residual: f64,
 }
 
 /// Run `study tradeoff`.
@@ -48,6 +51,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
                 s.setting.label(),
                 f(s.median_error_revs),
                 f(s.max_error_revs),
+                format!("{:.1e}", s.max_residual_error),
                 format!("{:.0} %", 100.0 * s.outcome_agreement),
                 format!("{:.0}", s.mean_rhs_calls),
                 format!("{:.3}", 1e3 * s.mean_wall_time_s),
@@ -61,6 +65,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
                 "setting",
                 "median |Δt_s| rev",
                 "max |Δt_s| rev",
+                "max |Δresidual|/A_ref",
                 "outcome agrees",
                 "RHS calls",
                 "ms/run"
@@ -68,10 +73,11 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
             &table
         )
     );
-    match recommend(&summary, args.budget_revs) {
+    match recommend(&summary, args.budget_revs, args.budget_residual) {
         Some(best) => println!(
-            "recommended within {} rev: {} ({:.3} ms/run, {:.0} RHS calls)",
+            "recommended within {} rev and {} A_ref: {} ({:.3} ms/run, {:.0} RHS calls)",
             args.budget_revs,
+            args.budget_residual,
             best.setting.label(),
             1e3 * best.mean_wall_time_s,
             best.mean_rhs_calls
