@@ -21,6 +21,7 @@ pub mod design;
 pub mod integrate;
 pub mod metrics;
 pub mod model;
+pub mod plot;
 pub mod scene_file;
 pub mod simulation;
 pub mod study;
