@@ -5,6 +5,7 @@
 mod bench_cmd;
 mod design_cmd;
 mod output;
+mod plot_cmd;
 mod run_cmd;
 mod simulate_cmd;
 
@@ -36,6 +37,9 @@ enum Command {
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
+    /// Figures as SVG or PNG: one run, one study, design curves, work–precision.
+    #[command(after_help = plot_cmd::EXAMPLES)]
+    Plot(plot_cmd::PlotArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -62,6 +66,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Bench(args) => bench_cmd::run(&args),
+        Command::Plot(args) => plot_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
