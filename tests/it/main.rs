@@ -8,6 +8,7 @@ mod design_transient;
 mod integrate;
 mod model_conservation;
 mod model_physics;
+mod plot;
 mod study_input;
 mod study_runner;
 mod study_summary;
