@@ -547,8 +547,9 @@ impl Figure for SettlingScatter<'_> {
         let settled = runs
             .iter()
             .filter(|r| r.metrics.settled)
-            .filter_map(|r| r.metrics.settling_revs);
-        let (lo, data_hi) = style::extent(settled.clone().filter(|v| *v > 0.0))
+            .filter_map(|r| r.metrics.settling_revs)
+            .filter(|v| *v > 0.0);
+        let (lo, data_hi) = style::extent(settled)
             .ok_or_else(|| PlotError::NoData("no positive settling time".into()))?;
         let any_unsettled = runs.iter().any(|r| !r.metrics.settled);
         // Unsettled runs have no settling time: they get a row of crosses above the data.
