@@ -23,6 +23,7 @@ pub mod integrate;
 pub mod metrics;
 pub mod model;
 pub mod optimize;
+pub mod plot;
 pub mod scene_file;
 pub mod simulation;
 pub mod study;

@@ -15,6 +15,7 @@ mod model_linear;
 mod model_physics;
 mod model_two_support;
 mod optimize;
+mod plot;
 mod study_input;
 mod study_runner;
 mod study_summary;

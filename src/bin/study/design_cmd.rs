@@ -33,7 +33,7 @@ pub struct DesignArgs {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
-enum KindArg {
+pub(crate) enum KindArg {
     Ball,
     Roller,
 }
@@ -49,9 +49,9 @@ impl From<KindArg> for Shape {
 
 /// The weight counts requested on the command line.
 #[derive(Clone)]
-struct Counts(Vec<u32>);
+pub(crate) struct Counts(pub(crate) Vec<u32>);
 
-fn parse_counts(text: &str) -> Result<Counts, String> {
+pub(crate) fn parse_counts(text: &str) -> Result<Counts, String> {
     let number = |s: &str| {
         let n: u32 = s
             .trim()

@@ -10,6 +10,7 @@ mod linear_cmd;
 mod map_cmd;
 mod optimize_cmd;
 mod output;
+mod plot_cmd;
 mod run_cmd;
 mod simulate_cmd;
 mod sweep_cmd;
@@ -64,6 +65,9 @@ enum Command {
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
+    /// Figures as SVG or PNG: one run, one study, design curves, work–precision.
+    #[command(after_help = plot_cmd::EXAMPLES)]
+    Plot(plot_cmd::PlotArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -97,6 +101,7 @@ fn main() -> ExitCode {
         Command::Claims(args) => claims_cmd::run(&args),
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
+        Command::Plot(args) => plot_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
