@@ -3,6 +3,7 @@
 //! bad input).
 
 mod bench_cmd;
+mod check_cmd;
 mod design_cmd;
 mod output;
 mod run_cmd;
@@ -36,6 +37,12 @@ enum Command {
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
+    /// Compare a fresh run of a study with its baseline: KS, Fisher and Mood tests, Holm; exit 1 on a regression.
+    #[command(after_help = check_cmd::CHECK_EXAMPLES)]
+    Check(check_cmd::CheckArgs),
+    /// Run a study and write (or refresh) its baseline for `study check`, with provenance.
+    #[command(after_help = check_cmd::BASELINE_EXAMPLES)]
+    Baseline(check_cmd::BaselineArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -62,6 +69,8 @@ fn main() -> ExitCode {
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Bench(args) => bench_cmd::run(&args),
+        Command::Check(args) => check_cmd::check(&args),
+        Command::Baseline(args) => check_cmd::baseline(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
