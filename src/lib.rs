@@ -17,6 +17,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bench;
+pub mod check;
 pub mod claims;
 pub mod design;
 pub mod integrate;

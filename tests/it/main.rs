@@ -1,6 +1,7 @@
 //! autobal's integration tests, linked into one binary to keep builds fast.
 
 mod bench;
+mod check;
 mod claims;
 mod cli_design;
 mod cli_simulate;

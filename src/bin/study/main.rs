@@ -3,6 +3,7 @@
 //! bad input).
 
 mod bench_cmd;
+mod check_cmd;
 mod claims_cmd;
 mod criterion_cmd;
 mod design_cmd;
@@ -68,6 +69,12 @@ enum Command {
     /// Figures as SVG or PNG: one run, one study, design curves, work–precision.
     #[command(after_help = plot_cmd::EXAMPLES)]
     Plot(plot_cmd::PlotArgs),
+    /// Compare a fresh run of a study with its baseline: KS, Fisher and Mood tests, Holm; exit 1 on a regression.
+    #[command(after_help = check_cmd::CHECK_EXAMPLES)]
+    Check(check_cmd::CheckArgs),
+    /// Run a study and write (or refresh) its baseline for `study check`, with provenance.
+    #[command(after_help = check_cmd::BASELINE_EXAMPLES)]
+    Baseline(check_cmd::BaselineArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -102,6 +109,8 @@ fn main() -> ExitCode {
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
+        Command::Check(args) => check_cmd::check(&args),
+        Command::Baseline(args) => check_cmd::baseline(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

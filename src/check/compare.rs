@@ -1,0 +1,243 @@
+//! The verdict table: every design's three metrics, baseline against now,
+//! tested, Holm-corrected together, and judged.
+//!
+//! A significant change in either direction is a regression: faster settling
+//! after a change nobody meant to make is as much a sign that the physics or
+//! numerics moved as slower settling is.
+
+use super::holm::holm_adjust;
+use super::ks::ks_two_sample;
+use super::median::{median, mood_median_test};
+use super::proportion::fisher_two_proportions;
+use super::samples::DesignSample;
+use serde::Serialize;
+
+/// Family-wise false-alarm rate used when none is given.
+pub const DEFAULT_ALPHA: f64 = 0.01;
+
+/// What is compared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// Settling time of the settled runs (revolutions): two-sample KS.
+    SettlingTime,
+    /// Fraction of runs that settled: Fisher's exact test.
+    SettledFraction,
+    /// Median residual vibration (relative to A_ref): Mood's median test.
+    ResidualMedian,
+}
+
+impl Metric {
+    /// Short name used in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::SettlingTime => "settling_revs",
+            Metric::SettledFraction => "settled_fraction",
+            Metric::ResidualMedian => "residual_rel",
+        }
+    }
+
+    /// The test applied.
+    pub fn test(self) -> &'static str {
+        match self {
+            Metric::SettlingTime => "KS",
+            Metric::SettledFraction => "Fisher",
+            Metric::ResidualMedian => "Mood",
+        }
+    }
+}
+
+/// The judgement on one hypothesis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// No significant change.
+    Pass,
+    /// A significant change (Holm-adjusted p ≤ α).
+    Regression,
+    /// Not testable: a sample is empty (e.g. no settled runs on one side).
+    NotTested,
+}
+
+impl Verdict {
+    /// Label used in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Pass => "pass",
+            Verdict::Regression => "REGRESSION",
+            Verdict::NotTested => "n/a",
+        }
+    }
+}
+
+/// One row of the verdict table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VerdictRow {
+    /// Design index.
+    pub design_id: u32,
+    /// Design label.
+    pub design: String,
+    /// The metric.
+    pub metric: Metric,
+    /// Baseline value: median settling time, settled fraction or median residual.
+    pub baseline: Option<f64>,
+    /// The same value now.
+    pub now: Option<f64>,
+    /// Effect size: relative change of the median (now/baseline − 1) for
+    /// settling time and residual, difference of fractions for the settled fraction.
+    pub effect: Option<f64>,
+    /// Test statistic where it is meaningful (KS: D, the largest CDF gap).
+    pub statistic: Option<f64>,
+    /// Sample sizes (baseline, now) the test used.
+    pub sizes: (u64, u64),
+    /// Raw p-value.
+    pub p_value: Option<f64>,
+    /// Holm-adjusted p-value over every tested row of the table.
+    pub p_holm: Option<f64>,
+    /// The judgement.
+    pub verdict: Verdict,
+}
+
+/// The whole comparison.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CheckReport {
+    /// One row per design and metric, in design order.
+    pub rows: Vec<VerdictRow>,
+    /// Family-wise level.
+    pub alpha: f64,
+    /// Number of hypotheses tested (the Holm family).
+    pub tested: usize,
+    /// True when every design's samples are identical to the baseline's.
+    pub identical: bool,
+}
+
+impl CheckReport {
+    /// Rows judged a regression.
+    pub fn regressions(&self) -> usize {
+        self.rows
+            .iter()
+            .filter(|r| r.verdict == Verdict::Regression)
+            .count()
+    }
+
+    /// True when nothing regressed.
+    pub fn passed(&self) -> bool {
+        self.regressions() == 0
+    }
+}
+
+/// Why two sets of samples cannot be compared.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CompareError {
+    /// The design lists differ.
+    #[error("the baseline has designs {baseline:?} but the new run has {now:?}")]
+    DifferentDesigns {
+        /// Design ids in the baseline.
+        baseline: Vec<u32>,
+        /// Design ids now.
+        now: Vec<u32>,
+    },
+    /// α outside (0, 1).
+    #[error("alpha = {0}: must lie strictly between 0 and 1")]
+    BadAlpha(f64),
+}
+
+fn relative(base: Option<f64>, now: Option<f64>) -> Option<f64> {
+    match (base, now) {
+        (Some(b), Some(n)) if b != 0.0 => Some(n / b - 1.0),
+        _ => None,
+    }
+}
+
+/// Test every design and metric, correct with Holm at family-wise level `alpha`.
+pub fn compare(
+    baseline: &[DesignSample],
+    now: &[DesignSample],
+    alpha: f64,
+) -> Result<CheckReport, CompareError> {
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(CompareError::BadAlpha(alpha));
+    }
+    let ids = |s: &[DesignSample]| s.iter().map(|d| d.design_id).collect::<Vec<_>>();
+    if ids(baseline) != ids(now) {
+        return Err(CompareError::DifferentDesigns {
+            baseline: ids(baseline),
+            now: ids(now),
+        });
+    }
+    let mut rows = Vec::with_capacity(3 * baseline.len());
+    for (b, n) in baseline.iter().zip(now) {
+        let row =
+            |metric, baseline, now, effect, statistic, sizes, p_value: Option<f64>| VerdictRow {
+                design_id: b.design_id,
+                design: b.label.clone(),
+                metric,
+                baseline,
+                now,
+                effect,
+                statistic,
+                sizes,
+                p_value,
+                p_holm: None,
+                verdict: Verdict::NotTested,
+            };
+        let (mb, mn) = (median(&b.settling_revs), median(&n.settling_revs));
+        let ks = ks_two_sample(&b.settling_revs, &n.settling_revs);
+        rows.push(row(
+            Metric::SettlingTime,
+            mb,
+            mn,
+            relative(mb, mn),
+            ks.map(|k| k.statistic),
+            (b.settling_revs.len() as u64, n.settling_revs.len() as u64),
+            ks.map(|k| k.p_value),
+        ));
+        let fraction = fisher_two_proportions(b.settled, b.runs, n.settled, n.runs);
+        rows.push(row(
+            Metric::SettledFraction,
+            fraction.map(|f| f.a),
+            fraction.map(|f| f.b),
+            fraction.map(|f| f.difference),
+            None,
+            (b.runs, n.runs),
+            fraction.map(|f| f.p_value),
+        ));
+        let mood = mood_median_test(&b.residual_rel, &n.residual_rel);
+        let (rb, rn) = (median(&b.residual_rel), median(&n.residual_rel));
+        rows.push(row(
+            Metric::ResidualMedian,
+            rb,
+            rn,
+            relative(rb, rn),
+            None,
+            (b.residual_rel.len() as u64, n.residual_rel.len() as u64),
+            mood.map(|m| m.p_value),
+        ));
+    }
+    let tested: Vec<usize> = (0..rows.len())
+        .filter(|&i| rows[i].p_value.is_some())
+        .collect();
+    let raw: Vec<f64> = tested
+        .iter()
+        .map(|&i| rows[i].p_value.unwrap_or(1.0))
+        .collect();
+    for (&i, p) in tested.iter().zip(holm_adjust(&raw)) {
+        rows[i].p_holm = Some(p);
+        rows[i].verdict = if p <= alpha {
+            Verdict::Regression
+        } else {
+            Verdict::Pass
+        };
+    }
+    Ok(CheckReport {
+        rows,
+        alpha,
+        tested: tested.len(),
+        identical: baseline.iter().zip(now).all(|(b, n)| {
+            b.runs == n.runs
+                && b.settled == n.settled
+                && b.settling_revs == n.settling_revs
+                && b.residual_rel == n.residual_rel
+        }),
+    })
+}

@@ -1,0 +1,166 @@
+//! The two halves of a regression check on a whole study: record a baseline
+//! from a run, and compare a fresh run (or a finished runs file) with it.
+//!
+//! Seeds: by default the fresh run uses the study's own seed, i.e. the
+//! baseline's random inputs. Unchanged code then reproduces the baseline
+//! (bit-identically on the same platform) and a changed one is compared
+//! unit by unit on the same unbalances, which is the most sensitive setting
+//! and can never raise a false alarm from sampling noise; the two-sample
+//! tests stay valid (conservative) because their samples are only more alike
+//! than independent ones. A different seed (`seed`) draws independent
+//! inputs: the honest test of the noise model, whose false-alarm rate is α.
+
+use super::baseline::{BaselineError, Manifest, check_same_study, read_baseline, write_baseline};
+use super::compare::{CheckReport, CompareError, compare};
+use super::samples::design_samples;
+use crate::study::config::StudyPlan;
+use crate::study::io::{read_metadata, read_parquet, sha256_hex};
+use crate::study::record::to_dataframe;
+use crate::study::run::{Progress, RunError, RunOptions, run_study};
+use polars::prelude::PolarsError;
+use std::path::{Path, PathBuf};
+
+/// How to obtain and judge the new results.
+#[derive(Debug, Clone)]
+pub struct CheckOptions {
+    /// Seed of the fresh run (default: the study's, i.e. the baseline's inputs).
+    pub seed: Option<u64>,
+    /// Family-wise false-alarm level of the Holm-corrected tests.
+    pub alpha: f64,
+    /// Compare this finished `runs.parquet` instead of running the study.
+    pub runs: Option<PathBuf>,
+    /// Root folder of the fresh run (default `<output>/check`); files go to `<root>/<name>/`.
+    pub output_root: Option<PathBuf>,
+    /// How to execute the fresh run.
+    pub run: RunOptions,
+}
+
+/// What a check found.
+#[derive(Debug)]
+pub struct CheckOutcome {
+    /// The verdict table.
+    pub report: CheckReport,
+    /// The baseline's manifest.
+    pub baseline: Manifest,
+    /// Seed of the new results.
+    pub seed: u64,
+    /// The runs file that was compared.
+    pub runs_file: PathBuf,
+}
+
+/// Why a check could not reach a verdict.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckError {
+    /// The baseline is missing, unreadable or from another study.
+    #[error(transparent)]
+    Baseline(#[from] BaselineError),
+    /// A runs file given for comparison is unusable.
+    #[error("{path}: {message}")]
+    BadRuns {
+        /// The file.
+        path: String,
+        /// Why.
+        message: String,
+    },
+    /// Baseline and new results cannot be compared.
+    #[error(transparent)]
+    Compare(#[from] CompareError),
+    /// The fresh run failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// Reading Parquet failed.
+    #[error("parquet: {0}")]
+    Polars(#[from] PolarsError),
+}
+
+impl CheckError {
+    /// True when the error is the user's (bad baseline, runs file or options): exit code 2.
+    pub fn is_user_error(&self) -> bool {
+        match self {
+            CheckError::Baseline(e) => e.is_user_error(),
+            CheckError::BadRuns { .. } | CheckError::Compare(_) => true,
+            CheckError::Run(e) => e.is_user_error(),
+            CheckError::Polars(_) => false,
+        }
+    }
+}
+
+/// Run `plan` as `study run` would and record its results as a baseline in `dir`.
+pub fn record_baseline(
+    plan: &StudyPlan,
+    dir: &Path,
+    run: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<Manifest, CheckError> {
+    let output = run_study(plan, run, progress)?;
+    Ok(write_baseline(dir, plan, &output.runs)?)
+}
+
+/// Compare new results of `plan` with the baseline in `baseline_dir`.
+pub fn check_study(
+    plan: &StudyPlan,
+    baseline_dir: &Path,
+    options: &CheckOptions,
+    progress: &dyn Progress,
+) -> Result<CheckOutcome, CheckError> {
+    let baseline = read_baseline(baseline_dir)?;
+    check_same_study(&baseline, plan)?;
+    let (samples, seed, runs_file) = match &options.runs {
+        Some(path) => {
+            let seed = runs_file_seed(path, plan)?;
+            (design_samples(&read_parquet(path)?)?, seed, path.clone())
+        }
+        None => {
+            let mut fresh = plan.clone();
+            fresh.file.seed = options.seed.unwrap_or(plan.file.seed);
+            let root = options
+                .output_root
+                .clone()
+                .unwrap_or_else(|| Path::new(&plan.file.output).join("check"));
+            fresh.file.output = root.display().to_string();
+            let out = run_study(&fresh, &options.run, progress)?;
+            (
+                design_samples(&to_dataframe(&out.runs)?)?,
+                fresh.file.seed,
+                out.dir.join("runs.parquet"),
+            )
+        }
+    };
+    let report = compare(&baseline.samples, &samples, options.alpha)?;
+    Ok(CheckOutcome {
+        report,
+        baseline: baseline.manifest,
+        seed,
+        runs_file,
+    })
+}
+
+/// The seed of a finished, unsharded runs file of this very study.
+fn runs_file_seed(path: &Path, plan: &StudyPlan) -> Result<u64, CheckError> {
+    let bad = |message: &str| CheckError::BadRuns {
+        path: path.display().to_string(),
+        message: message.to_string(),
+    };
+    if !path.is_file() {
+        return Err(bad("no such file"));
+    }
+    let meta = read_metadata(path).map_err(|e| bad(&e.to_string()))?;
+    let get = |k: &str| {
+        meta.iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.as_str())
+    };
+    if get("study_sha256") != Some(sha256_hex(&plan.text).as_str()) {
+        return Err(bad(
+            "was not written by this study file (its provenance names another study)",
+        ));
+    }
+    if get("shard") != Some("all") {
+        return Err(bad(
+            "holds one shard only; merge the shards with `study merge` first",
+        ));
+    }
+    get("seed")
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| bad("has no seed in its provenance"))
+}
