@@ -6,8 +6,19 @@
 //! radius, balance the rotor fastest and best over every unbalance it meets?
 //!
 //! ## Data flow
-//! - [`design`]: the analytic theory (capacity, optimal radius, transient measures)
-//!   — pure functions, microseconds.
+//! - [`design`]: the analytic theory (capacity, optimal radius, transient
+//!   measures, seed 003's criterion) — pure functions, microseconds.
+//! - [`model`]: what is simulated — a [`model::scene::Scene`] of rotor,
+//!   balancers, speed law and effects, assembled into an ODE system.
+//! - [`integrate`]: how — DP5, DOP853, Radau5 behind one `solve`, with dense
+//!   output and step observers.
+//! - [`metrics`]: what a run means — settling time, residual vibration,
+//!   outcome — defined once.
+//! - [`simulation`]: one run at a chosen fidelity.
+//! - [`study`]: many runs on all cores, statistics with polars, Parquet.
+//! - Analyses on top: [`optimize`], [`claims`], [`tradeoff`], [`check`], [`plot`].
+//!
+//! Start reading at [`simulation::Simulation::run`] and [`study::run::run_study`].
 //!
 //! The library never prints: the `study` binary is a thin layer that parses
 //! arguments, calls the library and formats the results.
