@@ -9,6 +9,7 @@
 
 pub mod decimate;
 pub mod design;
+pub mod map;
 pub mod run;
 pub mod study;
 pub mod style;

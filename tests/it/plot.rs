@@ -628,3 +628,49 @@ fn cli_writes_figures_and_rejects_bad_input() {
         "bad.toml",
     );
 }
+
+#[test]
+fn stability_map_is_drawn_from_the_map_table() {
+    use autobal::plot::map::{plot_stability_map, read_map};
+    use autobal::study::stability_map::{MapPoint, to_dataframe};
+    let tmp = tempfile::tempdir().unwrap();
+    let mut points = Vec::new();
+    for j in 0..4 {
+        for i in 0..5 {
+            let omega = 0.5 + f64::from(i);
+            points.push(MapPoint {
+                omega,
+                unbalance: 0.005 * f64::from(j + 1),
+                balanced: j < 3,
+                stable: Some(omega > 1.0),
+                slowest_decay: Some(0.1),
+            });
+        }
+    }
+    let table = tmp.path().join("map.parquet");
+    let mut df = to_dataframe(&points).unwrap();
+    autobal::study::io::write_parquet(
+        &table,
+        &mut df,
+        &autobal::study::io::Provenance::new("", 0, "test"),
+    )
+    .unwrap();
+    let back = read_map(&table).unwrap();
+    assert_eq!(back.len(), 20);
+    let png = tmp.path().join("map.png");
+    plot_stability_map(&back, "map test", &png).unwrap();
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let (w, h) = (
+        u32::from_be_bytes(bytes[16..20].try_into().unwrap()),
+        u32::from_be_bytes(bytes[20..24].try_into().unwrap()),
+    );
+    assert_eq!((w, h), (1000, 760));
+    let svg = tmp.path().join("map.svg");
+    plot_stability_map(&back, "map test", &svg).unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("map test") && text.contains("speed ω") && text.contains("rotor unbalance U")
+    );
+    assert!(plot_stability_map(&[], "empty", &svg).is_err());
+}

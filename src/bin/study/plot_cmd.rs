@@ -19,7 +19,8 @@ pub const EXAMPLES: &str = "Examples:
   study plot study results/three_balls --out figures/ --format png
   study plot study results/three_balls --out docs/figures/three_balls --only settling-time
   study plot design --kind ball --n 1..8 --out design.svg
-  study plot tradeoff results/tradeoff/tradeoff.parquet --out wp.png
+  study plot tradeoff results/three_balls/tradeoff.parquet --out wp.png
+  study plot map results/flexible_map.parquet --out map.png
 
 The format follows the extension of --out (.svg or .png); `plot study` writes
 settling_time, settled_fraction and settling_vs_unbalance into the --out folder.";
@@ -41,6 +42,20 @@ enum Figure {
     Design(DesignArgs),
     /// Plot the work–precision diagram of a trade-off table (error vs cost per fidelity).
     Tradeoff(TradeoffArgs),
+    /// Plot the stability map written by `study map --out` (speed × unbalance).
+    Map(MapArgs),
+}
+
+#[derive(Args)]
+struct MapArgs {
+    /// Parquet table written by `study map --out`.
+    table: PathBuf,
+    /// Output file: .svg or .png.
+    #[arg(long)]
+    out: PathBuf,
+    /// Figure title.
+    #[arg(long, default_value = "Stability map of the balanced state")]
+    title: String,
 }
 
 #[derive(Args)]
@@ -130,6 +145,13 @@ pub fn run(args: &PlotArgs) -> Result<(), UserError> {
                 None => Shape::ALL.to_vec(),
             };
             plot_design(&shapes, &a.n.0, &a.out).map_err(plot_error)?;
+            vec![a.out.clone()]
+        }
+        Figure::Map(a) => {
+            check_out(&a.out)?;
+            let points = autobal::plot::map::read_map(&a.table).map_err(plot_error)?;
+            autobal::plot::map::plot_stability_map(&points, &a.title, &a.out)
+                .map_err(plot_error)?;
             vec![a.out.clone()]
         }
         Figure::Tradeoff(a) => {
