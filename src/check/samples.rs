@@ -78,10 +78,10 @@ pub fn design_samples(df: &DataFrame) -> PolarsResult<Vec<DesignSample>> {
                 s.settling_revs.push(t);
             }
         }
-        if matches!(outcome.get(i), Some("settled" | "not_settled")) {
-            if let Some(r) = residual.get(i) {
-                s.residual_rel.push(r);
-            }
+        if matches!(outcome.get(i), Some("settled" | "not_settled"))
+            && let Some(r) = residual.get(i)
+        {
+            s.residual_rel.push(r);
         }
     }
     Ok(out)

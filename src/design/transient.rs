@@ -37,7 +37,7 @@ pub fn p_max(n: u32, rho: f64) -> Result<f64, DesignError> {
     }
     let alpha = half_angle(rho)?;
     let nf = f64::from(n);
-    let value = if n % 2 == 0 {
+    let value = if n.is_multiple_of(2) {
         // At ρ = ρ_max(2) = 1/2 both sin terms vanish; the limit is 1.
         let denom = nf * (2.0 * alpha).sin();
         if denom.abs() < 1e-300 {
@@ -58,7 +58,7 @@ pub fn p_max_half_race(n: u32) -> Result<f64, DesignError> {
     let nf = f64::from(n);
     match n {
         0 => Err(DesignError::ZeroWeights),
-        _ if n % 2 == 0 => Ok(2.0 / (nf * (PI / nf).sin())),
+        _ if n.is_multiple_of(2) => Ok(2.0 / (nf * (PI / nf).sin())),
         _ => Ok(1.0 / (nf * (PI / (2.0 * nf)).sin())),
     }
 }

@@ -56,10 +56,10 @@ pub fn validate(
     }
     // A zero, negative or NaN step would make the steppers walk backwards or
     // spin; say so up front instead of failing somewhere later.
-    if let Some(h0) = options.h0 {
-        if !(h0.is_finite() && h0 > 0.0) {
-            return Err(format!("h0 = {h0} must be positive and finite"));
-        }
+    if let Some(h0) = options.h0
+        && !(h0.is_finite() && h0 > 0.0)
+    {
+        return Err(format!("h0 = {h0} must be positive and finite"));
     }
     if options.h_max.is_nan() || options.h_max <= 0.0 {
         return Err(format!("h_max = {} must be positive", options.h_max));

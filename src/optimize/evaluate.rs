@@ -55,10 +55,10 @@ pub struct Evaluator<'a> {
 impl Evaluator<'_> {
     /// Build the candidate as a design, or say which constraint it breaks.
     fn design(&self, c: &Candidate) -> Result<Design, String> {
-        if let Some(h) = self.spec.housing_rho_max {
-            if c.rho > h {
-                return Err(format!("ρ = {:.4} exceeds the housing limit {h}", c.rho));
-            }
+        if let Some(h) = self.spec.housing_rho_max
+            && c.rho > h
+        {
+            return Err(format!("ρ = {:.4} exceeds the housing limit {h}", c.rho));
         }
         let g = &self.plan.file.designs;
         let spec = DesignSpec {
@@ -76,13 +76,13 @@ impl Evaluator<'_> {
             .file
             .resolve_design(u32::MAX, spec)
             .map_err(|(key, value, reason)| format!("{key} = {value}: {reason}"))?;
-        if let (Some(sf), Some(u)) = (self.spec.safety_factor, self.spec.max_unbalance) {
-            if design.capacity < sf * u {
-                return Err(format!(
-                    "capacity {:.4e} kg·m below {sf} × {u:.4e} kg·m",
-                    design.capacity
-                ));
-            }
+        if let (Some(sf), Some(u)) = (self.spec.safety_factor, self.spec.max_unbalance)
+            && design.capacity < sf * u
+        {
+            return Err(format!(
+                "capacity {:.4e} kg·m below {sf} × {u:.4e} kg·m",
+                design.capacity
+            ));
         }
         Ok(design)
     }

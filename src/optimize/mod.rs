@@ -76,37 +76,37 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             "must contain \"rho\" (and optionally \"drag\")",
         ));
     }
-    if let Some([lo, hi]) = spec.rho_bounds {
-        if !(lo > 0.0 && hi > lo && hi < 1.0) {
-            return Err(bad(
-                "rho_bounds",
-                format!("[{lo}, {hi}]"),
-                "need 0 < lo < hi < 1",
-            ));
-        }
+    if let Some([lo, hi]) = spec.rho_bounds
+        && !(lo > 0.0 && hi > lo && hi < 1.0)
+    {
+        return Err(bad(
+            "rho_bounds",
+            format!("[{lo}, {hi}]"),
+            "need 0 < lo < hi < 1",
+        ));
     }
-    if let Some([lo, hi]) = spec.drag_bounds {
-        if !(lo > 0.0 && hi > lo && hi.is_finite()) {
-            return Err(bad(
-                "drag_bounds",
-                format!("[{lo}, {hi}]"),
-                "need 0 < lo < hi",
-            ));
-        }
+    if let Some([lo, hi]) = spec.drag_bounds
+        && !(lo > 0.0 && hi > lo && hi.is_finite())
+    {
+        return Err(bad(
+            "drag_bounds",
+            format!("[{lo}, {hi}]"),
+            "need 0 < lo < hi",
+        ));
     }
-    if let Some(h) = spec.housing_rho_max {
-        if !(h > 0.0 && h < 1.0) {
-            return Err(bad("housing_rho_max", h.to_string(), "must lie in (0, 1)"));
-        }
+    if let Some(h) = spec.housing_rho_max
+        && !(h > 0.0 && h < 1.0)
+    {
+        return Err(bad("housing_rho_max", h.to_string(), "must lie in (0, 1)"));
     }
     for (key, v) in [
         ("safety_factor", spec.safety_factor),
         ("max_unbalance", spec.max_unbalance),
     ] {
-        if let Some(v) = v {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(key, v.to_string(), "must be positive and finite"));
-            }
+        if let Some(v) = v
+            && !(v.is_finite() && v > 0.0)
+        {
+            return Err(bad(key, v.to_string(), "must be positive and finite"));
         }
     }
     if spec.safety_factor.is_some() != spec.max_unbalance.is_some() {
@@ -124,14 +124,14 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
         ));
     }
     let ns = plan.file.designs.n.values();
-    if let Some(min) = spec.min_n {
-        if !ns.iter().any(|&n| n >= min) {
-            return Err(bad(
-                "min_n",
-                min.to_string(),
-                "excludes every n of [designs]",
-            ));
-        }
+    if let Some(min) = spec.min_n
+        && !ns.iter().any(|&n| n >= min)
+    {
+        return Err(bad(
+            "min_n",
+            min.to_string(),
+            "excludes every n of [designs]",
+        ));
     }
     Ok(())
 }

@@ -384,23 +384,23 @@ impl StudyFile {
         }
         check_distribution(&s.unbalance.distribution)
             .map_err(|(k, v, r)| invalid(&format!("sampling.unbalance.{k}"), v, r))?;
-        if let DirectionSpec::Fixed(d) = s.direction {
-            if !d.is_finite() {
-                return Err(invalid(
-                    "sampling.direction.fixed",
-                    d.to_string(),
-                    "must be finite",
-                ));
-            }
+        if let DirectionSpec::Fixed(d) = s.direction
+            && !d.is_finite()
+        {
+            return Err(invalid(
+                "sampling.direction.fixed",
+                d.to_string(),
+                "must be finite",
+            ));
         }
-        if let InitialSpec::BalancedForShift(d) = s.initial {
-            if !d.is_finite() {
-                return Err(invalid(
-                    "sampling.initial.balanced_for_shift",
-                    d.to_string(),
-                    "must be finite",
-                ));
-            }
+        if let InitialSpec::BalancedForShift(d) = s.initial
+            && !d.is_finite()
+        {
+            return Err(invalid(
+                "sampling.initial.balanced_for_shift",
+                d.to_string(),
+                "must be finite",
+            ));
         }
         for (key, value) in [
             ("solver.rtol", self.solver.rtol),

@@ -441,10 +441,9 @@ fn next_chunk_index(dir: &Path) -> Result<u64, RunError> {
         if let Some(num) = name
             .strip_prefix("chunk-")
             .and_then(|s| s.strip_suffix(".parquet"))
+            && let Ok(i) = num.parse::<u64>()
         {
-            if let Ok(i) = num.parse::<u64>() {
-                next = next.max(i + 1);
-            }
+            next = next.max(i + 1);
         }
     }
     Ok(next)

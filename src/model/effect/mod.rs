@@ -68,15 +68,15 @@ impl Effects {
     /// an effect that would add nothing is left out.
     pub fn build(&self, cargo: &[Cargo], omega: f64) -> Vec<Box<dyn Effect>> {
         let mut list: Vec<Box<dyn Effect>> = Vec::new();
-        if let Some(g) = &self.gravity {
-            if g.in_plane() != 0.0 {
-                list.push(Box::new(g.clone()));
-            }
+        if let Some(g) = &self.gravity
+            && g.in_plane() != 0.0
+        {
+            list.push(Box::new(g.clone()));
         }
-        if let Some(c) = &self.contact {
-            if let Some(effect) = contact::Contact::new(c, cargo, omega) {
-                list.push(Box::new(effect));
-            }
+        if let Some(c) = &self.contact
+            && let Some(effect) = contact::Contact::new(c, cargo, omega)
+        {
+            list.push(Box::new(effect));
         }
         list
     }
