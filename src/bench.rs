@@ -760,6 +760,11 @@ pub struct ThreadTiming {
     pub paired_speedup: f64,
     /// Speed-up over the baseline: ratio of the fastest studies.
     pub speedup_min: f64,
+    /// CPU time (user + system, all threads) of every timed study (s); empty where unknown.
+    pub cpu_s: Vec<f64>,
+    /// Median over the studies of CPU time / wall time: the cores the study
+    /// actually got (at most `threads`; less when other processes hold cores).
+    pub cores_used: Option<f64>,
 }
 
 /// How `run_study` scales with its thread count on a fixed small study.
@@ -816,6 +821,7 @@ pub fn measure_threads(
     let repeats = config.repeats.max(1);
     let load_before = load_average();
     let mut times = vec![Vec::with_capacity(repeats); counts.len()];
+    let mut cpu = vec![Vec::with_capacity(repeats); counts.len()];
     let mut records: Vec<Option<Vec<crate::study::record::RunRecord>>> = vec![None; counts.len()];
     for round in 0..repeats {
         // ABBA: a drifting background load then favours no thread count.
@@ -829,9 +835,13 @@ pub fn measure_threads(
                 threads: Some(counts[i].max(1)),
                 ..RunOptions::default()
             };
+            let cpu_start = process_cpu_seconds();
             let start = Instant::now();
             let out = run_study(&plan, &options, &NoProgress)?;
             times[i].push(start.elapsed().as_secs_f64());
+            if let (Some(a), Some(b)) = (cpu_start, process_cpu_seconds()) {
+                cpu[i].push(b - a);
+            }
             records[i].get_or_insert_with(|| {
                 out.runs
                     .into_iter()
@@ -850,7 +860,8 @@ pub fn measure_threads(
     let timings = counts
         .iter()
         .zip(&times)
-        .map(|(&threads, t)| {
+        .zip(cpu)
+        .map(|((&threads, t), cpu_s)| {
             let min_s = t.iter().copied().fold(f64::INFINITY, f64::min);
             let paired: Vec<f64> = base.iter().zip(t).map(|(b, x)| b / x).collect();
             ThreadTiming {
@@ -861,6 +872,9 @@ pub fn measure_threads(
                 speedup: base_median / median(t),
                 paired_speedup: median(&paired),
                 speedup_min: base_min / min_s,
+                cores_used: (cpu_s.len() == t.len())
+                    .then(|| median(&cpu_s.iter().zip(t).map(|(c, w)| c / w).collect::<Vec<_>>())),
+                cpu_s,
             }
         })
         .collect();
@@ -878,6 +892,19 @@ pub fn measure_threads(
         identical_results: records.iter().all(|r| r.as_deref() == Some(first)),
         timings,
     })
+}
+
+/// CPU time (user + system) of this process and all its threads so far, in
+/// seconds, from `/proc/self/stat` (`None` elsewhere). Resolution is one
+/// clock tick, 10 ms at the usual 100 Hz, which is assumed: reading the real
+/// rate would need libc.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The command name may contain spaces; fields after it start at field 3 (state).
+    let rest = &text[text.rfind(')')? + 1..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) / 100.0)
 }
 
 /// The 1, 5 and 15 minute load averages from `/proc/loadavg` (`None` elsewhere).

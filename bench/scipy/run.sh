@@ -4,9 +4,10 @@
 #
 # Usage: bench/scipy/run.sh [ROUNDS]          (default 7 rounds)
 # Environment:
-#   AUTOBAL_REPEATS  autobal solves per case per round (default 11)
+#   AUTOBAL_REPEATS  autobal solves per case per round (default 21)
 #   SCIPY_REPEATS    SciPy solves per case per round (default 1)
 #   REVOLUTIONS      horizon (default 500)
+#   SCIPY_RHS        auto (default: the faster translation), numpy or scalar
 #   OUT              folder for the per-round JSON files (default: a fresh temp folder)
 #   CARGO_TARGET_DIR honoured as by cargo
 #
@@ -19,9 +20,10 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 rounds=${1:-7}
-autobal_repeats=${AUTOBAL_REPEATS:-11}
+autobal_repeats=${AUTOBAL_REPEATS:-21}
 scipy_repeats=${SCIPY_REPEATS:-1}
 revolutions=${REVOLUTIONS:-500}
+scipy_rhs=${SCIPY_RHS:-auto}
 
 venv=$here/.venv
 if [ ! -x "$venv/bin/python" ]; then
@@ -53,7 +55,7 @@ run_autobal() {
 }
 run_scipy() {
     "$py" "$here/scipy_peer.py" solve --autobal "$out/input.json" \
-        --repeats "$scipy_repeats" --out "$out/scipy-$1.json" --quiet
+        --repeats "$scipy_repeats" --rhs "$scipy_rhs" --out "$out/scipy-$1.json" --quiet
 }
 
 for r in $(seq -w 1 "$rounds"); do

@@ -385,6 +385,8 @@ def cmd_report(args):
         f"autobal solves per case: {len(next(iter(a_times.values())))}, "
         f"SciPy solves per case: {len(next(iter(s_times.values())))}"
     )
+    # Per-call cost of the RHS the solves used, median over the rounds.
+    rhs_us = statistics.median(s["rhs_us_per_call"][s["rhs_variant"]] for s in scipys)
     rows = []
     ok = True
     for (method, rtol), st in sorted(s_times.items(), key=lambda kv: (kv[0][0], -kv[0][1])):
@@ -408,6 +410,8 @@ def cmd_report(args):
                 f"{statistics.median(paired[(method, rtol)]):.0f}",
                 f"{min(st) / min(a_times[same]):.0f}",
                 f"{s_med / d_med:.0f}",
+                f"{1e3 * s_med / sc['nfev']:.1f}",
+                f"{100 * rhs_us * sc['nfev'] / (1e3 * s_med):.0f}",
                 f"{sc['error_vs_reference']:.1e}",
                 f"{a_case[same]['error_vs_reference']:.1e}",
                 f"{sc['diff_to_autobal']:.1e}",
@@ -426,6 +430,8 @@ def cmd_report(args):
         "paired",
         "min",
         "vs dp5",
+        "µs/f",
+        "f %",
         "err scipy",
         "err autobal",
         "scipy−autobal",
@@ -438,7 +444,8 @@ def cmd_report(args):
     ref = last["reference"]
     print(
         "ratio: SciPy median / autobal median (same Runge–Kutta pair); paired: median over rounds\n"
-        "of the per-round ratio; min: ratio of fastest solves; vs dp5: against autobal's default.\n"
+        "of the per-round ratio; min: ratio of fastest solves; vs dp5: against autobal's default;\n"
+        "µs/f: SciPy's time per RHS call, solver included; f %: the share of it spent in the RHS.\n"
         f"err: final-state difference to autobal {ref['method']} at rtol {ref['rtol']:.0e} "
         f"(trusted to {ref['cross_check']:.1e}), in units of A_ref, rad, A_ref·ω, rad·ω;\n"
         "check: SciPy finished and err < 100·rtol (autobal's own test criterion)."

@@ -187,6 +187,10 @@ fn thread_scaling_reports_every_thread_count_with_identical_results() {
     for t in &r.timings {
         assert_eq!(t.times_s.len(), 2);
         assert!(t.median_s > 0.0 && t.speedup.is_finite() && t.paired_speedup.is_finite());
+        if cfg!(target_os = "linux") {
+            assert_eq!(t.cpu_s.len(), 2);
+            assert!(t.cores_used.is_some_and(|c| c >= 0.0));
+        }
     }
     assert_eq!(r.timings[0].speedup, 1.0);
 }

@@ -201,6 +201,7 @@ fn describe_threads(r: &ThreadScaling) -> String {
                 format!("{:.2}", t.speedup),
                 format!("{:.2}", t.paired_speedup),
                 format!("{:.2}", t.speedup_min),
+                t.cores_used.map_or("–".into(), |c| format!("{c:.2}")),
             ]
         })
         .collect();
@@ -212,6 +213,7 @@ fn describe_threads(r: &ThreadScaling) -> String {
             "speed-up",
             "paired",
             "of fastest",
+            "cores used",
         ],
         &rows,
     ));
@@ -221,7 +223,8 @@ fn describe_threads(r: &ThreadScaling) -> String {
         })
     };
     out.push_str(&format!(
-        "speed-up: ratio of medians; paired: median of per-round ratios; of fastest: ratio of minima\n\
+        "speed-up: ratio of medians; paired: median of per-round ratios; of fastest: ratio of minima;\n\
+         cores used: CPU time / wall time (below the thread count when other processes hold cores)\n\
          results identical across thread counts: {}\n\
          cores available: {}; load average before {}, after {}\n",
         if r.identical_results { "yes" } else { "NO" },
