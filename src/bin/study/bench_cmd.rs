@@ -202,6 +202,11 @@ fn describe_threads(r: &ThreadScaling) -> String {
                 format!("{:.2}", t.paired_speedup),
                 format!("{:.2}", t.speedup_min),
                 t.cores_used.map_or("–".into(), |c| format!("{c:.2}")),
+                if t.cpu_s.is_empty() {
+                    "–".into()
+                } else {
+                    format!("{:.3}", bench::median(&t.cpu_s))
+                },
             ]
         })
         .collect();
@@ -214,6 +219,7 @@ fn describe_threads(r: &ThreadScaling) -> String {
             "paired",
             "of fastest",
             "cores used",
+            "CPU s",
         ],
         &rows,
     ));
@@ -224,7 +230,8 @@ fn describe_threads(r: &ThreadScaling) -> String {
     };
     out.push_str(&format!(
         "speed-up: ratio of medians; paired: median of per-round ratios; of fastest: ratio of minima;\n\
-         cores used: CPU time / wall time (below the thread count when other processes hold cores)\n\
+         cores used: CPU time / wall time (below the thread count when other processes hold cores);\n\
+         CPU s: median CPU time per study, all threads (equal across thread counts when threading adds no work)\n\
          results identical across thread counts: {}\n\
          cores available: {}; load average before {}, after {}\n",
         if r.identical_results { "yes" } else { "NO" },
