@@ -504,6 +504,417 @@ pub fn measure_solves(config: &BenchConfig) -> Vec<SolveCost> {
         .collect()
 }
 
+/// Relative tolerances of the comparison with SciPy's `solve_ivp` (`bench/scipy`).
+pub const PEER_RTOLS: &[f64] = &[1e-6, 1e-8, 1e-9];
+
+/// autobal's methods in the SciPy comparison: `dp5` matches RK45, `dop853` matches DOP853.
+pub const PEER_METHODS: &[Method] = &[Method::Dp5, Method::Dop853];
+
+/// The solves that `bench/scipy` repeats in Python, and how often to time them here.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeerConfig {
+    /// Number of cargoes.
+    pub cargoes: usize,
+    /// autobal methods to time.
+    pub methods: Vec<Method>,
+    /// Relative tolerances (atol = rtol·[`ATOL_PER_RTOL`] on the problem's scales).
+    pub rtols: Vec<f64>,
+    /// Horizon in revolutions (no early stopping).
+    pub revolutions: f64,
+    /// Timed solves per case, interleaved across cases.
+    pub repeats: usize,
+    /// Relative tolerance of the DOP853 reference solve.
+    pub reference_rtol: f64,
+}
+
+impl PeerConfig {
+    /// The comparison recorded in `docs/benchmarks.md`.
+    pub fn full() -> Self {
+        PeerConfig {
+            cargoes: 3,
+            methods: PEER_METHODS.to_vec(),
+            rtols: PEER_RTOLS.to_vec(),
+            revolutions: 500.0,
+            repeats: 11,
+            reference_rtol: 1e-13,
+        }
+    }
+
+    /// Same cases over a short horizon with few repeats (tests, smoke runs).
+    pub fn quick() -> Self {
+        PeerConfig {
+            revolutions: 20.0,
+            repeats: 3,
+            ..PeerConfig::full()
+        }
+    }
+}
+
+/// One evaluation of the right-hand side, so that a peer can check its own
+/// translation of the equations against autobal's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RhsSample {
+    /// Time.
+    pub t: f64,
+    /// State.
+    pub y: Vec<f64>,
+    /// autobal's dy/dt at (t, y).
+    pub dydt: Vec<f64>,
+}
+
+/// The tight solve that every case (and every peer) is compared with.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeerReference {
+    /// Method of the reference solve.
+    pub method: Method,
+    /// Its relative tolerance.
+    pub rtol: f64,
+    /// Its final state at t_end.
+    pub y: Vec<f64>,
+    /// Largest scaled difference to a DP5 solve at rtol 10·`rtol` (how far the reference can be trusted).
+    pub cross_check: f64,
+}
+
+/// Timings, counts and final state of one (method, rtol) case.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeerCase {
+    /// Integration method.
+    pub method: Method,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance per state component.
+    pub atol: Vec<f64>,
+    /// Every timed solve (ms), in the order measured.
+    pub times_ms: Vec<f64>,
+    /// Median wall time per solve (ms).
+    pub median_ms: f64,
+    /// Fastest solve (ms).
+    pub min_ms: f64,
+    /// The solver's statistics.
+    pub stats: Stats,
+    /// Final status ("finished" or the failure).
+    pub status: String,
+    /// State at t_end.
+    pub y_final: Vec<f64>,
+    /// Largest final-state difference to the reference, in scale units.
+    pub error_vs_reference: f64,
+}
+
+/// What `bench/scipy` needs to repeat autobal's solves and judge its own.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeerReport {
+    /// What was asked.
+    pub config: PeerConfig,
+    /// True for a build with debug assertions (timings then mean little).
+    pub debug_build: bool,
+    /// Spin speed ω.
+    pub omega: f64,
+    /// Horizon in time units (from t = 0).
+    pub t_end: f64,
+    /// Initial state (`locked_steady` at [`reference_angles`]).
+    pub y0: Vec<f64>,
+    /// Unit of each state component for errors: A_ref, A_ref·ω, rad, rad·ω.
+    pub scale: Vec<f64>,
+    /// Right-hand side at a few states (start, a moving state, the reference end).
+    pub rhs_samples: Vec<RhsSample>,
+    /// The tight reference solve.
+    pub reference: PeerReference,
+    /// One entry per (method, rtol), methods outer.
+    pub cases: Vec<PeerCase>,
+}
+
+/// Time autobal's solves of the cases `bench/scipy` repeats with SciPy, and
+/// export everything the peer needs to check itself (start, tolerances,
+/// right-hand-side samples, reference and final states).
+pub fn peer_cases(config: &PeerConfig) -> PeerReport {
+    let n = config.cargoes;
+    let base = BenchProblem::new(n, config.reference_rtol, config.revolutions);
+    let reference = base.solve(Method::Dop853);
+    let cross =
+        BenchProblem::new(n, 10.0 * config.reference_rtol, config.revolutions).solve(Method::Dp5);
+    let problems: Vec<BenchProblem> = config
+        .rtols
+        .iter()
+        .map(|&rtol| BenchProblem::new(n, rtol, config.revolutions))
+        .collect();
+    let cases: Vec<(Method, usize)> = config
+        .methods
+        .iter()
+        .flat_map(|&m| (0..problems.len()).map(move |p| (m, p)))
+        .collect();
+    // The untimed first solve of each case also warms caches and branch predictors.
+    let results: Vec<SolveReport> = cases.iter().map(|&(m, p)| problems[p].solve(m)).collect();
+    let repeats = config.repeats.max(1);
+    let mut times = vec![Vec::with_capacity(repeats); cases.len()];
+    for _ in 0..repeats {
+        for (i, &(method, p)) in cases.iter().enumerate() {
+            let start = Instant::now();
+            black_box(problems[p].solve(method));
+            times[i].push(start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+
+    let sample = |t: f64, y: Vec<f64>| {
+        let mut dydt = vec![0.0; y.len()];
+        base.system.rhs(t, &y, &mut dydt);
+        RhsSample { t, y, dydt }
+    };
+    // A state with every term awake: rotor off-centre and moving, cargoes
+    // spread and sliding at different rates.
+    let nq = base.system.layout().nq();
+    let mut moving = base.y0.clone();
+    for j in 0..n {
+        moving[2 + j] += 0.3 * (j as f64 + 1.0);
+        moving[nq + 2 + j] = 0.05 * (j as f64 - 1.0);
+    }
+    moving[nq] *= -0.7;
+    moving[nq + 1] *= 1.3;
+    let rhs_samples = vec![
+        sample(0.0, base.y0.clone()),
+        sample(1.234, moving),
+        sample(base.t_end, reference.y.clone()),
+    ];
+
+    PeerReport {
+        config: config.clone(),
+        debug_build: cfg!(debug_assertions),
+        omega: OMEGA,
+        t_end: base.t_end,
+        y0: base.y0.clone(),
+        scale: scaled_atol(&base.system, 1.0, a_ref(&base.system, OMEGA), OMEGA),
+        rhs_samples,
+        reference: PeerReference {
+            method: Method::Dop853,
+            rtol: config.reference_rtol,
+            cross_check: base.scaled_error(&cross.y, &reference.y),
+            y: reference.y.clone(),
+        },
+        cases: cases
+            .iter()
+            .zip(results)
+            .zip(&times)
+            .map(|((&(method, p), report), t)| PeerCase {
+                method,
+                rtol: problems[p].options.rtol,
+                atol: problems[p].options.atol.clone(),
+                times_ms: t.clone(),
+                median_ms: median(t),
+                min_ms: t.iter().copied().fold(f64::INFINITY, f64::min),
+                stats: report.stats,
+                status: status_name(&report.status),
+                error_vs_reference: base.scaled_error(&report.y, &reference.y),
+                y_final: report.y,
+            })
+            .collect(),
+    }
+}
+
+/// The study behind the thread-scaling measurement (`studies/three_balls.toml`,
+/// with its samples cut down by [`ThreadConfig::samples`]).
+pub const THREAD_STUDY: &str = include_str!("../studies/three_balls.toml");
+
+/// How the thread-scaling measurement runs [`THREAD_STUDY`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThreadConfig {
+    /// Samples per design (the file's 20 designs each get this many runs).
+    pub samples: u32,
+    /// Thread counts to compare; the first is the baseline of the speed-ups.
+    pub thread_counts: Vec<usize>,
+    /// Timed studies per thread count, interleaved (ABBA order).
+    pub repeats: usize,
+}
+
+impl ThreadConfig {
+    /// The measurement recorded in `docs/benchmarks.md`: 1 against 2 threads.
+    pub fn full() -> Self {
+        ThreadConfig {
+            samples: 25,
+            thread_counts: vec![1, 2],
+            repeats: 7,
+        }
+    }
+
+    /// One sample per design and one repeat (tests, smoke runs).
+    pub fn quick() -> Self {
+        ThreadConfig {
+            samples: 1,
+            repeats: 1,
+            ..ThreadConfig::full()
+        }
+    }
+}
+
+/// Wall times of the study at one thread count.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThreadTiming {
+    /// Worker threads of the study's pool.
+    pub threads: usize,
+    /// Every timed study (s), in the order measured.
+    pub times_s: Vec<f64>,
+    /// Median wall time (s).
+    pub median_s: f64,
+    /// Fastest study (s).
+    pub min_s: f64,
+    /// Speed-up over the baseline: ratio of medians.
+    pub speedup: f64,
+    /// Speed-up over the baseline: median of the per-round ratios (robust to drifting load).
+    pub paired_speedup: f64,
+    /// Speed-up over the baseline: ratio of the fastest studies.
+    pub speedup_min: f64,
+    /// CPU time (user + system, all threads) of every timed study (s); empty where unknown.
+    pub cpu_s: Vec<f64>,
+    /// Median over the studies of CPU time / wall time: the cores the study
+    /// actually got (at most `threads`; less when other processes hold cores).
+    pub cores_used: Option<f64>,
+}
+
+/// How `run_study` scales with its thread count on a fixed small study.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThreadScaling {
+    /// What was asked.
+    pub config: ThreadConfig,
+    /// True for a build with debug assertions (timings then mean little).
+    pub debug_build: bool,
+    /// Name of the study.
+    pub study: String,
+    /// Designs in the study.
+    pub designs: usize,
+    /// Runs per study (designs × samples).
+    pub runs: u64,
+    /// RHS calls summed over the runs (the work, identical for every thread count).
+    pub rhs_calls: u64,
+    /// Threads the operating system offers this process.
+    pub available_parallelism: usize,
+    /// Load averages (1, 5, 15 min) before measuring (Linux only).
+    pub load_before: Option<[f64; 3]>,
+    /// Load averages after measuring.
+    pub load_after: Option<[f64; 3]>,
+    /// True when every thread count produced the same records (wall time aside).
+    pub identical_results: bool,
+    /// One entry per thread count, in the order asked.
+    pub timings: Vec<ThreadTiming>,
+}
+
+/// The cut-down [`THREAD_STUDY`] writing under `output`.
+pub fn thread_study(samples: u32, output: &std::path::Path) -> crate::study::config::StudyPlan {
+    use crate::study::config::StudyFile;
+    let path = "studies/three_balls.toml";
+    let mut file = StudyFile::parse(THREAD_STUDY, path).expect("the bundled study parses");
+    file.sampling.samples = samples.max(1);
+    file.output = output.display().to_string();
+    // The provenance text says what was changed, so the files are not mistaken for the real study.
+    let text = format!(
+        "{THREAD_STUDY}\n# study bench --thread-scaling: sampling.samples = {}\n",
+        file.sampling.samples
+    );
+    file.plan(&text, path).expect("the bundled study is valid")
+}
+
+/// Run [`thread_study`] at every thread count of `config`, interleaved, with
+/// its files under `output` (overwritten by every repeat).
+pub fn measure_threads(
+    config: &ThreadConfig,
+    output: &std::path::Path,
+) -> Result<ThreadScaling, crate::study::run::RunError> {
+    use crate::study::run::{NoProgress, RunOptions, run_study};
+    let plan = thread_study(config.samples, output);
+    let counts = &config.thread_counts;
+    let repeats = config.repeats.max(1);
+    let load_before = load_average();
+    let mut times = vec![Vec::with_capacity(repeats); counts.len()];
+    let mut cpu = vec![Vec::with_capacity(repeats); counts.len()];
+    let mut records: Vec<Option<Vec<crate::study::record::RunRecord>>> = vec![None; counts.len()];
+    for round in 0..repeats {
+        // ABBA: a drifting background load then favours no thread count.
+        let order: Vec<usize> = if round % 2 == 0 {
+            (0..counts.len()).collect()
+        } else {
+            (0..counts.len()).rev().collect()
+        };
+        for i in order {
+            let options = RunOptions {
+                threads: Some(counts[i].max(1)),
+                ..RunOptions::default()
+            };
+            let cpu_start = process_cpu_seconds();
+            let start = Instant::now();
+            let out = run_study(&plan, &options, &NoProgress)?;
+            times[i].push(start.elapsed().as_secs_f64());
+            if let (Some(a), Some(b)) = (cpu_start, process_cpu_seconds()) {
+                cpu[i].push(b - a);
+            }
+            records[i].get_or_insert_with(|| {
+                out.runs
+                    .into_iter()
+                    .map(|mut r| {
+                        r.wall_time_s = 0.0;
+                        r
+                    })
+                    .collect()
+            });
+        }
+    }
+    let load_after = load_average();
+    let base = &times[0];
+    let base_median = median(base);
+    let base_min = base.iter().copied().fold(f64::INFINITY, f64::min);
+    let timings = counts
+        .iter()
+        .zip(&times)
+        .zip(cpu)
+        .map(|((&threads, t), cpu_s)| {
+            let min_s = t.iter().copied().fold(f64::INFINITY, f64::min);
+            let paired: Vec<f64> = base.iter().zip(t).map(|(b, x)| b / x).collect();
+            ThreadTiming {
+                threads,
+                times_s: t.clone(),
+                median_s: median(t),
+                min_s,
+                speedup: base_median / median(t),
+                paired_speedup: median(&paired),
+                speedup_min: base_min / min_s,
+                cores_used: (cpu_s.len() == t.len())
+                    .then(|| median(&cpu_s.iter().zip(t).map(|(c, w)| c / w).collect::<Vec<_>>())),
+                cpu_s,
+            }
+        })
+        .collect();
+    let first = records[0].as_deref().unwrap_or_default();
+    Ok(ThreadScaling {
+        config: config.clone(),
+        debug_build: cfg!(debug_assertions),
+        study: plan.name.clone(),
+        designs: plan.designs.len(),
+        runs: plan.total_runs(),
+        rhs_calls: first.iter().map(|r| r.metrics.rhs_calls).sum(),
+        available_parallelism: std::thread::available_parallelism().map_or(1, usize::from),
+        load_before,
+        load_after,
+        identical_results: records.iter().all(|r| r.as_deref() == Some(first)),
+        timings,
+    })
+}
+
+/// CPU time (user + system) of this process and all its threads so far, in
+/// seconds, from `/proc/self/stat` (`None` elsewhere). Resolution is one
+/// clock tick, 10 ms at the usual 100 Hz, which is assumed: reading the real
+/// rate would need libc.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The command name may contain spaces; fields after it start at field 3 (state).
+    let rest = &text[text.rfind(')')? + 1..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) / 100.0)
+}
+
+/// The 1, 5 and 15 minute load averages from `/proc/loadavg` (`None` elsewhere).
+pub fn load_average() -> Option<[f64; 3]> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    let mut it = text.split_whitespace().map(|s| s.parse::<f64>().ok());
+    Some([it.next()??, it.next()??, it.next()??])
+}
+
 fn status_name(status: &Status) -> String {
     match status {
         Status::Finished => "finished".into(),

@@ -1,8 +1,12 @@
 //! `autobal::bench` and `study bench`: structure and exact counts only —
 //! wall-clock figures are never asserted (the machine is shared and noisy).
 
-use autobal::bench::{self, BenchConfig, CARGO_COUNTS, METHODS, RTOLS};
+use autobal::bench::{
+    self, BenchConfig, CARGO_COUNTS, METHODS, PEER_METHODS, PEER_RTOLS, PeerConfig, RTOLS,
+    ThreadConfig,
+};
 use autobal::integrate::Method;
+use autobal::integrate::OdeSystem;
 use autobal::model::start::StartMode;
 use autobal::scene_file::SceneFile;
 use std::process::Command;
@@ -122,4 +126,99 @@ fn study_bench_rejects_bad_options_and_documents_itself() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--repeats"));
     let help = study(&["bench", "--help"]);
     assert!(String::from_utf8_lossy(&help.stdout).contains("Examples:"));
+}
+
+#[test]
+fn peer_cases_export_what_the_scipy_peer_needs() {
+    let config = PeerConfig {
+        revolutions: 5.0,
+        repeats: 1,
+        ..PeerConfig::quick()
+    };
+    let r = bench::peer_cases(&config);
+    let dim = 2 * (2 + config.cargoes);
+    assert_eq!((r.y0.len(), r.scale.len()), (dim, dim));
+    assert_eq!(r.cases.len(), PEER_METHODS.len() * PEER_RTOLS.len());
+    for (i, c) in r.cases.iter().enumerate() {
+        assert_eq!(c.method, PEER_METHODS[i / PEER_RTOLS.len()]);
+        assert_eq!(c.rtol, PEER_RTOLS[i % PEER_RTOLS.len()]);
+        assert_eq!(c.status, "finished");
+        assert_eq!(
+            (c.atol.len(), c.y_final.len(), c.times_ms.len()),
+            (dim, dim, 1)
+        );
+        // atol is rtol/100 on the scales that the peer recomputes.
+        for (a, s) in c.atol.iter().zip(&r.scale) {
+            assert!((a / (c.rtol * bench::ATOL_PER_RTOL * s) - 1.0).abs() < 1e-12);
+        }
+        assert!(c.error_vs_reference < 100.0 * c.rtol, "{c:?}");
+    }
+    assert!(
+        r.reference.cross_check < 1e-9,
+        "{:?}",
+        r.reference.cross_check
+    );
+    // The exported RHS samples are the system's own values (the peer checks against them).
+    let system = bench::reference_scene(config.cargoes).build().unwrap();
+    assert_eq!(r.rhs_samples.len(), 3);
+    assert_eq!(r.rhs_samples[0].y, r.y0);
+    assert_eq!(r.rhs_samples[2].t, r.t_end);
+    for s in &r.rhs_samples {
+        let mut d = vec![0.0; dim];
+        system.rhs(s.t, &s.y, &mut d);
+        assert_eq!(d, s.dydt);
+    }
+}
+
+#[test]
+fn thread_scaling_reports_every_thread_count_with_identical_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = ThreadConfig {
+        samples: 1,
+        thread_counts: vec![1, 2],
+        repeats: 2,
+    };
+    let r = bench::measure_threads(&config, dir.path()).unwrap();
+    assert_eq!(r.runs, r.designs as u64);
+    assert!(r.designs >= 2 && r.rhs_calls > 0);
+    assert!(r.identical_results);
+    let threads: Vec<usize> = r.timings.iter().map(|t| t.threads).collect();
+    assert_eq!(threads, [1, 2]);
+    for t in &r.timings {
+        assert_eq!(t.times_s.len(), 2);
+        assert!(t.median_s > 0.0 && t.speedup.is_finite() && t.paired_speedup.is_finite());
+        if cfg!(target_os = "linux") {
+            assert_eq!(t.cpu_s.len(), 2);
+            assert!(t.cores_used.is_some_and(|c| c >= 0.0));
+        }
+    }
+    assert_eq!(r.timings[0].speedup, 1.0);
+}
+
+#[test]
+fn study_bench_peer_cases_and_thread_scaling_json() {
+    let out = study(&["bench", "--peer-cases", "--quick", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in ["y0", "scale", "t_end", "rhs_samples", "reference", "cases"] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["cases"][0]["method"], "dp5");
+
+    let out = study(&["bench", "--thread-scaling", "--quick", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["identical_results"], true);
+    assert_eq!(v["timings"].as_array().unwrap().len(), 2);
+
+    let both = study(&["bench", "--peer-cases", "--thread-scaling"]);
+    assert_eq!(both.status.code(), Some(2));
 }

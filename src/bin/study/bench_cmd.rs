@@ -1,9 +1,12 @@
 //! `study bench`: time the ODE core (RHS cost per cargo count, solves per
-//! method and tolerance) and print the figures.
+//! method and tolerance), the solves `bench/scipy` repeats with SciPy, or a
+//! small study at 1 and 2 threads, and print the figures.
 
 use crate::UserError;
 use crate::output::text_table;
-use autobal::bench::{self, BenchConfig, BenchReport};
+use autobal::bench::{
+    self, BenchConfig, BenchReport, PeerConfig, PeerReport, ThreadConfig, ThreadScaling,
+};
 use clap::Args;
 
 /// Examples shown under `study bench --help`.
@@ -12,6 +15,8 @@ pub const EXAMPLES: &str = "Examples:
   cargo run --release -- bench --json > bench.json
   study bench --quick
   study bench --revolutions 2000 --repeats 21
+  cargo run --release -- bench --peer-cases --json > autobal.json   # bench/scipy/run.sh does this
+  cargo run --release -- bench --thread-scaling --repeats 9
 
 Timings are only comparable within one run (cases are interleaved and the
 median is reported); build with --release, a debug build says so in the output.";
@@ -28,18 +33,31 @@ pub struct BenchArgs {
     /// Horizon of each solve in revolutions (default 500; 20 with --quick).
     #[arg(long)]
     revolutions: Option<f64>,
-    /// Timed solves per case and RHS batches per n (default 11 and 21; 3 with --quick).
+    /// Timed solves per case and RHS batches per n (default 11 and 21; 3 with --quick);
+    /// studies per thread count with --thread-scaling (default 7; 1 with --quick).
     #[arg(long)]
     repeats: Option<usize>,
+    /// Only the solves `bench/scipy` repeats with SciPy (dp5 and dop853 at rtol
+    /// 1e-6, 1e-8, 1e-9), with start, tolerances, RHS samples and final states.
+    #[arg(long, conflicts_with = "thread_scaling")]
+    peer_cases: bool,
+    /// Run a small fixed study (three_balls, 25 samples per design) with 1 and
+    /// with 2 threads, interleaved, and report the speed-up.
+    #[arg(long)]
+    thread_scaling: bool,
+    /// Samples per design with --thread-scaling (default 25; 1 with --quick).
+    #[arg(long, requires = "thread_scaling")]
+    samples: Option<u32>,
 }
 
 /// Run `study bench`.
 pub fn run(args: &BenchArgs) -> Result<(), UserError> {
-    let mut config = if args.quick {
-        BenchConfig::quick()
-    } else {
-        BenchConfig::full()
-    };
+    if args.repeats == Some(0) {
+        return Err(UserError("--repeats 0: need at least one".into(), 2));
+    }
+    if args.samples == Some(0) {
+        return Err(UserError("--samples 0: need at least one".into(), 2));
+    }
     if let Some(revs) = args.revolutions {
         if !(revs.is_finite() && revs > 0.0) {
             return Err(UserError(
@@ -47,12 +65,22 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
                 2,
             ));
         }
+    }
+    if args.peer_cases {
+        return run_peer_cases(args);
+    }
+    if args.thread_scaling {
+        return run_thread_scaling(args);
+    }
+    let mut config = if args.quick {
+        BenchConfig::quick()
+    } else {
+        BenchConfig::full()
+    };
+    if let Some(revs) = args.revolutions {
         config.revolutions = revs;
     }
     if let Some(repeats) = args.repeats {
-        if repeats == 0 {
-            return Err(UserError("--repeats 0: need at least one".into(), 2));
-        }
         config.solve_repeats = repeats;
         config.rhs_samples = repeats;
     }
@@ -63,6 +91,155 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
         print!("{}", describe(&report));
     }
     Ok(())
+}
+
+fn run_peer_cases(args: &BenchArgs) -> Result<(), UserError> {
+    let mut config = if args.quick {
+        PeerConfig::quick()
+    } else {
+        PeerConfig::full()
+    };
+    if let Some(revs) = args.revolutions {
+        config.revolutions = revs;
+    }
+    if let Some(repeats) = args.repeats {
+        config.repeats = repeats;
+    }
+    let report = bench::peer_cases(&config);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", describe_peers(&report));
+    }
+    Ok(())
+}
+
+fn describe_peers(r: &PeerReport) -> String {
+    let mut out = String::new();
+    if r.debug_build {
+        out.push_str("warning: debug build; use `cargo run --release -- bench` for timings\n\n");
+    }
+    let c = &r.config;
+    out.push_str(&format!(
+        "Solves repeated by bench/scipy: {} cargoes, {} revolutions (t_end {:.4}), median of {}\n",
+        c.cargoes, c.revolutions, r.t_end, c.repeats
+    ));
+    let rows: Vec<Vec<String>> = r
+        .cases
+        .iter()
+        .map(|s| {
+            vec![
+                s.method.name().to_string(),
+                format!("{:.0e}", s.rtol),
+                format!("{:.3}", s.median_ms),
+                format!("{:.3}", s.min_ms),
+                s.stats.steps.to_string(),
+                s.stats.rejected.to_string(),
+                s.stats.rhs_calls.to_string(),
+                format!("{:.1e}", s.error_vs_reference),
+                s.status.clone(),
+            ]
+        })
+        .collect();
+    out.push_str(&text_table(
+        &[
+            "method", "rtol", "ms", "min ms", "steps", "rejected", "RHS", "error", "status",
+        ],
+        &rows,
+    ));
+    out.push_str(&format!(
+        "error: largest final-state difference to {} at rtol {:.0e} (which agrees with dp5 at 10× its rtol to {:.1e}),\n       in units of A_ref, A_ref·ω, rad, rad·ω\n",
+        r.reference.method.name(),
+        r.reference.rtol,
+        r.reference.cross_check
+    ));
+    out
+}
+
+fn run_thread_scaling(args: &BenchArgs) -> Result<(), UserError> {
+    let mut config = if args.quick {
+        ThreadConfig::quick()
+    } else {
+        ThreadConfig::full()
+    };
+    if let Some(repeats) = args.repeats {
+        config.repeats = repeats;
+    }
+    if let Some(samples) = args.samples {
+        config.samples = samples;
+    }
+    let dir = std::env::temp_dir().join(format!("autobal-bench-threads-{}", std::process::id()));
+    let result = bench::measure_threads(&config, &dir);
+    // The study's files are scratch: remove them whatever happened.
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = result.map_err(|e| UserError::internal(e.to_string()))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", describe_threads(&report));
+    }
+    Ok(())
+}
+
+fn describe_threads(r: &ThreadScaling) -> String {
+    let mut out = String::new();
+    if r.debug_build {
+        out.push_str("warning: debug build; use `cargo run --release -- bench` for timings\n\n");
+    }
+    out.push_str(&format!(
+        "Study {}: {} designs × {} samples = {} runs, {} RHS calls; {} repeats per thread count (ABBA)\n",
+        r.study, r.designs, r.config.samples, r.runs, r.rhs_calls, r.config.repeats
+    ));
+    let rows: Vec<Vec<String>> = r
+        .timings
+        .iter()
+        .map(|t| {
+            vec![
+                t.threads.to_string(),
+                format!("{:.3}", t.median_s),
+                format!("{:.3}", t.min_s),
+                format!("{:.2}", t.speedup),
+                format!("{:.2}", t.paired_speedup),
+                format!("{:.2}", t.speedup_min),
+                t.cores_used.map_or("–".into(), |c| format!("{c:.2}")),
+                if t.cpu_s.is_empty() {
+                    "–".into()
+                } else {
+                    format!("{:.3}", bench::median(&t.cpu_s))
+                },
+            ]
+        })
+        .collect();
+    out.push_str(&text_table(
+        &[
+            "threads",
+            "median s",
+            "min s",
+            "speed-up",
+            "paired",
+            "of fastest",
+            "cores used",
+            "CPU s",
+        ],
+        &rows,
+    ));
+    let load = |l: Option<[f64; 3]>| {
+        l.map_or("unknown".into(), |[a, b, c]| {
+            format!("{a:.2} {b:.2} {c:.2}")
+        })
+    };
+    out.push_str(&format!(
+        "speed-up: ratio of medians; paired: median of per-round ratios; of fastest: ratio of minima;\n\
+         cores used: CPU time / wall time (below the thread count when other processes hold cores);\n\
+         CPU s: median CPU time per study, all threads (equal across thread counts when threading adds no work)\n\
+         results identical across thread counts: {}\n\
+         cores available: {}; load average before {}, after {}\n",
+        if r.identical_results { "yes" } else { "NO" },
+        r.available_parallelism,
+        load(r.load_before),
+        load(r.load_after)
+    ));
+    out
 }
 
 fn describe(r: &BenchReport) -> String {
