@@ -41,6 +41,10 @@ pub struct BenchArgs {
     /// 1e-6, 1e-8, 1e-9), with start, tolerances, RHS samples and final states.
     #[arg(long, conflicts_with = "thread_scaling")]
     peer_cases: bool,
+    /// Compare the `full` and `rotating` fidelities on the isotropic reference
+    /// scene over 10 000 revolutions (RHS calls, steps, time, same answer).
+    #[arg(long, conflicts_with_all = ["thread_scaling", "peer_cases"])]
+    fidelity: bool,
     /// Run a small fixed study (three_balls, 25 samples per design) with 1 and
     /// with 2 threads, interleaved, and report the speed-up.
     #[arg(long)]
@@ -52,19 +56,65 @@ pub struct BenchArgs {
 
 /// Run `study bench`.
 pub fn run(args: &BenchArgs) -> Result<(), UserError> {
+    if args.fidelity {
+        let revs = if args.quick { 1000.0 } else { 10_000.0 };
+        let rows = autobal::bench::measure_fidelities(revs, 1e-6, if args.quick { 1 } else { 5 });
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&rows)?);
+            return Ok(());
+        }
+        let table: Vec<Vec<String>> = rows
+            .iter()
+            .map(|r| {
+                vec![
+                    r.fidelity.clone(),
+                    r.method.clone(),
+                    r.steps.to_string(),
+                    r.rhs_calls.to_string(),
+                    format!("{:.3}", 1e3 * r.wall_s),
+                    r.settling_revs.map_or("–".into(), |t| format!("{t:.3}")),
+                    format!("{:.1e}", r.residual_rel),
+                ]
+            })
+            .collect();
+        print!(
+            "{}",
+            crate::output::text_table(
+                &[
+                    "fidelity",
+                    "method",
+                    "steps",
+                    "RHS calls",
+                    "ms",
+                    "t_s rev",
+                    "residual/A_ref"
+                ],
+                &table
+            )
+        );
+        if let [full, rot] = rows.as_slice() {
+            println!(
+                "{revs} revolutions at rtol 1e-6: rotating uses {:.1}× fewer RHS calls and {:.1}× less time than full",
+                full.rhs_calls as f64 / rot.rhs_calls as f64,
+                full.wall_s / rot.wall_s
+            );
+        }
+        return Ok(());
+    }
+
     if args.repeats == Some(0) {
         return Err(UserError("--repeats 0: need at least one".into(), 2));
     }
     if args.samples == Some(0) {
         return Err(UserError("--samples 0: need at least one".into(), 2));
     }
-    if let Some(revs) = args.revolutions {
-        if !(revs.is_finite() && revs > 0.0) {
-            return Err(UserError(
-                format!("--revolutions {revs}: must be positive and finite"),
-                2,
-            ));
-        }
+    if let Some(revs) = args.revolutions
+        && !(revs.is_finite() && revs > 0.0)
+    {
+        return Err(UserError(
+            format!("--revolutions {revs}: must be positive and finite"),
+            2,
+        ));
     }
     if args.peer_cases {
         return run_peer_cases(args);
