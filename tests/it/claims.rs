@@ -1,5 +1,6 @@
 //! The claims experiment end to end on a tiny configuration.
 
+use crate::fixtures::SI_SCENE;
 use autobal::claims::normalisation::{Normalisation, design_capacity, rho_for};
 use autobal::claims::{report::render, run_claims};
 use autobal::model::balancer::Kind;
@@ -8,16 +9,9 @@ use autobal::study::run::NoProgress;
 
 #[test]
 fn normalisations_hold_what_they_promise() {
-    let text = r#"
-[scene.rotor]
-mass = 10.0
-kx = 1.0e5
-ky = 1.0e5
-bx = 100.0
-by = 100.0
-[scene.speed]
-mode = "constant"
-omega = 300.0
+    let text = &[
+        SI_SCENE,
+        r#"
 [designs]
 kind = "ball"
 n = [2, 3, 4, 5]
@@ -27,7 +21,9 @@ drag = 10.0
 [sampling]
 samples = 1
 unbalance = { distribution = "fixed", value = 0.5 }
-"#;
+"#,
+    ]
+    .concat();
     let file = StudyFile::parse(text, "n.toml").unwrap();
     let g = &file.designs;
     let ns = [2, 3, 4, 5];

@@ -9,6 +9,7 @@ mod design_capacity;
 mod design_criterion;
 mod design_transient;
 mod extremes;
+mod fixtures;
 mod integrate;
 mod model_conservation;
 mod model_flexible;

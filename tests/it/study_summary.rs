@@ -1,21 +1,15 @@
 //! Per-design statistics against hand computations on a small fixture.
 
+use crate::fixtures::SI_SCENE;
 use autobal::metrics::{Outcome, RunMetrics};
 use autobal::study::aggregate::{bootstrap_mean_ci, summarize, wilson_interval};
 use autobal::study::config::StudyFile;
 use autobal::study::record::RunRecord;
 
 fn plan() -> autobal::study::config::StudyPlan {
-    let text = r#"
-[scene.rotor]
-mass = 10.0
-kx = 1.0e5
-ky = 1.0e5
-bx = 100.0
-by = 100.0
-[scene.speed]
-mode = "constant"
-omega = 300.0
+    let text = &[
+        SI_SCENE,
+        r#"
 [designs]
 kind = "ball"
 n = 3
@@ -25,7 +19,9 @@ drag = 10.0
 [sampling]
 samples = 6
 unbalance = { distribution = "fixed", value = 0.5 }
-"#;
+"#,
+    ]
+    .concat();
     StudyFile::parse(text, "fixture.toml")
         .unwrap()
         .plan(text, "fixture.toml")

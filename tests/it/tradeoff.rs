@@ -1,21 +1,15 @@
 //! `study tradeoff`: every setting measured on the same runs against the reference.
 
+use crate::fixtures::SI_SCENE;
 use autobal::simulation::Fidelity;
 use autobal::study::config::StudyFile;
 use autobal::tradeoff::{measure, recommend, rows_frame, settings, spread_runs, summarize};
 
 #[test]
 fn tradeoff_measures_every_setting_and_recommends_within_budget() {
-    let text = r#"
-[scene.rotor]
-mass = 10.0
-kx = 1.0e5
-ky = 1.0e5
-bx = 100.0
-by = 100.0
-[scene.speed]
-mode = "constant"
-omega = 300.0
+    let text = &[
+        SI_SCENE,
+        r#"
 [designs]
 kind = "ball"
 n = 3
@@ -27,7 +21,9 @@ samples = 4
 unbalance = { distribution = "uniform", min = 0.2, max = 0.8 }
 [metrics]
 t_end_revs = 300
-"#;
+"#,
+    ]
+    .concat();
     let plan = StudyFile::parse(text, "t.toml")
         .unwrap()
         .plan(text, "t.toml")
