@@ -17,7 +17,7 @@
     reason = "coefficients keep the published digits so that they can be compared with the source"
 )]
 
-use super::norm::{atol_of, initial_step};
+use super::norm::{atol_of, check_step, initial_step};
 use super::{
     DenseOutput, Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step,
     StepObserver,
@@ -508,15 +508,7 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     let mut last_rejected = false;
 
     loop {
-        if stats.steps + stats.rejected >= options.max_steps {
-            let f = Failure::TooManySteps {
-                t,
-                max: options.max_steps,
-            };
-            return report(Status::Failed(f), t, y, stats);
-        }
-        if 0.1 * h.abs() <= t.abs() * f64::EPSILON {
-            let f = Failure::StepSizeUnderflow { t, h };
+        if let Err(f) = check_step(t, h, &stats, options) {
             return report(Status::Failed(f), t, y, stats);
         }
         let last = t + 1.01 * h >= t_end;

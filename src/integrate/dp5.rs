@@ -1,7 +1,7 @@
 //! Dormand–Prince 5(4) (Hairer's DOPRI5): explicit, adaptive, FSAL, with the
 //! 4th-order continuous extension for dense output and PI step-size control.
 
-use super::norm::{error_norm, initial_step};
+use super::norm::{check_step, error_norm, initial_step};
 use super::{
     DenseOutput, Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step,
     StepObserver,
@@ -122,15 +122,7 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     };
 
     loop {
-        if stats.steps + stats.rejected >= options.max_steps {
-            let f = Failure::TooManySteps {
-                t,
-                max: options.max_steps,
-            };
-            return fail(Status::Failed(f), t, y, stats);
-        }
-        if 0.1 * h.abs() <= t.abs() * f64::EPSILON {
-            let f = Failure::StepSizeUnderflow { t, h };
+        if let Err(f) = check_step(t, h, &stats, options) {
             return fail(Status::Failed(f), t, y, stats);
         }
         let last = t + 1.01 * h >= t_end;

@@ -113,3 +113,23 @@ pub fn initial_step<S: OdeSystem + ?Sized>(
     };
     (100.0 * h).min(h1).min(h_max)
 }
+
+/// The checks every stepper makes before a step: the step budget and a step
+/// size that floating point can still resolve at t.
+pub fn check_step(
+    t: f64,
+    h: f64,
+    stats: &super::Stats,
+    options: &SolverOptions,
+) -> Result<(), super::Failure> {
+    if stats.steps + stats.rejected >= options.max_steps {
+        return Err(super::Failure::TooManySteps {
+            t,
+            max: options.max_steps,
+        });
+    }
+    if 0.1 * h.abs() <= t.abs() * f64::EPSILON {
+        return Err(super::Failure::StepSizeUnderflow { t, h });
+    }
+    Ok(())
+}

@@ -37,7 +37,7 @@
 )]
 
 use super::lu::{ComplexLu, RealLu};
-use super::norm::{atol_of, initial_step};
+use super::norm::{atol_of, check_step, initial_step};
 use super::{
     DenseOutput, Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step,
     StepObserver,
@@ -274,15 +274,7 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
             need_lu = singular;
         }
 
-        if stats.steps + stats.rejected >= options.max_steps {
-            let f = Failure::TooManySteps {
-                t,
-                max: options.max_steps,
-            };
-            return report(Status::Failed(f), t, y, stats);
-        }
-        if 0.1 * h.abs() <= t.abs() * f64::EPSILON {
-            let f = Failure::StepSizeUnderflow { t, h };
+        if let Err(f) = check_step(t, h, &stats, options) {
             return report(Status::Failed(f), t, y, stats);
         }
         let t_new = t + h;
