@@ -222,3 +222,17 @@ fn study_bench_peer_cases_and_thread_scaling_json() {
     let both = study(&["bench", "--peer-cases", "--thread-scaling"]);
     assert_eq!(both.status.code(), Some(2));
 }
+
+#[test]
+fn rotating_frame_needs_ten_times_fewer_rhs_calls_over_a_long_run() {
+    // Counts, not times: deterministic for a given build.
+    let rows = autobal::bench::measure_fidelities(10_000.0, 1e-6, 1);
+    let (full, rotating) = (&rows[0], &rows[1]);
+    assert_eq!(
+        (full.fidelity.as_str(), rotating.fidelity.as_str()),
+        ("full", "rotating")
+    );
+    assert_eq!(full.settling_revs, rotating.settling_revs, "same answer");
+    let ratio = full.rhs_calls as f64 / rotating.rhs_calls as f64;
+    assert!(ratio >= 10.0, "only {ratio:.1}× fewer RHS calls");
+}
