@@ -30,30 +30,18 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Analytic design table (Table 1 of seed 000): optimal radius, capacity, p_max, ã.
-    #[command(after_help = design_cmd::EXAMPLES)]
-    Design(design_cmd::DesignArgs),
-    /// Seed 003's criterion for a rotor on two supports: resonances, extra speeds, balancing ranges.
-    #[command(after_help = criterion_cmd::EXAMPLES)]
-    Criterion(criterion_cmd::CriterionArgs),
-    /// Simulate one scene and print settling time, residual vibration and more.
-    #[command(after_help = simulate_cmd::EXAMPLES)]
-    Simulate(simulate_cmd::SimulateArgs),
-    /// Linear stability of a scene's balanced state: eigenvalues, slowest decay rate.
-    #[command(after_help = linear_cmd::EXAMPLES)]
-    Linear(linear_cmd::LinearArgs),
-    /// Simulate one scene over a grid of speeds next to the criterion and linear stability.
-    #[command(after_help = sweep_cmd::EXAMPLES)]
-    Sweep(sweep_cmd::SweepArgs),
-    /// Stability map of the balanced state over speed and unbalance (Parquet and a character picture).
-    #[command(after_help = map_cmd::EXAMPLES)]
-    Map(map_cmd::MapArgs),
     /// Run a Monte Carlo study: every design × sample, statistics, Parquet files.
     #[command(after_help = run_cmd::RUN_EXAMPLES)]
     Run(run_cmd::RunArgs),
     /// Merge the outputs of `study run --shard k/N` into one study's files.
     #[command(after_help = run_cmd::MERGE_EXAMPLES)]
     Merge(run_cmd::MergeArgs),
+    /// Simulate one scene and print settling time, residual vibration and more.
+    #[command(after_help = simulate_cmd::EXAMPLES)]
+    Simulate(simulate_cmd::SimulateArgs),
+    /// Analytic design table (Table 1 of seed 000): optimal radius, capacity, p_max, ã.
+    #[command(after_help = design_cmd::EXAMPLES)]
+    Design(design_cmd::DesignArgs),
     /// Optimise weight count, radius (and drag) for an analytic or simulated objective.
     #[command(after_help = optimize_cmd::EXAMPLES)]
     Optimize(optimize_cmd::OptimizeArgs),
@@ -63,18 +51,30 @@ enum Command {
     /// Measure speed against accuracy for every fidelity and tolerance on a study's runs.
     #[command(after_help = tradeoff_cmd::EXAMPLES)]
     Tradeoff(tradeoff_cmd::TradeoffArgs),
-    /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
-    #[command(after_help = bench_cmd::EXAMPLES)]
-    Bench(bench_cmd::BenchArgs),
-    /// Figures as SVG or PNG: one run, one study, design curves, work–precision.
-    #[command(after_help = plot_cmd::EXAMPLES)]
-    Plot(plot_cmd::PlotArgs),
     /// Compare a fresh run of a study with its baseline: KS, Fisher and Mood tests, Holm; exit 1 on a regression.
     #[command(after_help = check_cmd::CHECK_EXAMPLES)]
     Check(check_cmd::CheckArgs),
     /// Run a study and write (or refresh) its baseline for `study check`, with provenance.
     #[command(after_help = check_cmd::BASELINE_EXAMPLES)]
     Baseline(check_cmd::BaselineArgs),
+    /// Figures as SVG or PNG: one run, one study, design curves, work–precision.
+    #[command(after_help = plot_cmd::EXAMPLES)]
+    Plot(plot_cmd::PlotArgs),
+    /// Linear stability of a scene's balanced state: eigenvalues, slowest decay rate.
+    #[command(after_help = linear_cmd::EXAMPLES)]
+    Linear(linear_cmd::LinearArgs),
+    /// Seed 003's criterion for a rotor on two supports: resonances, extra speeds, balancing ranges.
+    #[command(after_help = criterion_cmd::EXAMPLES)]
+    Criterion(criterion_cmd::CriterionArgs),
+    /// Simulate one scene over a grid of speeds next to the criterion and linear stability.
+    #[command(after_help = sweep_cmd::EXAMPLES)]
+    Sweep(sweep_cmd::SweepArgs),
+    /// Stability map of the balanced state over speed and unbalance (Parquet and a character picture).
+    #[command(after_help = map_cmd::EXAMPLES)]
+    Map(map_cmd::MapArgs),
+    /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
+    #[command(after_help = bench_cmd::EXAMPLES)]
+    Bench(bench_cmd::BenchArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
