@@ -10,6 +10,7 @@ mod design_criterion;
 mod design_transient;
 mod extremes;
 mod fixtures;
+mod golden;
 mod integrate;
 mod model_conservation;
 mod model_flexible;
