@@ -2,9 +2,7 @@
 //! executed and measured. This is the executor for a single simulation; the
 //! study runner fans many of them out over threads.
 
-use crate::integrate::{
-    Failure, Flow, Method, OdeSystem, SolverOptions, Status, Step, StepObserver, solve,
-};
+use crate::integrate::{Method, OdeSystem, SolverOptions, Stiffness, solve};
 use crate::metrics::observer::{Series, SettlingObserver};
 use crate::metrics::{MetricOptions, Outcome, RunMetrics};
 use crate::model::frame::{RotatingSystem, rotating_frame_obstacle};
@@ -231,45 +229,22 @@ impl Simulation {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: self.solver.max_steps,
-            detect_stiffness: explicit && self.solver.implicit_fallback,
+            stiffness: if explicit && self.solver.implicit_fallback {
+                Stiffness::SwitchToImplicit
+            } else {
+                Stiffness::Ignore
+            },
         };
         let report = solve(method, ode, 0.0, y0, t_end, &options, &mut observer);
-        let stalled = matches!(
-            &report.status,
-            Status::Failed(
-                Failure::StiffnessDetected { .. }
-                    | Failure::TooManySteps { .. }
-                    | Failure::StepSizeUnderflow { .. }
-            )
-        );
-        if !(explicit && self.solver.implicit_fallback && stalled) {
-            let (mut metrics, series) = observer.finish(&report);
-            metrics.method = method.name().to_string();
-            return (metrics, series);
+        let (mut metrics, series) = observer.finish(&report);
+        metrics.method = method.name().to_string();
+        if let Some(switch) = &report.switched {
+            metrics.method = format!("{}→{}", switch.from.name(), Method::Radau5.name());
+            metrics.reason = format!(
+                "{} (switched to radau5 at t = {:.4}: {})",
+                metrics.reason, switch.t, switch.why
+            );
         }
-        // Continue from where the explicit method stalled with Radau5; the
-        // observer keeps its samples, so the run's metrics are seamless.
-        let why = match &report.status {
-            Status::Failed(f) => f.to_string(),
-            _ => String::new(),
-        };
-        let rest = solve(
-            Method::Radau5,
-            ode,
-            report.t,
-            &report.y,
-            t_end,
-            &options,
-            &mut Continuation(&mut observer),
-        );
-        let (mut metrics, series) = observer.finish(&rest);
-        metrics.method = format!("{}→{}", method.name(), Method::Radau5.name());
-        metrics.reason = format!(
-            "{} (switched to radau5 at t = {:.4}: {why})",
-            metrics.reason, report.t
-        );
-        metrics.steps += report.stats.steps;
-        metrics.rhs_calls += report.stats.rhs_calls;
         (metrics, series)
     }
 
@@ -372,15 +347,6 @@ impl Simulation {
                 ..base
             },
         }
-    }
-}
-
-/// Passes a continued run's steps to an observer that already saw its start.
-struct Continuation<'a, O: StepObserver>(&'a mut O);
-
-impl<O: StepObserver> StepObserver for Continuation<'_, O> {
-    fn step(&mut self, step: &Step<'_>) -> Flow {
-        self.0.step(step)
     }
 }
 

@@ -17,11 +17,10 @@
     reason = "coefficients keep the published digits so that they can be compared with the source"
 )]
 
-use super::norm::{atol_of, check_step, initial_step};
-use super::{
-    DenseOutput, Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step,
-    StepObserver,
-};
+use super::controller::PiController;
+use super::norm::{atol_of, initial_step};
+use super::stepper::{Stepper, Trial};
+use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
 const C2: f64 = 0.526_001_519_587_677_318_785_587_544_488e-1;
 const C3: f64 = 0.789_002_279_381_515_978_178_381_316_732e-1;
@@ -208,6 +207,8 @@ fn dot(w: &[f64; 12], k: &[f64; 12]) -> f64 {
 const SAFE: f64 = 0.9;
 const FAC_MIN: f64 = 1.0 / 3.0;
 const FAC_MAX: f64 = 6.0;
+/// Hairer's bound on h·|λ| for the stability region of DOP853.
+const STIFF_BOUND: f64 = 6.1;
 
 /// The 7th-order continuous extension over one step: Hairer's eight `rcont`
 /// vectors, evaluated in nested form.
@@ -463,107 +464,126 @@ impl Stages {
     }
 }
 
-/// Integrate with DOP853; see [`super::solve`].
-pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
-    system: &S,
-    t0: f64,
-    y0: &[f64],
-    t_end: f64,
-    options: &SolverOptions,
-    observer: &mut O,
-) -> SolveReport {
-    let n = y0.len();
-    let zeros = || vec![0.0; n];
-    let (mut y, mut y1, mut ys) = (y0.to_vec(), zeros(), zeros());
-    let mut st = Stages {
-        k: std::array::from_fn(|_| zeros()),
-    };
-    let mut dense = Dense {
-        t_old: t0,
-        h: 1.0,
-        r: std::array::from_fn(|_| zeros()),
-    };
-    let mut stats = Stats::default();
-    let (rtol, atol) = (options.rtol, &options.atol[..]);
-    let h_max = options.h_max.min(t_end - t0);
-    let report = |status, t, y, stats| SolveReport {
-        status,
-        t,
-        y,
-        stats,
-    };
+/// DOP853's work vectors: the stages, the trial solution, the stage
+/// argument and the dense output.
+pub struct Dop853 {
+    options: SolverOptions,
+    controller: PiController,
+    st: Stages,
+    y1: Vec<f64>,
+    ys: Vec<f64>,
+    dense: Dense,
+}
 
-    observer.start(t0, y0);
-    system.rhs(t0, &y, &mut st.k[0]);
-    stats.rhs_calls += 1;
-    let mut h = match options.h0 {
-        Some(h0) => h0.min(h_max),
-        None => {
-            stats.rhs_calls += 1;
-            let [k1, k2, k3, ..] = &mut st.k;
-            initial_step(system, t0, &y, k1, 8, h_max, options, (k2, k3))
-        }
-    };
-    let mut t = t0;
-    let mut last_rejected = false;
+impl Stepper for Dop853 {
+    const METHOD: Method = Method::Dop853;
 
-    loop {
-        if let Err(f) = check_step(t, h, &stats, options) {
-            return report(Status::Failed(f), t, y, stats);
+    fn new(dim: usize, options: &SolverOptions) -> Self {
+        let zeros = || vec![0.0; dim];
+        Dop853 {
+            options: options.clone(),
+            controller: PiController::new(1.0 / 8.0, 0.0, SAFE, FAC_MIN, FAC_MAX),
+            st: Stages {
+                k: std::array::from_fn(|_| zeros()),
+            },
+            y1: zeros(),
+            ys: zeros(),
+            dense: Dense {
+                t_old: 0.0,
+                h: 1.0,
+                r: std::array::from_fn(|_| zeros()),
+            },
         }
-        let last = t + 1.01 * h >= t_end;
-        if last {
-            h = t_end - t;
-        }
-        st.step(system, t, h, &y, &mut ys, &mut y1);
+    }
+
+    fn start<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64],
+        h_max: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, Failure> {
+        let [k1, k2, k3, ..] = &mut self.st.k;
+        system.rhs(t0, y0, k1);
+        stats.rhs_calls += 1;
+        Ok(match self.options.h0 {
+            Some(h0) => h0.min(h_max),
+            None => {
+                stats.rhs_calls += 1;
+                initial_step(system, t0, y0, k1, 8, h_max, &self.options, (k2, k3))
+            }
+        })
+    }
+
+    fn end_stretch(&self) -> f64 {
+        1.01
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Trial {
+        self.st.step(system, t, h, y, &mut self.ys, &mut self.y1);
         stats.rhs_calls += 11;
-        let e = h.abs() * error_estimate(&st.k, &y, &y1, rtol, atol);
+        let (rtol, atol) = (self.options.rtol, &self.options.atol[..]);
+        let e = h.abs() * error_estimate(&self.st.k, y, &self.y1, rtol, atol);
         if !e.is_finite() {
             // As in dp5: a non-finite trial means the step was far too large;
             // give up only when the state itself is already bad.
             if y.iter().any(|v| !v.is_finite()) {
-                return report(Status::Failed(Failure::NonFinite { t }), t, y, stats);
+                return Trial::Failed(Failure::NonFinite { t });
             }
-            stats.rejected += 1;
-            h *= FAC_MIN;
-            last_rejected = true;
-            continue;
+            return Trial::Rejected {
+                h_new: self.controller.after_non_finite(h),
+            };
         }
-        let fac11 = e.powf(1.0 / 8.0);
-        if e <= 1.0 {
-            let fac = (fac11 / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-            let mut h_new = h / fac;
-            stats.steps += 1;
-            let t_new = t + h;
-            system.rhs(t_new, &y1, &mut st.k[12]);
-            st.dense(system, t, h, &y, &y1, &mut ys, &mut dense);
-            stats.rhs_calls += 4;
-            // FSAL: the derivative at the new point starts the next step.
-            st.k.swap(0, 12);
-            std::mem::swap(&mut y, &mut y1);
-            t = t_new;
-            if last_rejected {
-                h_new = h_new.min(h);
+        match self.controller.propose(e, h) {
+            (true, h_new) => {
+                // f at the new point: the stiffness test, the dense output
+                // and (FSAL) the next step all need it.
+                system.rhs(t + h, &self.y1, &mut self.st.k[12]);
+                stats.rhs_calls += 1;
+                Trial::Accepted { h_new }
             }
-            last_rejected = false;
-            let flow = observer.step(&Step {
-                t_prev: dense.t_old,
-                t,
-                y: &y,
-                dense: &dense,
-            });
-            if flow == Flow::Stop {
-                return report(Status::Stopped, t, y, stats);
-            }
-            if last || t >= t_end {
-                return report(Status::Finished, t, y, stats);
-            }
-            h = h_new.min(h_max);
-        } else {
-            stats.rejected += 1;
-            h /= (fac11 / SAFE).min(1.0 / FAC_MIN);
-            last_rejected = true;
+            (false, h_new) => Trial::Rejected { h_new },
         }
+    }
+
+    fn looks_stiff(&self, h: f64) -> bool {
+        // h·|λ| from stage 12 and the new point, which both sit at t + h.
+        let (k12, k13) = (&self.st.k[11], &self.st.k[12]);
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..k12.len() {
+            num += (k13[i] - k12[i]).powi(2);
+            den += (self.y1[i] - self.ys[i]).powi(2);
+        }
+        den > 0.0 && h * (num / den).sqrt() > STIFF_BOUND
+    }
+
+    fn accept<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        h: f64,
+        y: &mut Vec<f64>,
+        stats: &mut Stats,
+    ) -> Result<(), Failure> {
+        self.st
+            .dense(system, t, h, y, &self.y1, &mut self.ys, &mut self.dense);
+        stats.rhs_calls += 3;
+        // FSAL: the derivative at the new point starts the next step.
+        self.st.k.swap(0, 12);
+        std::mem::swap(y, &mut self.y1);
+        Ok(())
+    }
+
+    fn dense(&self) -> &dyn DenseOutput {
+        &self.dense
     }
 }
 

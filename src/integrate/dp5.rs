@@ -1,11 +1,10 @@
 //! Dormand–Prince 5(4) (Hairer's DOPRI5): explicit, adaptive, FSAL, with the
 //! 4th-order continuous extension for dense output and PI step-size control.
 
-use super::norm::{check_step, error_norm, initial_step};
-use super::{
-    DenseOutput, Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step,
-    StepObserver,
-};
+use super::controller::PiController;
+use super::norm::{error_norm, initial_step};
+use super::stepper::{Stepper, Trial};
+use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -49,6 +48,8 @@ const SAFE: f64 = 0.9;
 const FAC_MIN: f64 = 0.2;
 const FAC_MAX: f64 = 10.0;
 const BETA: f64 = 0.04;
+/// Hairer's bound on h·|λ| for the stability region of DOPRI5.
+const STIFF_BOUND: f64 = 3.25;
 
 /// The continuous extension over one step: Hairer's five `rcont` vectors.
 struct Dense {
@@ -68,193 +69,162 @@ impl DenseOutput for Dense {
     }
 }
 
-/// Integrate with DOPRI5; see [`super::solve`].
-pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
-    system: &S,
-    t0: f64,
-    y0: &[f64],
-    t_end: f64,
-    options: &SolverOptions,
-    observer: &mut O,
-) -> SolveReport {
-    let n = y0.len();
-    let zeros = || vec![0.0; n];
-    let (mut y, mut y1, mut ystage) = (y0.to_vec(), zeros(), zeros());
-    let (mut k1, mut k2, mut k3, mut k4, mut k5, mut k6, mut k7) = (
-        zeros(),
-        zeros(),
-        zeros(),
-        zeros(),
-        zeros(),
-        zeros(),
-        zeros(),
-    );
-    let mut err = zeros();
-    let mut dense = Dense {
-        t_old: t0,
-        h: 1.0,
-        r: [zeros(), zeros(), zeros(), zeros(), zeros()],
-    };
-    let mut stats = Stats::default();
-    let (rtol, atol) = (options.rtol, &options.atol[..]);
-    let h_max = options.h_max.min(t_end - t0);
+/// DOPRI5's work vectors: the seven stages, the trial solution, the last
+/// stage's argument (for the stiffness test) and the dense output.
+pub struct Dp5 {
+    options: SolverOptions,
+    controller: PiController,
+    k: [Vec<f64>; 7],
+    y1: Vec<f64>,
+    ystage: Vec<f64>,
+    err: Vec<f64>,
+    dense: Dense,
+}
 
-    observer.start(t0, y0);
-    system.rhs(t0, &y, &mut k1);
-    stats.rhs_calls += 1;
-    let mut h = match options.h0 {
-        Some(h0) => h0.min(h_max),
-        None => {
-            stats.rhs_calls += 1;
-            initial_step(system, t0, &y, &k1, 5, h_max, options, (&mut k2, &mut k3))
-        }
-    };
-    let mut t = t0;
-    let mut fac_old: f64 = 1e-4;
-    // Hairer's stiffness test: h·|λ| estimated from the last two stages.
-    let (mut stiff_count, mut non_stiff_count) = (0u32, 0u32);
-    let mut last_rejected = false;
-    let fail = |status, t, y: Vec<f64>, stats| SolveReport {
-        status,
-        t,
-        y,
-        stats,
-    };
+impl Stepper for Dp5 {
+    const METHOD: Method = Method::Dp5;
 
-    loop {
-        if let Err(f) = check_step(t, h, &stats, options) {
-            return fail(Status::Failed(f), t, y, stats);
+    fn new(dim: usize, options: &SolverOptions) -> Self {
+        let zeros = || vec![0.0; dim];
+        Dp5 {
+            options: options.clone(),
+            controller: PiController::new(0.2, BETA, SAFE, FAC_MIN, FAC_MAX),
+            k: std::array::from_fn(|_| zeros()),
+            y1: zeros(),
+            ystage: zeros(),
+            err: zeros(),
+            dense: Dense {
+                t_old: 0.0,
+                h: 1.0,
+                r: std::array::from_fn(|_| zeros()),
+            },
         }
-        let last = t + 1.01 * h >= t_end;
-        if last {
-            h = t_end - t;
-        }
+    }
+
+    fn start<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64],
+        h_max: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, Failure> {
+        let [k1, k2, k3, ..] = &mut self.k;
+        system.rhs(t0, y0, k1);
+        stats.rhs_calls += 1;
+        Ok(match self.options.h0 {
+            Some(h0) => h0.min(h_max),
+            None => {
+                stats.rhs_calls += 1;
+                initial_step(system, t0, y0, k1, 5, h_max, &self.options, (k2, k3))
+            }
+        })
+    }
+
+    fn end_stretch(&self) -> f64 {
+        1.01
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Trial {
+        let n = y.len();
+        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        let (ystage, y1) = (&mut self.ystage, &mut self.y1);
         for i in 0..n {
             ystage[i] = y[i] + h * A21 * k1[i];
         }
-        system.rhs(t + C2 * h, &ystage, &mut k2);
+        system.rhs(t + C2 * h, ystage, k2);
         for i in 0..n {
             ystage[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
         }
-        system.rhs(t + C3 * h, &ystage, &mut k3);
+        system.rhs(t + C3 * h, ystage, k3);
         for i in 0..n {
             ystage[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
         }
-        system.rhs(t + C4 * h, &ystage, &mut k4);
+        system.rhs(t + C4 * h, ystage, k4);
         for i in 0..n {
             ystage[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
         }
-        system.rhs(t + C5 * h, &ystage, &mut k5);
+        system.rhs(t + C5 * h, ystage, k5);
         for i in 0..n {
             ystage[i] =
                 y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
         }
         let t_new = t + h;
-        system.rhs(t_new, &ystage, &mut k6);
+        system.rhs(t_new, ystage, k6);
         for i in 0..n {
             y1[i] =
                 y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
         }
-        system.rhs(t_new, &y1, &mut k7);
+        system.rhs(t_new, y1, k7);
         stats.rhs_calls += 6;
+        let err = &mut self.err;
         for i in 0..n {
             err[i] =
                 h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         }
-        let e = error_norm(&err, &y, &y1, rtol, atol);
+        let e = error_norm(err, y, y1, self.options.rtol, &self.options.atol);
         if !e.is_finite() {
-            // A non-finite trial usually means the step was far too large; shrink
-            // hard, and give up only when the state itself is already bad.
             if y.iter().any(|v| !v.is_finite()) {
-                return fail(Status::Failed(Failure::NonFinite { t }), t, y, stats);
+                return Trial::Failed(Failure::NonFinite { t });
             }
-            stats.rejected += 1;
-            h *= FAC_MIN;
-            last_rejected = true;
-            continue;
+            return Trial::Rejected {
+                h_new: self.controller.after_non_finite(h),
+            };
         }
-        // PI controller (Hairer's DOPRI5 with β = 0.04).
-        let fac11 = e.powf(0.2 - BETA * 0.75);
-        if e <= 1.0 {
-            let fac = (fac11 / fac_old.powf(BETA) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-            let mut h_new = h / fac;
-            fac_old = e.max(1e-4);
-            stats.steps += 1;
-            if options.detect_stiffness {
-                let (mut num, mut den) = (0.0, 0.0);
-                for i in 0..n {
-                    num += (k7[i] - k6[i]).powi(2);
-                    den += (y1[i] - ystage[i]).powi(2);
-                }
-                if den > 0.0 && h * (num / den).sqrt() > 3.25 {
-                    non_stiff_count = 0;
-                    stiff_count += 1;
-                    if stiff_count == 15 {
-                        let f = Failure::StiffnessDetected { t };
-                        return fail(Status::Failed(f), t, y, stats);
-                    }
-                } else {
-                    non_stiff_count += 1;
-                    if non_stiff_count == 6 {
-                        stiff_count = 0;
-                    }
-                }
-            }
-            // Dense output coefficients for [t, t + h].
-            {
-                let [r1, r2, r3, r4, r5] = &mut dense.r;
-                for i in 0..n {
-                    let ydiff = y1[i] - y[i];
-                    let bspl = h * k1[i] - ydiff;
-                    r1[i] = y[i];
-                    r2[i] = ydiff;
-                    r3[i] = bspl;
-                    r4[i] = ydiff - h * k7[i] - bspl;
-                    r5[i] = h
-                        * (D1 * k1[i]
-                            + D3 * k3[i]
-                            + D4 * k4[i]
-                            + D5 * k5[i]
-                            + D6 * k6[i]
-                            + D7 * k7[i]);
-                }
-            }
-            dense.t_old = t;
-            dense.h = h;
-            std::mem::swap(&mut k1, &mut k7);
-            std::mem::swap(&mut y, &mut y1);
-            t = t_new;
-            if last_rejected {
-                h_new = h_new.min(h);
-            }
-            last_rejected = false;
-            let flow = observer.step(&Step {
-                t_prev: dense.t_old,
-                t,
-                y: &y,
-                dense: &dense,
-            });
-            if flow == Flow::Stop {
-                return SolveReport {
-                    status: Status::Stopped,
-                    t,
-                    y,
-                    stats,
-                };
-            }
-            if last || t >= t_end {
-                return SolveReport {
-                    status: Status::Finished,
-                    t,
-                    y,
-                    stats,
-                };
-            }
-            h = h_new.min(h_max);
-        } else {
-            stats.rejected += 1;
-            h /= (fac11 / SAFE).min(1.0 / FAC_MIN);
-            last_rejected = true;
+        match self.controller.propose(e, h) {
+            (true, h_new) => Trial::Accepted { h_new },
+            (false, h_new) => Trial::Rejected { h_new },
         }
+    }
+
+    fn looks_stiff(&self, h: f64) -> bool {
+        // h·|λ| from the last two stages, which both sit at t + h.
+        let [.., k6, k7] = &self.k;
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..k6.len() {
+            num += (k7[i] - k6[i]).powi(2);
+            den += (self.y1[i] - self.ystage[i]).powi(2);
+        }
+        den > 0.0 && h * (num / den).sqrt() > STIFF_BOUND
+    }
+
+    fn accept<S: OdeSystem + ?Sized>(
+        &mut self,
+        _system: &S,
+        t: f64,
+        h: f64,
+        y: &mut Vec<f64>,
+        _stats: &mut Stats,
+    ) -> Result<(), Failure> {
+        let [k1, _, k3, k4, k5, k6, k7] = &self.k;
+        let y1 = &self.y1;
+        let [r1, r2, r3, r4, r5] = &mut self.dense.r;
+        for i in 0..y.len() {
+            let ydiff = y1[i] - y[i];
+            let bspl = h * k1[i] - ydiff;
+            r1[i] = y[i];
+            r2[i] = ydiff;
+            r3[i] = bspl;
+            r4[i] = ydiff - h * k7[i] - bspl;
+            r5[i] =
+                h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
+        }
+        self.dense.t_old = t;
+        self.dense.h = h;
+        // FSAL: the derivative at the new point starts the next step.
+        self.k.swap(0, 6);
+        std::mem::swap(y, &mut self.y1);
+        Ok(())
+    }
+
+    fn dense(&self) -> &dyn DenseOutput {
+        &self.dense
     }
 }

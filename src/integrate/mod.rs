@@ -13,11 +13,16 @@
 //! two of them had correctness bugs for time-dependent right-hand sides (see
 //! `docs/integrators.md` for the numbers).
 
+pub mod controller;
 pub mod dop853;
 pub mod dp5;
+mod driver;
 mod lu;
 pub mod norm;
 pub mod radau5;
+pub mod stepper;
+
+pub use stepper::{Stepper, Trial};
 
 use serde::{Deserialize, Serialize};
 
@@ -140,10 +145,30 @@ pub struct SolverOptions {
     pub h_max: f64,
     /// Give up after this many steps (accepted plus rejected).
     pub max_steps: u64,
-    /// Explicit methods stop with [`Failure::StiffnessDetected`] when the step
-    /// size is held at the stability boundary (Hairer's test), so that a caller
-    /// can switch to an implicit method instead of crawling.
-    pub detect_stiffness: bool,
+    /// What an explicit method does when its step size is held at the
+    /// stability boundary (Hairer's test) instead of by accuracy.
+    pub stiffness: Stiffness,
+}
+
+/// What the driver does about stiffness met by an explicit method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stiffness {
+    /// Do not watch: the explicit method crawls on with tiny steps.
+    #[default]
+    Ignore,
+    /// Stop with [`Failure::StiffnessDetected`] and let the caller decide.
+    Stop,
+    /// Continue from the current state with Radau5 when the explicit method
+    /// is held by stiffness, runs out of its step budget or its step size
+    /// underflows; the report's [`SolveReport::switched`] says when and why.
+    SwitchToImplicit,
+}
+
+impl Stiffness {
+    /// Whether the driver runs Hairer's stiffness test at all.
+    fn is_watched(self) -> bool {
+        self != Stiffness::Ignore
+    }
 }
 
 impl Default for SolverOptions {
@@ -154,7 +179,7 @@ impl Default for SolverOptions {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: 10_000_000,
-            detect_stiffness: false,
+            stiffness: Stiffness::Ignore,
         }
     }
 }
@@ -172,6 +197,16 @@ pub struct Stats {
     pub jacobians: u64,
     /// LU factorisations (implicit methods).
     pub factorizations: u64,
+}
+
+impl std::ops::AddAssign for Stats {
+    fn add_assign(&mut self, other: Stats) {
+        self.steps += other.steps;
+        self.rejected += other.rejected;
+        self.rhs_calls += other.rhs_calls;
+        self.jacobians += other.jacobians;
+        self.factorizations += other.factorizations;
+    }
 }
 
 /// Why a run could not continue.
@@ -236,8 +271,23 @@ pub struct SolveReport {
     pub t: f64,
     /// State at `t`.
     pub y: Vec<f64>,
-    /// Work done.
+    /// Work done (by every segment of the run).
     pub stats: Stats,
+    /// When the explicit method handed over to Radau5 ([`Stiffness::SwitchToImplicit`]).
+    pub switched: Option<Switch>,
+}
+
+/// A hand-over from an explicit method to the implicit one during a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Switch {
+    /// The method that stalled.
+    pub from: Method,
+    /// Time of the hand-over.
+    pub t: f64,
+    /// Why the explicit method could not go on.
+    pub why: Failure,
+    /// Work done by the explicit method before the hand-over.
+    pub before: Stats,
 }
 
 /// Integrate `system` from (t0, y0) to t_end with `method`, reporting every
@@ -251,17 +301,48 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     options: &SolverOptions,
     observer: &mut O,
 ) -> SolveReport {
+    let invalid = |reason, t, y: &[f64], stats| SolveReport {
+        status: Status::Failed(Failure::Invalid(reason)),
+        t,
+        y: y.to_vec(),
+        stats,
+        switched: None,
+    };
     if let Err(reason) = norm::validate(system.dim(), y0, t0, t_end, options) {
-        return SolveReport {
-            status: Status::Failed(Failure::Invalid(reason)),
-            t: t0,
-            y: y0.to_vec(),
-            stats: Stats::default(),
-        };
+        return invalid(reason, t0, y0, Stats::default());
     }
-    match method {
-        Method::Dp5 => dp5::solve(system, t0, y0, t_end, options, observer),
-        Method::Dop853 => dop853::solve(system, t0, y0, t_end, options, observer),
-        Method::Radau5 => radau5::solve(system, t0, y0, t_end, options, observer),
+    observer.start(t0, y0);
+    let first = match method {
+        Method::Dp5 => driver::drive::<dp5::Dp5, _, _>(system, t0, y0, t_end, options, observer),
+        Method::Dop853 => {
+            driver::drive::<dop853::Dop853, _, _>(system, t0, y0, t_end, options, observer)
+        }
+        Method::Radau5 => {
+            driver::drive::<radau5::Radau5, _, _>(system, t0, y0, t_end, options, observer)
+        }
+    };
+    let switch = options.stiffness == Stiffness::SwitchToImplicit
+        && method != Method::Radau5
+        && driver::stalled(&first.status);
+    if !switch {
+        return first;
     }
+    let Status::Failed(why) = first.status else {
+        unreachable!("a stalled run has failed")
+    };
+    // The implicit method continues where the explicit one stalled, with a
+    // step budget of its own; the observer sees one seamless run.
+    if let Err(reason) = norm::validate(system.dim(), &first.y, first.t, t_end, options) {
+        return invalid(reason, first.t, &first.y, first.stats);
+    }
+    let mut rest =
+        driver::drive::<radau5::Radau5, _, _>(system, first.t, &first.y, t_end, options, observer);
+    rest.stats += first.stats;
+    rest.switched = Some(Switch {
+        from: method,
+        t: first.t,
+        why,
+        before: first.stats,
+    });
+    rest
 }

@@ -37,11 +37,9 @@
 )]
 
 use super::lu::{ComplexLu, RealLu};
-use super::norm::{atol_of, check_step, initial_step};
-use super::{
-    DenseOutput, Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step,
-    StepObserver,
-};
+use super::norm::{atol_of, initial_step};
+use super::stepper::{Stepper, Trial};
+use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
 /// T: eigenvectors of the inverse Radau IIA matrix (Hairer's digits); T32 = 1, T33 = 0.
 const T11: f64 = 9.123_239_487_089_294_279_2e-2;
@@ -155,383 +153,470 @@ fn rms(v: &[f64], scal: &[f64]) -> f64 {
     (sum / v.len() as f64).sqrt()
 }
 
-/// Integrate with RADAU5; see [`super::solve`].
-pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
-    system: &S,
-    t0: f64,
-    y0: &[f64],
-    t_end: f64,
-    options: &SolverOptions,
-    observer: &mut O,
-) -> SolveReport {
-    let n = y0.len();
-    let k = Coeffs::new();
-    let zeros = || vec![0.0; n];
-    // Hairer's tolerance mapping (see the module docs).
-    let rtol = 0.1 * options.rtol.powf(2.0 / 3.0);
-    let atol: Vec<f64> = options
-        .atol
-        .iter()
-        .map(|a| a * rtol / options.rtol)
-        .collect();
-    let fnewt = (10.0 * UROUND / rtol).max(0.03f64.min(rtol.sqrt()));
-    let h_max = options.h_max.min(t_end - t0);
+/// RADAU5's state between steps: the transformed tolerances, the Newton
+/// iterates, the Jacobian and its two shifted factorisations (reused while
+/// they stay good), and the step-size controller's memory.
+pub struct Radau5 {
+    k: Coeffs,
+    options: SolverOptions,
+    rtol: f64,
+    atol: Vec<f64>,
+    fnewt: f64,
+    fy: Vec<f64>,
+    scal: Vec<f64>,
+    tmp: Vec<f64>,
+    y_perturbed: Vec<f64>,
+    z: [Vec<f64>; 3],
+    f: [Vec<f64>; 3],
+    jac: Vec<f64>,
+    e1: RealLu,
+    e2: ComplexLu,
+    dense: Dense,
+    h_old: f64,
+    first: bool,
+    reject: bool,
+    faccon: f64,
+    theta: f64,
+    cfac: f64,
+    h_acc: f64,
+    err_acc: f64,
+    need_jac: bool,
+    need_lu: bool,
+    fresh_jac: bool,
+    analytic: bool,
+    newton_failures: u32,
+    accepted: u64,
+    fac1: f64,
+    alphn: f64,
+    betan: f64,
+}
 
-    let mut y = y0.to_vec();
-    let (mut fy, mut scal, mut tmp) = (zeros(), zeros(), zeros());
-    let (mut z1, mut z2, mut z3) = (zeros(), zeros(), zeros());
-    let (mut f1, mut f2, mut f3) = (zeros(), zeros(), zeros());
-    let mut jac = vec![0.0; n * n];
-    let mut e1 = RealLu::new(n);
-    let mut e2 = ComplexLu::new(n);
-    let mut dense = Dense {
-        t: t0,
-        h: 1.0,
-        c1m1: k.c1m1,
-        c2m1: k.c2m1,
-        cont: [zeros(), zeros(), zeros(), zeros()],
-    };
-    let mut stats = Stats::default();
-    let report = |status, t, y, stats| SolveReport {
-        status,
-        t,
-        y,
-        stats,
-    };
-    let set_scal = |y: &[f64], scal: &mut [f64]| {
-        for i in 0..n {
-            scal[i] = atol_of(&atol, i) + rtol * y[i].abs();
-        }
-    };
-
-    observer.start(t0, y0);
-    let mut t = t0;
-    set_scal(&y, &mut scal);
-    system.rhs(t, &y, &mut fy);
-    stats.rhs_calls += 1;
-    if fy.iter().any(|v| !v.is_finite()) {
-        return report(Status::Failed(Failure::NonFinite { t }), t, y, stats);
-    }
-    let mut h = match options.h0 {
-        Some(h0) => h0,
-        None => {
-            stats.rhs_calls += 1;
-            let inner = SolverOptions {
-                rtol,
-                atol: atol.clone(),
-                ..options.clone()
-            };
-            initial_step(system, t0, &y, &fy, 3, h_max, &inner, (&mut z1, &mut z2))
+impl Radau5 {
+    fn set_scal(&mut self, y: &[f64]) {
+        for i in 0..y.len() {
+            self.scal[i] = atol_of(&self.atol, i) + self.rtol * y[i].abs();
         }
     }
-    .min(h_max);
-    let mut last = false;
-    if t + h * 1.0001 >= t_end {
-        h = t_end - t;
-        last = true;
-    }
 
-    let mut h_old = h;
-    let (mut first, mut reject) = (true, false);
-    let mut faccon: f64 = 1.0;
-    let mut theta = THET;
-    let cfac = SAFE * f64::from(1 + 2 * NIT);
-    let (mut h_acc, mut err_acc) = (h, 1.0);
-    let (mut need_jac, mut need_lu, mut fresh_jac) = (true, true, false);
-    let mut analytic = true;
-    let mut newton_failures = 0;
-    let (mut fac1, mut alphn, mut betan) = (0.0, 0.0, 0.0);
-
-    loop {
-        let mut singular = false;
-        if need_jac {
+    /// Jacobian (analytic when the system has one, else forward differences)
+    /// and the two shifted factorisations, as far as they are due; false
+    /// when a matrix is singular.
+    fn prepare<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> bool {
+        let n = y.len();
+        if self.need_jac {
             stats.jacobians += 1;
-            if !(analytic && system.jacobian(t, &y, &mut jac)) {
-                // Forward differences as in Hairer's code, against f(t, y) in `fy`.
-                analytic = false;
+            if !(self.analytic && system.jacobian(t, y, &mut self.jac)) {
+                self.analytic = false;
+                self.y_perturbed.copy_from_slice(y);
                 for j in 0..n {
                     let ysafe = y[j];
                     let delt = (UROUND * ysafe.abs().max(1e-5)).sqrt();
-                    y[j] = ysafe + delt;
-                    system.rhs(t, &y, &mut tmp);
+                    self.y_perturbed[j] = ysafe + delt;
+                    system.rhs(t, &self.y_perturbed, &mut self.tmp);
                     for i in 0..n {
-                        jac[i * n + j] = (tmp[i] - fy[i]) / delt;
+                        self.jac[i * n + j] = (self.tmp[i] - self.fy[i]) / delt;
                     }
-                    y[j] = ysafe;
+                    self.y_perturbed[j] = ysafe;
                 }
                 stats.rhs_calls += n as u64;
             }
-            fresh_jac = true;
-            need_jac = false;
-            need_lu = true;
+            self.fresh_jac = true;
+            self.need_jac = false;
+            self.need_lu = true;
         }
-        if need_lu {
-            fac1 = k.u1 / h;
-            alphn = k.alph / h;
-            betan = k.beta / h;
+        if self.need_lu {
+            self.fac1 = self.k.u1 / h;
+            self.alphn = self.k.alph / h;
+            self.betan = self.k.beta / h;
             stats.factorizations += 1;
-            singular = !(e1.factor_shifted(fac1, &jac) && e2.factor_shifted(alphn, betan, &jac));
-            need_lu = singular;
+            let singular = !(self.e1.factor_shifted(self.fac1, &self.jac)
+                && self.e2.factor_shifted(self.alphn, self.betan, &self.jac));
+            self.need_lu = singular;
+            return !singular;
         }
+        true
+    }
 
-        if let Err(f) = check_step(t, h, &stats, options) {
-            return report(Status::Failed(f), t, y, stats);
-        }
+    /// Simplified Newton iteration on the transformed stage equations.
+    fn newton<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Newton {
+        let n = y.len();
+        let k = &self.k;
         let t_new = t + h;
-
-        let outcome = if singular {
-            Newton::Failed
+        let [z1, z2, z3] = &mut self.z;
+        let [f1, f2, f3] = &mut self.f;
+        let tmp = &mut self.tmp;
+        if self.first {
+            for v in [&mut *z1, &mut *z2, &mut *z3, &mut *f1, &mut *f2, &mut *f3] {
+                v.fill(0.0);
+            }
         } else {
-            // Starting values: zero on the first step, else the last
-            // collocation polynomial extrapolated over the new step.
-            if first {
-                for v in [&mut z1, &mut z2, &mut z3, &mut f1, &mut f2, &mut f3] {
-                    v.fill(0.0);
-                }
-            } else {
-                let c3q = h / h_old;
-                let (c1q, c2q) = (k.c1 * c3q, k.c2 * c3q);
-                let [_, a1, a2, a3] = &dense.cont;
-                for i in 0..n {
-                    let ext = |q: f64| q * (a1[i] + (q - k.c2m1) * (a2[i] + (q - k.c1m1) * a3[i]));
-                    let (w1, w2, w3) = (ext(c1q), ext(c2q), ext(c3q));
-                    z1[i] = w1;
-                    z2[i] = w2;
-                    z3[i] = w3;
-                    f1[i] = TI11 * w1 + TI12 * w2 + TI13 * w3;
-                    f2[i] = TI21 * w1 + TI22 * w2 + TI23 * w3;
-                    f3[i] = TI31 * w1 + TI32 * w2 + TI33 * w3;
-                }
+            // Start from the previous step's collocation polynomial.
+            let c3q = h / self.h_old;
+            let (c1q, c2q) = (k.c1 * c3q, k.c2 * c3q);
+            let [_, a1, a2, a3] = &self.dense.cont;
+            for i in 0..n {
+                let ext = |q: f64| q * (a1[i] + (q - k.c2m1) * (a2[i] + (q - k.c1m1) * a3[i]));
+                let (w1, w2, w3) = (ext(c1q), ext(c2q), ext(c3q));
+                z1[i] = w1;
+                z2[i] = w2;
+                z3[i] = w3;
+                f1[i] = TI11 * w1 + TI12 * w2 + TI13 * w3;
+                f2[i] = TI21 * w1 + TI22 * w2 + TI23 * w3;
+                f3[i] = TI31 * w1 + TI32 * w2 + TI33 * w3;
             }
-            faccon = faccon.max(UROUND).powf(0.8);
-            theta = THET;
-            let mut newt = 0;
-            let (mut dyno_old, mut thq_old) = (1.0, 1.0);
-            loop {
-                if newt >= NIT {
-                    break Newton::Failed;
-                }
-                for (z, c) in [(&mut z1, k.c1), (&mut z2, k.c2)] {
-                    for i in 0..n {
-                        tmp[i] = y[i] + z[i];
-                    }
-                    system.rhs(t + c * h, &tmp, z);
-                }
+        }
+        self.faccon = self.faccon.max(UROUND).powf(0.8);
+        self.theta = THET;
+        let (fac1, alphn, betan) = (self.fac1, self.alphn, self.betan);
+        let mut newt = 0;
+        let (mut dyno_old, mut thq_old) = (1.0, 1.0);
+        loop {
+            if newt >= NIT {
+                break Newton::Failed;
+            }
+            for (z, c) in [(&mut *z1, k.c1), (&mut *z2, k.c2)] {
                 for i in 0..n {
-                    tmp[i] = y[i] + z3[i];
+                    tmp[i] = y[i] + z[i];
                 }
-                system.rhs(t_new, &tmp, &mut z3);
-                stats.rhs_calls += 3;
-                for i in 0..n {
-                    let (a1, a2, a3) = (z1[i], z2[i], z3[i]);
-                    let w1 = TI11 * a1 + TI12 * a2 + TI13 * a3;
-                    let w2 = TI21 * a1 + TI22 * a2 + TI23 * a3;
-                    let w3 = TI31 * a1 + TI32 * a2 + TI33 * a3;
-                    z1[i] = w1 - f1[i] * fac1;
-                    z2[i] = w2 - f2[i] * alphn + f3[i] * betan;
-                    z3[i] = w3 - f3[i] * alphn - f2[i] * betan;
-                }
-                e1.solve(&mut z1);
-                e2.solve(&mut z2, &mut z3);
-                newt += 1;
-                let dyno = {
-                    let s: f64 = (0..n)
-                        .map(|i| {
-                            let (a, b, c) = (z1[i] / scal[i], z2[i] / scal[i], z3[i] / scal[i]);
-                            a * a + b * b + c * c
-                        })
-                        .sum();
-                    (s / (3 * n) as f64).sqrt()
+                system.rhs(t + c * h, tmp, z);
+            }
+            for i in 0..n {
+                tmp[i] = y[i] + z3[i];
+            }
+            system.rhs(t_new, tmp, z3);
+            stats.rhs_calls += 3;
+            for i in 0..n {
+                let (a1, a2, a3) = (z1[i], z2[i], z3[i]);
+                let w1 = TI11 * a1 + TI12 * a2 + TI13 * a3;
+                let w2 = TI21 * a1 + TI22 * a2 + TI23 * a3;
+                let w3 = TI31 * a1 + TI32 * a2 + TI33 * a3;
+                z1[i] = w1 - f1[i] * fac1;
+                z2[i] = w2 - f2[i] * alphn + f3[i] * betan;
+                z3[i] = w3 - f3[i] * alphn - f2[i] * betan;
+            }
+            self.e1.solve(z1);
+            self.e2.solve(z2, z3);
+            newt += 1;
+            let dyno = {
+                let scal = &self.scal;
+                let s: f64 = (0..n)
+                    .map(|i| {
+                        let (a, b, c) = (z1[i] / scal[i], z2[i] / scal[i], z3[i] / scal[i]);
+                        a * a + b * b + c * c
+                    })
+                    .sum();
+                (s / (3 * n) as f64).sqrt()
+            };
+            if !dyno.is_finite() {
+                break Newton::Failed;
+            }
+            if newt > 1 && newt < NIT {
+                let thq = dyno / dyno_old;
+                self.theta = if newt == 2 {
+                    thq
+                } else {
+                    (thq * thq_old).sqrt()
                 };
-                if !dyno.is_finite() {
+                thq_old = thq;
+                if self.theta < 0.99 {
+                    self.faccon = self.theta / (1.0 - self.theta);
+                    let dyth = self.faccon * dyno * self.theta.powi(NIT - 1 - newt) / self.fnewt;
+                    if dyth >= 1.0 {
+                        let qnewt = dyth.clamp(1e-4, 20.0);
+                        break Newton::TooSlow(
+                            0.8 * qnewt.powf(-1.0 / f64::from(4 + NIT - 1 - newt)),
+                        );
+                    }
+                } else {
                     break Newton::Failed;
                 }
-                if newt > 1 && newt < NIT {
-                    let thq = dyno / dyno_old;
-                    theta = if newt == 2 {
-                        thq
-                    } else {
-                        (thq * thq_old).sqrt()
-                    };
-                    thq_old = thq;
-                    if theta < 0.99 {
-                        faccon = theta / (1.0 - theta);
-                        let dyth = faccon * dyno * theta.powi(NIT - 1 - newt) / fnewt;
-                        if dyth >= 1.0 {
-                            let qnewt = dyth.clamp(1e-4, 20.0);
-                            break Newton::TooSlow(
-                                0.8 * qnewt.powf(-1.0 / f64::from(4 + NIT - 1 - newt)),
-                            );
-                        }
-                    } else {
-                        break Newton::Failed;
-                    }
-                }
-                dyno_old = dyno.max(UROUND);
-                for i in 0..n {
-                    let w1 = f1[i] + z1[i];
-                    let w2 = f2[i] + z2[i];
-                    let w3 = f3[i] + z3[i];
-                    f1[i] = w1;
-                    f2[i] = w2;
-                    f3[i] = w3;
-                    z1[i] = T11 * w1 + T12 * w2 + T13 * w3;
-                    z2[i] = T21 * w1 + T22 * w2 + T23 * w3;
-                    z3[i] = T31 * w1 + w2;
-                }
-                if faccon * dyno <= fnewt {
-                    break Newton::Converged(newt);
-                }
             }
-        };
+            dyno_old = dyno.max(UROUND);
+            for i in 0..n {
+                let w1 = f1[i] + z1[i];
+                let w2 = f2[i] + z2[i];
+                let w3 = f3[i] + z3[i];
+                f1[i] = w1;
+                f2[i] = w2;
+                f3[i] = w3;
+                z1[i] = T11 * w1 + T12 * w2 + T13 * w3;
+                z2[i] = T21 * w1 + T22 * w2 + T23 * w3;
+                z3[i] = T31 * w1 + w2;
+            }
+            if self.faccon * dyno <= self.fnewt {
+                break Newton::Converged(newt);
+            }
+        }
+    }
 
+    /// A trial that failed before its error could be judged: halve h, and
+    /// give up after too many in a row.
+    fn retreat(&mut self, h: f64, failure: Failure) -> Trial {
+        self.newton_failures += 1;
+        if self.newton_failures >= MAX_NEWTON_FAILURES {
+            return Trial::Failed(failure);
+        }
+        self.mark_rejected();
+        Trial::Rejected { h_new: h * 0.5 }
+    }
+
+    fn mark_rejected(&mut self) {
+        self.reject = true;
+        self.need_lu = true;
+        self.need_jac = !self.fresh_jac;
+    }
+}
+
+impl Stepper for Radau5 {
+    const METHOD: Method = Method::Radau5;
+
+    fn new(n: usize, options: &SolverOptions) -> Self {
+        let k = Coeffs::new();
+        let zeros = || vec![0.0; n];
+        let rtol = 0.1 * options.rtol.powf(2.0 / 3.0);
+        let atol: Vec<f64> = options
+            .atol
+            .iter()
+            .map(|a| a * rtol / options.rtol)
+            .collect();
+        let fnewt = (10.0 * UROUND / rtol).max(0.03f64.min(rtol.sqrt()));
+        let dense = Dense {
+            t: 0.0,
+            h: 1.0,
+            c1m1: k.c1m1,
+            c2m1: k.c2m1,
+            cont: [zeros(), zeros(), zeros(), zeros()],
+        };
+        Radau5 {
+            k,
+            options: options.clone(),
+            rtol,
+            atol,
+            fnewt,
+            fy: zeros(),
+            scal: zeros(),
+            tmp: zeros(),
+            y_perturbed: zeros(),
+            z: [zeros(), zeros(), zeros()],
+            f: [zeros(), zeros(), zeros()],
+            jac: vec![0.0; n * n],
+            e1: RealLu::new(n),
+            e2: ComplexLu::new(n),
+            dense,
+            h_old: 0.0,
+            first: true,
+            reject: false,
+            faccon: 1.0,
+            theta: THET,
+            cfac: SAFE * f64::from(1 + 2 * NIT),
+            h_acc: 0.0,
+            err_acc: 1.0,
+            need_jac: true,
+            need_lu: true,
+            fresh_jac: false,
+            analytic: true,
+            newton_failures: 0,
+            accepted: 0,
+            fac1: 0.0,
+            alphn: 0.0,
+            betan: 0.0,
+        }
+    }
+
+    fn start<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64],
+        h_max: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, Failure> {
+        self.set_scal(y0);
+        system.rhs(t0, y0, &mut self.fy);
+        stats.rhs_calls += 1;
+        if self.fy.iter().any(|v| !v.is_finite()) {
+            return Err(Failure::NonFinite { t: t0 });
+        }
+        let h = match self.options.h0 {
+            Some(h0) => h0,
+            None => {
+                stats.rhs_calls += 1;
+                let inner = SolverOptions {
+                    rtol: self.rtol,
+                    atol: self.atol.clone(),
+                    ..self.options.clone()
+                };
+                let [z1, z2, _] = &mut self.z;
+                initial_step(system, t0, y0, &self.fy, 3, h_max, &inner, (z1, z2))
+            }
+        }
+        .min(h_max);
+        // The first step's interpolant is not used (the Newton start is
+        // zero), so h_old only has to be finite; the controller starts here.
+        self.h_old = h;
+        self.h_acc = h;
+        Ok(h)
+    }
+
+    fn end_stretch(&self) -> f64 {
+        // Hairer stretches only the first step; later ones are compared
+        // with t_end as they are (his quot1 = 1).
+        if self.first { 1.0001 } else { 1.0 }
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Trial {
+        let n = y.len();
+        let outcome = if self.prepare(system, t, y, h, stats) {
+            self.newton(system, t, y, h, stats)
+        } else {
+            Newton::Failed
+        };
         let newt = match outcome {
             Newton::Converged(newt) => newt,
             Newton::TooSlow(factor) => {
-                stats.rejected += 1;
-                h *= factor;
-                reject = true;
-                last = false;
-                need_lu = true;
-                need_jac = !fresh_jac;
-                continue;
+                self.mark_rejected();
+                return Trial::Rejected { h_new: h * factor };
             }
-            Newton::Failed => {
-                stats.rejected += 1;
-                newton_failures += 1;
-                if newton_failures >= MAX_NEWTON_FAILURES {
-                    return report(Status::Failed(Failure::NewtonFailure { t }), t, y, stats);
-                }
-                h *= 0.5;
-                reject = true;
-                last = false;
-                need_lu = true;
-                need_jac = !fresh_jac;
-                continue;
-            }
+            Newton::Failed => return self.retreat(h, Failure::NewtonFailure { t }),
         };
 
-        // Error estimate: the embedded 3rd-order difference, smoothed by
-        // (γ/h·I − J)⁻¹ so that it stays bounded for stiff components.
+        // The embedded error estimate, filtered through (γ/h·I − J)⁻¹.
+        let k = &self.k;
+        let [z1, z2, z3] = &self.z;
+        let [f1, f2, _] = &mut self.f;
+        let tmp = &mut self.tmp;
         let [d1, d2, d3] = [k.dd[0] / h, k.dd[1] / h, k.dd[2] / h];
         for i in 0..n {
             f2[i] = d1 * z1[i] + d2 * z2[i] + d3 * z3[i];
-            tmp[i] = f2[i] + fy[i];
+            tmp[i] = f2[i] + self.fy[i];
         }
-        e1.solve(&mut tmp);
-        let mut err = rms(&tmp, &scal);
-        if err >= 1.0 && err.is_finite() && (first || reject) {
-            // After a rejection the plain estimate can be far too pessimistic
-            // for stiff components: apply the filter once more (Hairer).
+        self.e1.solve(tmp);
+        let mut err = rms(tmp, &self.scal);
+        if err >= 1.0 && err.is_finite() && (self.first || self.reject) {
             for i in 0..n {
                 tmp[i] += y[i];
             }
-            system.rhs(t, &tmp, &mut f1);
+            system.rhs(t, tmp, f1);
             stats.rhs_calls += 1;
             for i in 0..n {
                 tmp[i] = f1[i] + f2[i];
             }
-            e1.solve(&mut tmp);
-            err = rms(&tmp, &scal);
+            self.e1.solve(tmp);
+            err = rms(tmp, &self.scal);
         }
         if !err.is_finite() {
-            stats.rejected += 1;
-            newton_failures += 1;
-            if newton_failures >= MAX_NEWTON_FAILURES {
-                return report(Status::Failed(Failure::NonFinite { t }), t, y, stats);
-            }
-            h *= 0.5;
-            reject = true;
-            last = false;
-            need_lu = true;
-            need_jac = !fresh_jac;
-            continue;
+            return self.retreat(h, Failure::NonFinite { t });
         }
         let err = err.max(1e-10);
-        let fac = SAFE.min(cfac / f64::from(newt + 2 * NIT));
+        let fac = SAFE.min(self.cfac / f64::from(newt + 2 * NIT));
         let mut quot = (err.powf(0.25) / fac).clamp(FACR, FACL);
         let mut h_new = h / quot;
 
         if err < 1.0 {
-            first = false;
-            newton_failures = 0;
-            stats.steps += 1;
-            if stats.steps > 1 {
+            self.first = false;
+            self.newton_failures = 0;
+            self.accepted += 1;
+            if self.accepted > 1 {
                 // Gustafsson's predictive controller.
-                let facgus = (h_acc / h) * (err * err / err_acc).powf(0.25) / SAFE;
+                let facgus = (self.h_acc / h) * (err * err / self.err_acc).powf(0.25) / SAFE;
                 quot = quot.max(facgus.clamp(FACR, FACL));
                 h_new = h / quot;
             }
-            h_acc = h;
-            err_acc = err.max(1e-2);
-            h_old = h;
-            let t_prev = t;
-            t = t_new;
-            {
-                let [c0, c1, c2, c3] = &mut dense.cont;
-                for i in 0..n {
-                    y[i] += z3[i];
-                    c0[i] = y[i];
-                    c1[i] = (z2[i] - z3[i]) / k.c2m1;
-                    let ak = (z1[i] - z2[i]) / k.c1mc2;
-                    let acont3 = (ak - z1[i] / k.c1) / k.c2;
-                    c2[i] = (ak - c1[i]) / k.c1m1;
-                    c3[i] = c2[i] - acont3;
-                }
-            }
-            dense.t = t;
-            dense.h = h;
-            if y.iter().any(|v| !v.is_finite()) {
-                return report(Status::Failed(Failure::NonFinite { t }), t, y, stats);
-            }
-            set_scal(&y, &mut scal);
-            let flow = observer.step(&Step {
-                t_prev,
-                t,
-                y: &y,
-                dense: &dense,
-            });
-            if flow == Flow::Stop {
-                return report(Status::Stopped, t, y, stats);
-            }
-            if last || t >= t_end {
-                return report(Status::Finished, t, y, stats);
-            }
-            fresh_jac = false;
-            system.rhs(t, &y, &mut fy);
-            stats.rhs_calls += 1;
-            if fy.iter().any(|v| !v.is_finite()) {
-                return report(Status::Failed(Failure::NonFinite { t }), t, y, stats);
-            }
-            h_new = h_new.min(h_max);
-            if reject {
-                h_new = h_new.min(h);
-            }
-            reject = false;
-            if t + h_new / QUOT1 >= t_end {
-                h = t_end - t;
-                last = true;
-            } else {
-                let qt = h_new / h;
-                if theta <= THET && (QUOT1..=QUOT2).contains(&qt) {
-                    // Same Jacobian and LU: h is kept as it is.
-                    continue;
-                }
-                h = h_new;
-            }
-            if theta <= THET {
-                need_lu = true;
-            } else {
-                need_jac = true;
-            }
+            self.h_acc = h;
+            self.err_acc = err.max(1e-2);
+            self.h_old = h;
+            Trial::Accepted { h_new }
         } else {
-            stats.rejected += 1;
-            reject = true;
-            last = false;
-            h = if first { h * 0.1 } else { h_new };
-            need_lu = true;
-            need_jac = !fresh_jac;
+            let h_new = if self.first { h * 0.1 } else { h_new };
+            self.mark_rejected();
+            Trial::Rejected { h_new }
         }
+    }
+
+    fn accept<S: OdeSystem + ?Sized>(
+        &mut self,
+        _system: &S,
+        t: f64,
+        h: f64,
+        y: &mut Vec<f64>,
+        _stats: &mut Stats,
+    ) -> Result<(), Failure> {
+        let k = &self.k;
+        let [z1, z2, z3] = &self.z;
+        let [c0, c1, c2, c3] = &mut self.dense.cont;
+        for i in 0..y.len() {
+            y[i] += z3[i];
+            c0[i] = y[i];
+            c1[i] = (z2[i] - z3[i]) / k.c2m1;
+            let ak = (z1[i] - z2[i]) / k.c1mc2;
+            let acont3 = (ak - z1[i] / k.c1) / k.c2;
+            c2[i] = (ak - c1[i]) / k.c1m1;
+            c3[i] = c2[i] - acont3;
+        }
+        let t_new = t + h;
+        self.dense.t = t_new;
+        self.dense.h = h;
+        if y.iter().any(|v| !v.is_finite()) {
+            return Err(Failure::NonFinite { t: t_new });
+        }
+        self.set_scal(y);
+        Ok(())
+    }
+
+    fn dense(&self) -> &dyn DenseOutput {
+        &self.dense
+    }
+
+    fn advance<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        stats: &mut Stats,
+    ) -> Result<(), Failure> {
+        self.fresh_jac = false;
+        system.rhs(t, y, &mut self.fy);
+        stats.rhs_calls += 1;
+        if self.fy.iter().any(|v| !v.is_finite()) {
+            return Err(Failure::NonFinite { t });
+        }
+        Ok(())
+    }
+
+    fn next_step(&mut self, h: f64, h_next: f64, reaches_end: bool) -> f64 {
+        self.reject = false;
+        // Keep h, and with it the factorisations, while Newton converges
+        // fast and the controller asks for a change within [QUOT1, QUOT2].
+        if !reaches_end && self.theta <= THET && (QUOT1..=QUOT2).contains(&(h_next / h)) {
+            return h;
+        }
+        if self.theta <= THET {
+            self.need_lu = true;
+        } else {
+            self.need_jac = true;
+        }
+        h_next
     }
 }
 

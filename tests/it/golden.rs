@@ -170,6 +170,11 @@ fn shipped_studies_and_scenes_are_bit_identical_to_the_golden_files() {
         let name = format!("scene-{}", path.file_stem().unwrap().to_string_lossy());
         check(&name, &scene_text(&path), &mut mismatches);
     }
+    // Scenes kept only for this check: paths the shipped ones do not take.
+    for path in shipped("tests/golden/cases") {
+        let name = format!("case-{}", path.file_stem().unwrap().to_string_lossy());
+        check(&name, &scene_text(&path), &mut mismatches);
+    }
     assert!(
         mismatches.is_empty(),
         "results changed (re-bless with AUTOBAL_BLESS=1 only if deliberate):\n{}",

@@ -1,0 +1,131 @@
+//! The one step loop every method runs in: step budget and step-size floor,
+//! the end of the interval, acceptance bookkeeping, the observer's dense
+//! output and early stop, and stiffness detection with the switch to the
+//! implicit method. A [`Stepper`] supplies only the method itself.
+
+use super::norm::check_step;
+use super::stepper::{Stepper, Trial};
+use super::{
+    Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step, StepObserver,
+};
+
+/// Hairer's stiffness counting (DOPRI5, DOP853): this many accepted steps
+/// held by stability in a row mean the problem is stiff ...
+const STIFF_STEPS: u32 = 15;
+/// ... unless this many steps held by accuracy come in between.
+const NON_STIFF_STEPS: u32 = 6;
+
+/// Run `St` from (t0, y0) towards t_end until it finishes, the observer
+/// stops it or it fails. The observer's `start` is the caller's business, so
+/// that a run can continue in a second segment with another stepper.
+pub(super) fn drive<St, S, O>(
+    system: &S,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    options: &SolverOptions,
+    observer: &mut O,
+) -> SolveReport
+where
+    St: Stepper,
+    S: OdeSystem + ?Sized,
+    O: StepObserver + ?Sized,
+{
+    let mut stepper = St::new(y0.len(), options);
+    let mut stats = Stats::default();
+    let mut y = y0.to_vec();
+    let h_max = options.h_max.min(t_end - t0);
+    let watch_stiffness = options.stiffness.is_watched();
+    let report = |status, t, y, stats| SolveReport {
+        status,
+        t,
+        y,
+        stats,
+        switched: None,
+    };
+
+    let mut h = match stepper.start(system, t0, &y, h_max, &mut stats) {
+        Ok(h) => h.min(h_max),
+        Err(f) => return report(Status::Failed(f), t0, y, stats),
+    };
+    let mut t = t0;
+    let mut last_rejected = false;
+    let (mut stiff_count, mut non_stiff_count) = (0u32, 0u32);
+
+    loop {
+        if let Err(f) = check_step(t, h, &stats, options) {
+            return report(Status::Failed(f), t, y, stats);
+        }
+        let last = t + stepper.end_stretch() * h >= t_end;
+        if last {
+            h = t_end - t;
+        }
+        let h_new = match stepper.attempt(system, t, &y, h, &mut stats) {
+            Trial::Failed(f) => return report(Status::Failed(f), t, y, stats),
+            Trial::Rejected { h_new } => {
+                stats.rejected += 1;
+                h = h_new;
+                last_rejected = true;
+                continue;
+            }
+            Trial::Accepted { h_new } => h_new,
+        };
+        stats.steps += 1;
+        if watch_stiffness {
+            if stepper.looks_stiff(h) {
+                non_stiff_count = 0;
+                stiff_count += 1;
+                if stiff_count == STIFF_STEPS {
+                    let f = Failure::StiffnessDetected { t };
+                    return report(Status::Failed(f), t, y, stats);
+                }
+            } else {
+                non_stiff_count += 1;
+                if non_stiff_count == NON_STIFF_STEPS {
+                    stiff_count = 0;
+                }
+            }
+        }
+        let t_prev = t;
+        let committed = stepper.accept(system, t, h, &mut y, &mut stats);
+        t = t_prev + h;
+        if let Err(f) = committed {
+            return report(Status::Failed(f), t, y, stats);
+        }
+        let flow = observer.step(&Step {
+            t_prev,
+            t,
+            y: &y,
+            dense: stepper.dense(),
+        });
+        if flow == Flow::Stop {
+            return report(Status::Stopped, t, y, stats);
+        }
+        if last || t >= t_end {
+            return report(Status::Finished, t, y, stats);
+        }
+        if let Err(f) = stepper.advance(system, t, &y, &mut stats) {
+            return report(Status::Failed(f), t, y, stats);
+        }
+        // A step right after a rejection does not grow (Hairer).
+        let mut h_next = h_new.min(h_max);
+        if last_rejected {
+            h_next = h_next.min(h);
+        }
+        last_rejected = false;
+        let reaches_end = t + stepper.end_stretch() * h_next >= t_end;
+        h = stepper.next_step(h, h_next, reaches_end);
+    }
+}
+
+/// Did an explicit segment stop in a way the implicit method can get past?
+pub(super) fn stalled(status: &Status) -> bool {
+    matches!(
+        status,
+        Status::Failed(
+            Failure::StiffnessDetected { .. }
+                | Failure::TooManySteps { .. }
+                | Failure::StepSizeUnderflow { .. }
+        )
+    )
+}
