@@ -660,6 +660,66 @@ fn stiff_over_damped_mode_needs_few_implicit_steps() {
     );
 }
 
+/// The driver's stiffness handling works for every explicit stepper: on the
+/// over-damped mode (fast eigenvalue ≈ −1000), `Stop` ends the run with
+/// `StiffnessDetected` early on, and `SwitchToImplicit` hands over to Radau5
+/// and still meets the exact solution, at a small fraction of the explicit
+/// method's work.
+#[test]
+fn every_explicit_stepper_detects_stiffness_and_hands_over() {
+    use autobal::integrate::Stiffness;
+    let t_end = 1000.0;
+    for method in [Method::Dp5, Method::Dop853] {
+        let stop = SolverOptions {
+            stiffness: Stiffness::Stop,
+            ..options(1e-6, 1e-8)
+        };
+        let stopped = solve(
+            method,
+            &OVER_DAMPED,
+            0.0,
+            &[1.0, 0.0],
+            t_end,
+            &stop,
+            &mut NoObserver,
+        );
+        match stopped.status {
+            Status::Failed(Failure::StiffnessDetected { t }) => {
+                assert!(t < 1.0, "{method:?} noticed only at t = {t}")
+            }
+            ref other => panic!("{method:?}: {other:?}"),
+        }
+        assert!(stopped.switched.is_none());
+
+        let switch = SolverOptions {
+            stiffness: Stiffness::SwitchToImplicit,
+            ..options(1e-6, 1e-8)
+        };
+        let handed = run(method, &OVER_DAMPED, &[1.0, 0.0], t_end, &switch);
+        assert_eq!(handed.status, Status::Finished, "{method:?}");
+        let e = error_at(over_damped_exact, t_end, &handed.y);
+        assert!(e < 1e-6, "{method:?}: error {e}");
+        let switch_info = handed.switched.as_ref().expect("a hand-over");
+        assert_eq!(switch_info.from, method);
+        assert!(matches!(switch_info.why, Failure::StiffnessDetected { .. }));
+        // The totals include the explicit segment's work.
+        assert!(handed.stats.steps > switch_info.before.steps);
+        let crawling = run(
+            method,
+            &OVER_DAMPED,
+            &[1.0, 0.0],
+            t_end,
+            &options(1e-6, 1e-8),
+        );
+        assert!(
+            100 * handed.stats.rhs_calls < crawling.stats.rhs_calls,
+            "{method:?}: {:?} vs {:?}",
+            handed.stats,
+            crawling.stats
+        );
+    }
+}
+
 /// Damping up to 1e12 over ten slow time constants: Radau5's step count
 /// stays flat as the fast eigenvalue grows (L-stability), and the slow mode
 /// stays within the absolute tolerance.
