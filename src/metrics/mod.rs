@@ -129,3 +129,33 @@ pub struct RunMetrics {
     /// Formulation that produced it ("rotating", "full", "analytic").
     pub fidelity: String,
 }
+
+impl RunMetrics {
+    /// Metrics of a run that was not integrated (a closed-form estimate, or
+    /// a run that could not be simulated at all): nothing settled, no
+    /// residual, no work; estimates fill in what they know.
+    pub fn not_integrated(a_ref: f64, outcome: Outcome, reason: String, method: &str) -> Self {
+        RunMetrics {
+            settled: false,
+            settling_time: None,
+            settling_revs: None,
+            settling_time_err: 0.0,
+            settling_time_eps: None,
+            hold_complete: false,
+            residual_abs: 0.0,
+            residual_rel: 0.0,
+            a_ref,
+            balancing_error: 0.0,
+            peak_r: 0.0,
+            final_rel_angles_deg: Vec::new(),
+            p_final: 0.0,
+            outcome,
+            reason,
+            t_final: 0.0,
+            steps: 0,
+            rhs_calls: 0,
+            method: method.to_string(),
+            fidelity: String::new(),
+        }
+    }
+}

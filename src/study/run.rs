@@ -231,28 +231,7 @@ pub fn run_design_sample(
 
 /// Metrics of a run that could not be simulated at all.
 fn failed(reason: String) -> RunMetrics {
-    RunMetrics {
-        settled: false,
-        settling_time: None,
-        settling_revs: None,
-        settling_time_err: 0.0,
-        settling_time_eps: None,
-        hold_complete: false,
-        residual_abs: 0.0,
-        residual_rel: 0.0,
-        a_ref: 0.0,
-        balancing_error: 0.0,
-        peak_r: 0.0,
-        final_rel_angles_deg: Vec::new(),
-        p_final: 0.0,
-        outcome: Outcome::SolverFailed,
-        reason,
-        t_final: 0.0,
-        steps: 0,
-        rhs_calls: 0,
-        method: String::new(),
-        fidelity: String::new(),
-    }
+    RunMetrics::not_integrated(0.0, Outcome::SolverFailed, reason, "")
 }
 
 /// Label stored in provenance: "all" or "k/N".

@@ -1,0 +1,134 @@
+//! One run: a scene, its initial state, a solver and the metric definitions,
+//! built, integrated, observed and measured. This is the executor for a
+//! single simulation; the study runner fans many of them out over threads.
+//!
+//! - [`settings`]: the solver settings a run asks for;
+//! - [`estimate`]: the closed-form and linear rungs of the fidelity ladder.
+
+mod estimate;
+pub mod settings;
+
+pub use settings::{Fidelity, MethodChoice, SolverSettings, scaled_atol};
+
+use crate::integrate::{Method, OdeSystem, SolverOptions, Stiffness, solve};
+use crate::metrics::observer::{Series, SettlingObserver};
+use crate::metrics::{MetricOptions, RunMetrics};
+use crate::model::frame::{RotatingSystem, rotating_frame_obstacle};
+use crate::model::scene::{Scene, SceneError};
+use crate::model::start::{StartMode, initial_state};
+use crate::model::system::RotorSystem;
+use std::f64::consts::PI;
+
+/// Everything that defines one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Simulation {
+    /// The physics.
+    pub scene: Scene,
+    /// How the run starts.
+    pub start: StartMode,
+    /// Initial cargo angles relative to the rotor (rad).
+    pub initial_angles: Vec<f64>,
+    /// Integrator settings.
+    pub solver: SolverSettings,
+    /// Metric definitions.
+    pub metrics: MetricOptions,
+}
+
+/// The result of one run.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    /// Every metric.
+    pub metrics: RunMetrics,
+    /// The sampled time history, when requested.
+    pub series: Option<Series>,
+}
+
+impl Simulation {
+    /// The fidelity this run uses (`auto` resolved against the scene).
+    pub fn resolved_fidelity(&self) -> Fidelity {
+        match self.solver.fidelity {
+            Fidelity::Auto if rotating_frame_obstacle(&self.scene).is_none() => Fidelity::Rotating,
+            Fidelity::Auto => Fidelity::Full,
+            f => f,
+        }
+    }
+
+    /// Build, integrate and measure the run; `record` keeps the sampled series.
+    pub fn run(&self, record: bool) -> Result<RunResult, SceneError> {
+        let system = self.scene.build()?;
+        let n = system.cargo().len();
+        if self.initial_angles.len() != n {
+            return Err(SceneError::Invalid {
+                field: "start.angles_deg".into(),
+                value: format!("{} angles", self.initial_angles.len()),
+                reason: format!("the balancer has {n} cargoes"),
+            });
+        }
+        let omega = self.scene.speed.nominal_speed();
+        let y0 = initial_state(&system, self.start, &self.initial_angles);
+        let fidelity = self.resolved_fidelity();
+        let (mut metrics, series) = match fidelity {
+            Fidelity::Analytic => (self.analytic(&system, omega), None),
+            Fidelity::Linear => (self.linear(&system, &y0, omega), None),
+            Fidelity::Rotating => {
+                let rotating = RotatingSystem::new(&self.scene)?;
+                let nq = system.layout().nq();
+                let [u, ud, v, vd] = rotating.from_inertial(0.0, y0[0], y0[nq], y0[1], y0[nq + 1]);
+                let mut z0 = y0.clone();
+                (z0[0], z0[1], z0[nq], z0[nq + 1]) = (u, v, ud, vd);
+                self.integrate(&rotating, &system, &z0, Some(omega), record)
+            }
+            Fidelity::Full | Fidelity::Auto => self.integrate(&system, &system, &y0, None, record),
+        };
+        metrics.fidelity = fidelity.name().to_string();
+        Ok(RunResult { metrics, series })
+    }
+
+    /// Integrate `ode` (whose state has the layout of `system`), switching to
+    /// Radau5 when an explicit method stalls; `frame` is ω for the rotating frame.
+    fn integrate<S: OdeSystem>(
+        &self,
+        ode: &S,
+        system: &RotorSystem,
+        y0: &[f64],
+        frame: Option<f64>,
+        record: bool,
+    ) -> (RunMetrics, Option<Series>) {
+        let omega = self.scene.speed.nominal_speed();
+        let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
+        let method = self.solver.method.resolve(frame.is_some());
+        let explicit = method != Method::Radau5;
+        let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);
+        if let Some(w) = frame {
+            observer = observer.in_rotating_frame(w);
+        }
+        let options = SolverOptions {
+            rtol: self.solver.rtol,
+            atol: scaled_atol(system, self.solver.atol, observer.a_ref(), omega),
+            h0: None,
+            h_max: f64::INFINITY,
+            max_steps: self.solver.max_steps,
+            stiffness: if explicit && self.solver.implicit_fallback {
+                Stiffness::SwitchToImplicit
+            } else {
+                Stiffness::Ignore
+            },
+        };
+        let report = solve(method, ode, 0.0, y0, t_end, &options, &mut observer);
+        let (mut metrics, series) = observer.finish(&report);
+        metrics.method = method.name().to_string();
+        if let Some(switch) = &report.switched {
+            metrics.method = format!("{}→{}", switch.from.name(), Method::Radau5.name());
+            metrics.reason = format!(
+                "{} (switched to radau5 at t = {:.4}: {})",
+                metrics.reason, switch.t, switch.why
+            );
+        }
+        (metrics, series)
+    }
+}
+
+/// n angles evenly spaced around the race (a regular polygon: p = 0 and no net unbalance).
+pub fn evenly_spaced(n: usize) -> Vec<f64> {
+    (0..n).map(|j| 2.0 * PI * j as f64 / n as f64).collect()
+}
