@@ -17,8 +17,9 @@
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
 use super::rotor::RotorModel;
-use super::scene::{Scene, SceneError};
+use super::scene::Scene;
 use super::speed::SpeedLaw;
+use super::validate::SceneError;
 use crate::integrate::OdeSystem;
 
 /// Why a scene cannot use the rotating frame.

@@ -10,6 +10,7 @@
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
 //! - [`linear`]: linear stability of the balanced state (rotating frame).
+//! - [`validate`]: why a scene is rejected (a leaf every layer may use).
 //! - [`zero_approx`]: seed 003's empirical criterion for any rotor model.
 
 pub mod balancer;
@@ -25,4 +26,5 @@ pub mod scene;
 pub mod speed;
 pub mod start;
 pub mod system;
+pub mod validate;
 pub mod zero_approx;

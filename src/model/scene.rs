@@ -7,9 +7,13 @@ use super::effect::Effects;
 use super::rotor::RotorModel;
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
+use super::validate::{invalid, non_negative, positive};
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
 use serde::{Deserialize, Serialize};
+
+/// Re-exported where it was first defined: most of the crate names it here.
+pub use super::validate::SceneError;
 
 /// Everything that defines the physics of one simulation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -96,60 +100,6 @@ impl DesignSpec {
             roller_height: self.roller_height,
             drag: self.drag,
         })
-    }
-}
-
-/// A scene that cannot be built, naming the field and the reason.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SceneError {
-    /// A field has a value outside its domain.
-    #[error("{field} = {value}: {reason}")]
-    Invalid {
-        /// Dotted path of the field, e.g. `rotor.kx`.
-        field: String,
-        /// The offending value.
-        value: String,
-        /// Why it is rejected.
-        reason: String,
-    },
-    /// The balancer design is outside the design theory's domain.
-    #[error("balancer: {0}")]
-    Design(#[from] DesignError),
-}
-
-/// A [`SceneError::Invalid`] for a numeric field.
-pub(crate) fn invalid(field: &str, value: f64, reason: &str) -> SceneError {
-    SceneError::Invalid {
-        field: field.to_string(),
-        value: value.to_string(),
-        reason: reason.to_string(),
-    }
-}
-
-/// Require a positive, finite value.
-pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(field, value, "must be positive and finite"))
-    }
-}
-
-/// Require a finite value.
-pub(crate) fn finite(field: &str, value: f64) -> Result<(), SceneError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(invalid(field, value, "must be finite"))
-    }
-}
-
-/// Require a non-negative, finite value.
-pub(crate) fn non_negative(field: &str, value: f64) -> Result<(), SceneError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(field, value, "must be zero or positive and finite"))
     }
 }
 

@@ -20,7 +20,7 @@
 //! out, about m R²/J = 4 m/M of the tilt inertia.
 
 use super::{DofVec, MAX_DOF, Rotor};
-use crate::model::scene::{SceneError, finite, non_negative, positive};
+use crate::model::validate::{SceneError, finite, non_negative, positive};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the flexible rotor (SI or dimensionless).

@@ -103,7 +103,7 @@ impl RotorModel {
     }
 
     /// Check every parameter (field names prefixed `rotor.`).
-    pub fn validate(&self) -> Result<(), crate::model::scene::SceneError> {
+    pub fn validate(&self) -> Result<(), crate::model::validate::SceneError> {
         match self {
             RotorModel::Plane(r) => r.validate(),
             RotorModel::TwoSupport(r) => r.validate(),

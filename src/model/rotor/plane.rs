@@ -3,7 +3,7 @@
 //! shaft centre. Coordinates x, y of the shaft centre from static equilibrium.
 
 use super::{DofVec, MAX_DOF, Rotor};
-use crate::model::scene::{SceneError, invalid, non_negative, positive};
+use crate::model::validate::{SceneError, invalid, non_negative, positive};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the plane rotor (any consistent units, SI in study files).

@@ -24,7 +24,7 @@
 //! unbalances s at z and angle θ, or directly as |S|, arg S, |I|, arg I.
 
 use super::{DofVec, MAX_DOF, Rotor};
-use crate::model::scene::{SceneError, finite, invalid, non_negative, positive};
+use crate::model::validate::{SceneError, finite, invalid, non_negative, positive};
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
