@@ -33,15 +33,7 @@ pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
     if !matches!(scene.speed, SpeedLaw::Constant { .. }) {
         return Some("the speed is not constant");
     }
-    if scene
-        .effects
-        .gravity
-        .as_ref()
-        .is_some_and(|g| g.in_plane() != 0.0)
-    {
-        return Some("gravity in the plane turns in the rotating frame");
-    }
-    None
+    scene.effects.rotating_frame_obstacle()
 }
 
 /// The plane rotor with cargoes in the rotor-fixed frame, as an [`OdeSystem`].
@@ -96,6 +88,13 @@ impl RotatingSystem {
         })
     }
 
+    /// The same system with one more effect, applied after the built ones
+    /// (as [`super::system::RotorSystem::with_effect`]).
+    pub fn with_effect(mut self, effect: Box<dyn Effect>) -> Self {
+        self.effects.push(effect);
+        self
+    }
+
     /// The constant spin speed ω.
     pub fn omega(&self) -> f64 {
         self.omega
@@ -137,9 +136,9 @@ impl OdeSystem for RotatingSystem {
         let psi = &q[2..];
         let psi_rate = &qd[2..];
         let cargo_f = &mut dydt[nq + 2..];
-        for (j, c) in self.cargo.iter().enumerate() {
-            cargo_f[j] = -c.drag * c.track_radius * c.track_radius * psi_rate[j];
-        }
+        // −0.0 is the exact additive identity: the effects' terms (drag's
+        // first) land bit for bit as when drag assigned them directly.
+        cargo_f.fill(-0.0);
         if !self.effects.is_empty() {
             let ctx = EffectContext {
                 t,
@@ -151,7 +150,8 @@ impl OdeSystem for RotatingSystem {
                 psi_rate,
                 rotor_unbalance: self.rotor_unbalance,
             };
-            let (mut rotor_f, mut spin_f) = ([0.0; super::rotor::MAX_DOF], 0.0);
+            // −0.0 again: adding an untouched rotor force leaves G exactly as it was.
+            let (mut rotor_f, mut spin_f) = ([-0.0; super::rotor::MAX_DOF], 0.0);
             let mut forces = Forces {
                 rotor: &mut rotor_f,
                 spin: &mut spin_f,

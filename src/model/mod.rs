@@ -4,7 +4,7 @@
 //! - [`scene::Scene`]: a plain, serialisable description of one simulation.
 //! - [`rotor`]: rotor models (one file each) behind the [`rotor::Rotor`] trait.
 //! - [`balancer`]: ball, roller and pendulum kinds (one file each).
-//! - [`effect`]: optional effects such as gravity (one file each).
+//! - [`effect`]: drag, gravity, contact … (one file each, one registry line).
 //! - [`system::RotorSystem`]: the assembled equations (O(n) per call).
 //! - [`forced`]: steady forced response with the cargoes locked.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).

@@ -151,16 +151,7 @@ impl Scene {
             }
             SpeedLaw::Free { omega_start } => non_negative("speed.omega_start", *omega_start)?,
         }
-        if let Some(g) = &self.effects.gravity {
-            non_negative("effects.gravity.g", g.g)?;
-            if !(-90.0..=90.0).contains(&g.axis_inclination_deg) {
-                return Err(invalid(
-                    "effects.gravity.axis_inclination_deg",
-                    g.axis_inclination_deg,
-                    "must lie in [-90, 90] degrees",
-                ));
-            }
-        }
+        self.effects.validate()?;
         let designs: Vec<(String, &DesignSpec)> = self
             .balancer
             .iter()
