@@ -16,7 +16,7 @@
 
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
-use super::rotor::RotorModel;
+use super::rotor::PlaneRotor;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
@@ -24,7 +24,7 @@ use crate::integrate::OdeSystem;
 
 /// Why a scene cannot use the rotating frame.
 pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
-    let RotorModel::Plane(r) = &scene.rotor else {
+    let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
         return Some("only the plane rotor has a rotating-frame formulation");
     };
     if r.kx != r.ky || r.bx != r.by {
@@ -69,7 +69,7 @@ impl RotatingSystem {
             unreachable!("checked above")
         };
         let cargo = scene.cargoes()?;
-        let RotorModel::Plane(r) = &scene.rotor else {
+        let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
             unreachable!("checked above")
         };
         let me = r.mass * r.eccentricity;
