@@ -83,7 +83,7 @@ fn rhs_with_gravity_never_allocates() {
         axis_inclination_deg: 0.0,
     });
     let system = scene.build().unwrap();
-    assert_eq!(system.effect_names(), ["gravity"]);
+    assert_eq!(system.effect_names(), ["drag", "gravity"]);
     let y = initial_state(&system, StartMode::LockedSteady, &[0.1, 0.2, 0.3]);
     let mut dydt = vec![0.0; y.len()];
     let count = allocations_during(|| {

@@ -5,6 +5,7 @@ use super::{ClaimsOutput, DesignResult};
 use crate::design::geometry::{rho_half_race, sector_angle};
 use crate::design::optimum::optimal_rho;
 use crate::model::balancer::Kind;
+use crate::model::rotor::{PlaneRotor, RotorModel};
 use crate::study::config::StudyPlan;
 use std::fmt::Write;
 
@@ -42,15 +43,13 @@ fn design_table(out: &mut String, rows: &[&DesignResult]) {
 }
 
 /// One line describing the rotor of the study.
-fn rotor_description(rotor: &crate::model::rotor::RotorModel) -> String {
-    match rotor {
-        crate::model::rotor::RotorModel::Plane(r) => {
-            format!(
-                "plane, M = {} kg, k = {:.3e} N/m, b = {} N·s/m",
-                r.mass, r.kx, r.bx
-            )
-        }
-        other => other.name().to_string(),
+fn rotor_description(rotor: &RotorModel) -> String {
+    match rotor.downcast_ref::<PlaneRotor>() {
+        Some(r) => format!(
+            "plane, M = {} kg, k = {:.3e} N/m, b = {} N·s/m",
+            r.mass, r.kx, r.bx
+        ),
+        None => rotor.name().to_string(),
     }
 }
 

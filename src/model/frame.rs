@@ -16,14 +16,15 @@
 
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
-use super::rotor::RotorModel;
-use super::scene::{Scene, SceneError};
+use super::rotor::PlaneRotor;
+use super::scene::Scene;
 use super::speed::SpeedLaw;
+use super::validate::SceneError;
 use crate::integrate::OdeSystem;
 
 /// Why a scene cannot use the rotating frame.
 pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
-    let RotorModel::Plane(r) = &scene.rotor else {
+    let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
         return Some("only the plane rotor has a rotating-frame formulation");
     };
     if r.kx != r.ky || r.bx != r.by {
@@ -32,15 +33,7 @@ pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
     if !matches!(scene.speed, SpeedLaw::Constant { .. }) {
         return Some("the speed is not constant");
     }
-    if scene
-        .effects
-        .gravity
-        .as_ref()
-        .is_some_and(|g| g.in_plane() != 0.0)
-    {
-        return Some("gravity in the plane turns in the rotating frame");
-    }
-    None
+    scene.effects.rotating_frame_obstacle()
 }
 
 /// The plane rotor with cargoes in the rotor-fixed frame, as an [`OdeSystem`].
@@ -76,7 +69,7 @@ impl RotatingSystem {
             unreachable!("checked above")
         };
         let cargo = scene.cargoes()?;
-        let RotorModel::Plane(r) = &scene.rotor else {
+        let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
             unreachable!("checked above")
         };
         let me = r.mass * r.eccentricity;
@@ -93,6 +86,13 @@ impl RotatingSystem {
             effects,
             rotor_unbalance: (me, r.unbalance_angle),
         })
+    }
+
+    /// The same system with one more effect, applied after the built ones
+    /// (as [`super::system::RotorSystem::with_effect`]).
+    pub fn with_effect(mut self, effect: Box<dyn Effect>) -> Self {
+        self.effects.push(effect);
+        self
     }
 
     /// The constant spin speed ω.
@@ -136,9 +136,9 @@ impl OdeSystem for RotatingSystem {
         let psi = &q[2..];
         let psi_rate = &qd[2..];
         let cargo_f = &mut dydt[nq + 2..];
-        for (j, c) in self.cargo.iter().enumerate() {
-            cargo_f[j] = -c.drag * c.track_radius * c.track_radius * psi_rate[j];
-        }
+        // −0.0 is the exact additive identity: the effects' terms (drag's
+        // first) land bit for bit as when drag assigned them directly.
+        cargo_f.fill(-0.0);
         if !self.effects.is_empty() {
             let ctx = EffectContext {
                 t,
@@ -150,7 +150,8 @@ impl OdeSystem for RotatingSystem {
                 psi_rate,
                 rotor_unbalance: self.rotor_unbalance,
             };
-            let (mut rotor_f, mut spin_f) = ([0.0; super::rotor::MAX_DOF], 0.0);
+            // −0.0 again: adding an untouched rotor force leaves G exactly as it was.
+            let (mut rotor_f, mut spin_f) = ([-0.0; super::rotor::MAX_DOF], 0.0);
             let mut forces = Forces {
                 rotor: &mut rotor_f,
                 spin: &mut spin_f,

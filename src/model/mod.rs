@@ -4,12 +4,13 @@
 //! - [`scene::Scene`]: a plain, serialisable description of one simulation.
 //! - [`rotor`]: rotor models (one file each) behind the [`rotor::Rotor`] trait.
 //! - [`balancer`]: ball, roller and pendulum kinds (one file each).
-//! - [`effect`]: optional effects such as gravity (one file each).
+//! - [`effect`]: drag, gravity, contact … (one file each, one registry line).
 //! - [`system::RotorSystem`]: the assembled equations (O(n) per call).
 //! - [`forced`]: steady forced response with the cargoes locked.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
 //! - [`linear`]: linear stability of the balanced state (rotating frame).
+//! - [`validate`]: why a scene is rejected (a leaf every layer may use).
 //! - [`zero_approx`]: seed 003's empirical criterion for any rotor model.
 
 pub mod balancer;
@@ -25,4 +26,5 @@ pub mod scene;
 pub mod speed;
 pub mod start;
 pub mod system;
+pub mod validate;
 pub mod zero_approx;

@@ -13,7 +13,7 @@
 //! overdamped limit, λ ≈ −(1 − p) m n b_cr²/(4 b̃). The n − 2 zero roots are
 //! the neutral family of balanced positions.
 
-use super::rotor::RotorModel;
+use super::rotor::PlaneRotor;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::start::balanced_fan;
@@ -65,7 +65,7 @@ pub fn slow_mode(scene: &Scene) -> Result<SlowMode, AnalyticError> {
     if first.drag <= 0.0 {
         return Err(AnalyticError::NoDrag);
     }
-    let RotorModel::Plane(r) = &scene.rotor else {
+    let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
         return Err(AnalyticError::NotPlane);
     };
     let m_total = r.mass + cargo.iter().map(|c| c.mass).sum::<f64>();

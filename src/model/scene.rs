@@ -7,9 +7,13 @@ use super::effect::Effects;
 use super::rotor::RotorModel;
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
+use super::validate::{invalid, non_negative, positive};
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
 use serde::{Deserialize, Serialize};
+
+/// Re-exported where it was first defined: most of the crate names it here.
+pub use super::validate::SceneError;
 
 /// Everything that defines the physics of one simulation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -99,60 +103,6 @@ impl DesignSpec {
     }
 }
 
-/// A scene that cannot be built, naming the field and the reason.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SceneError {
-    /// A field has a value outside its domain.
-    #[error("{field} = {value}: {reason}")]
-    Invalid {
-        /// Dotted path of the field, e.g. `rotor.kx`.
-        field: String,
-        /// The offending value.
-        value: String,
-        /// Why it is rejected.
-        reason: String,
-    },
-    /// The balancer design is outside the design theory's domain.
-    #[error("balancer: {0}")]
-    Design(#[from] DesignError),
-}
-
-/// A [`SceneError::Invalid`] for a numeric field.
-pub(crate) fn invalid(field: &str, value: f64, reason: &str) -> SceneError {
-    SceneError::Invalid {
-        field: field.to_string(),
-        value: value.to_string(),
-        reason: reason.to_string(),
-    }
-}
-
-/// Require a positive, finite value.
-pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(field, value, "must be positive and finite"))
-    }
-}
-
-/// Require a finite value.
-pub(crate) fn finite(field: &str, value: f64) -> Result<(), SceneError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(invalid(field, value, "must be finite"))
-    }
-}
-
-/// Require a non-negative, finite value.
-pub(crate) fn non_negative(field: &str, value: f64) -> Result<(), SceneError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(field, value, "must be zero or positive and finite"))
-    }
-}
-
 /// A balancer plane index must name one of the rotor's planes.
 fn check_plane(field: &str, plane: usize, rotor: &RotorModel) -> Result<(), SceneError> {
     let planes = rotor.as_rotor().planes();
@@ -201,16 +151,7 @@ impl Scene {
             }
             SpeedLaw::Free { omega_start } => non_negative("speed.omega_start", *omega_start)?,
         }
-        if let Some(g) = &self.effects.gravity {
-            non_negative("effects.gravity.g", g.g)?;
-            if !(-90.0..=90.0).contains(&g.axis_inclination_deg) {
-                return Err(invalid(
-                    "effects.gravity.axis_inclination_deg",
-                    g.axis_inclination_deg,
-                    "must lie in [-90, 90] degrees",
-                ));
-            }
-        }
+        self.effects.validate()?;
         let designs: Vec<(String, &DesignSpec)> = self
             .balancer
             .iter()

@@ -70,6 +70,8 @@ pub struct RotorSystem {
     head_mass: [DofVec; MAX_DOF],
     /// J_P plus the rolling inertia of balls and rollers.
     spin_inertia: f64,
+    /// The rotor's static unbalance, cached for the effects (constant).
+    rotor_unbalance: (f64, f64),
 }
 
 impl RotorSystem {
@@ -100,6 +102,7 @@ impl RotorSystem {
         };
         RotorSystem {
             inertia: cargo.iter().map(Cargo::inertia).collect(),
+            rotor_unbalance: rotor.static_unbalance(),
             rotor,
             cargo,
             plane_maps,
@@ -109,6 +112,13 @@ impl RotorSystem {
             head_mass,
             spin_inertia,
         }
+    }
+
+    /// The same system with one more effect, applied after the built ones:
+    /// how code outside the scene format (a test, an experiment) adds physics.
+    pub fn with_effect(mut self, effect: Box<dyn Effect>) -> Self {
+        self.effects.push(effect);
+        self
     }
 
     /// Where each coordinate lives in the state.
@@ -185,11 +195,10 @@ impl OdeSystem for RotorSystem {
         self.rotor.unbalance_forces(phi, spin_rate, &mut rotor_f);
         let mut spin_f = self.speed.torque(spin_rate);
         let cargo_f = &mut dydt[nq + head..];
-        for (j, c) in self.cargo.iter().enumerate() {
-            let drag = c.drag * c.track_radius * c.track_radius * psi_rate[j];
-            cargo_f[j] = -drag;
-            spin_f += drag;
-        }
+        // −0.0, not 0.0: it is the exact additive identity (−0.0 − x is −x
+        // bit for bit, sign of zero included), so the first effect's terms
+        // land unchanged, as when drag used to assign them directly.
+        cargo_f.fill(-0.0);
         if !self.effects.is_empty() {
             let ctx = EffectContext {
                 t,
@@ -199,7 +208,7 @@ impl OdeSystem for RotorSystem {
                 cargo: &self.cargo,
                 psi,
                 psi_rate,
-                rotor_unbalance: self.rotor.static_unbalance(),
+                rotor_unbalance: self.rotor_unbalance,
             };
             let mut forces = Forces {
                 rotor: &mut rotor_f,

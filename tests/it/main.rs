@@ -23,4 +23,5 @@ mod study_input;
 mod study_runner;
 mod study_summary;
 mod study_sweep;
+mod toy_effect;
 mod tradeoff;

@@ -6,7 +6,7 @@ use autobal::design::criterion::{
     RotorShape, SpeedRanges, dynamic_ranges, extra_speed, partial_frequencies, resonances,
     static_ranges, z_max,
 };
-use autobal::model::rotor::RotorModel;
+use autobal::model::rotor::{RotorParams, TwoSupportRotor};
 use autobal::scene_file::SceneFile;
 use clap::Args;
 use serde::Serialize;
@@ -51,7 +51,7 @@ struct Report {
 pub fn run(args: &CriterionArgs) -> Result<(), UserError> {
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
-    let RotorModel::TwoSupport(rotor) = &file.rotor else {
+    let Some(rotor) = file.rotor.downcast_ref::<TwoSupportRotor>() else {
         return Err(UserError(
             format!(
                 "{shown}: the closed-form criterion is for `model = \"two_support\"` (this is \"{}\"); `study sweep` computes it for any rotor",

@@ -10,7 +10,7 @@
 //! Pairs are checked exhaustively: O(n²), fine for the n ≤ 64 of a balancer,
 //! and only when a scene asks for contact.
 
-use super::{Effect, EffectContext, Forces};
+use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
@@ -41,6 +41,12 @@ impl Default for ContactSpec {
             frequency_ratio: default_ratio(),
             damping_ratio: default_damping(),
         }
+    }
+}
+
+impl EffectSpec for ContactSpec {
+    fn build(&self, cargo: &[Cargo], omega: f64) -> Option<Box<dyn Effect>> {
+        Contact::new(self, cargo, omega).map(|c| Box::new(c) as Box<dyn Effect>)
     }
 }
 

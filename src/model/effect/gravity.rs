@@ -3,7 +3,9 @@
 //! the static equilibrium, so only the cargoes and, at variable speed, the
 //! rotor's own unbalance feel it.
 
-use super::{Effect, EffectContext, Forces};
+use super::{Effect, EffectContext, EffectSpec, Forces};
+use crate::model::cargo::Cargo;
+use crate::model::validate::{SceneError, invalid, non_negative};
 use serde::{Deserialize, Serialize};
 
 /// Gravity acting along −Y in the rotor plane.
@@ -31,6 +33,28 @@ impl Gravity {
         } else {
             self.g * self.axis_inclination_deg.to_radians().cos()
         }
+    }
+}
+
+impl EffectSpec for Gravity {
+    fn validate(&self, key: &str) -> Result<(), SceneError> {
+        non_negative(&format!("{key}.g"), self.g)?;
+        if !(-90.0..=90.0).contains(&self.axis_inclination_deg) {
+            return Err(invalid(
+                &format!("{key}.axis_inclination_deg"),
+                self.axis_inclination_deg,
+                "must lie in [-90, 90] degrees",
+            ));
+        }
+        Ok(())
+    }
+
+    fn build(&self, _cargo: &[Cargo], _omega: f64) -> Option<Box<dyn Effect>> {
+        (self.in_plane() != 0.0).then(|| Box::new(self.clone()) as Box<dyn Effect>)
+    }
+
+    fn rotating_frame_obstacle(&self) -> Option<&'static str> {
+        (self.in_plane() != 0.0).then_some("gravity in the plane turns in the rotating frame")
     }
 }
 

@@ -1,15 +1,20 @@
-//! Optional physical effects. A scene enables only what it needs, and the
-//! assembled right-hand side then contains only those terms: no gravity term
-//! at all when the axis is vertical, no contact model unless asked.
+//! Physical effects. A scene enables only what it needs, and the assembled
+//! right-hand side then contains only those terms: no gravity term at all
+//! when the axis is vertical, no contact model unless asked, no drag when no
+//! weight has any.
 //!
-//! To add an effect: write one file implementing [`Effect`], add its
-//! parameters to [`Effects`] and one line to [`Effects::build`].
+//! To add an effect: write one file with the effect (implementing [`Effect`])
+//! and its scene parameters (implementing [`EffectSpec`]), then add one line
+//! to the `effect_registry!` call below. Code outside the scene can also
+//! add an effect to a built system ([`crate::model::system::RotorSystem::with_effect`]).
 
 pub mod contact;
+pub mod drag;
 pub mod gravity;
 
 use super::cargo::Cargo;
 use super::rotor::DofVec;
+use super::validate::SceneError;
 use serde::{Deserialize, Serialize};
 
 /// The state an effect may read.
@@ -50,34 +55,106 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>);
 }
 
-/// Which optional effects a scene enables, with their parameters.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Effects {
-    /// Gravity in the plane of the rotor (absent: none, e.g. a vertical axis).
-    #[serde(default)]
-    pub gravity: Option<gravity::Gravity>,
-    /// Contact between neighbouring weights of finite size (absent: weights
-    /// pass through each other, as the analytic theory assumes).
-    #[serde(default)]
-    pub contact: Option<contact::ContactSpec>,
+/// An effect's parameters as a scene file gives them (`[effects.<key>]`).
+pub trait EffectSpec {
+    /// Check the parameters; `key` is the field prefix, e.g. `effects.gravity`.
+    fn validate(&self, _key: &str) -> Result<(), SceneError> {
+        Ok(())
+    }
+    /// The effect for these cargoes at nominal speed `omega`; `None` when it
+    /// would add nothing, so the right-hand side skips it altogether.
+    fn build(&self, cargo: &[Cargo], omega: f64) -> Option<Box<dyn Effect>>;
+    /// Why the rotating-frame formulation cannot include this effect, if so.
+    fn rotating_frame_obstacle(&self) -> Option<&'static str> {
+        None
+    }
+}
+
+/// An effect with no scene table of its own: it reads its parameters from
+/// the cargoes, and is present whenever they call for it.
+pub trait IntrinsicEffect: Effect + Sized + 'static {
+    /// The effect for these cargoes at nominal speed `omega`; `None` when it
+    /// would add nothing.
+    fn from_cargo(cargo: &[Cargo], omega: f64) -> Option<Self>;
+}
+
+/// Declares every effect once: the intrinsic ones (built from the cargoes)
+/// and the optional ones, each with its scene key and parameter type. The
+/// right-hand side applies them in this order, which is the order of the
+/// floating-point additions into each force, so a new effect goes last.
+macro_rules! effect_registry {
+    (
+        intrinsic: [$($intrinsic:ty),* $(,)?],
+        optional: { $( $(#[$doc:meta])* $key:ident: $spec:ty ),* $(,)? } $(,)?
+    ) => {
+        /// Add the intrinsic effects these cargoes call for, in application order.
+        fn build_intrinsic(cargo: &[Cargo], omega: f64, list: &mut Vec<Box<dyn Effect>>) {
+            $(
+                if let Some(effect) = <$intrinsic as IntrinsicEffect>::from_cargo(cargo, omega) {
+                    list.push(Box::new(effect));
+                }
+            )*
+        }
+
+        /// Which optional effects a scene enables, with their parameters.
+        #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct Effects {
+            $(
+                $(#[$doc])*
+                #[serde(default)]
+                pub $key: Option<$spec>,
+            )*
+        }
+
+        impl Effects {
+            /// The enabled optional effects with their keys, in application order.
+            fn enabled(&self) -> impl Iterator<Item = (&'static str, &dyn EffectSpec)> {
+                [$((stringify!($key), self.$key.as_ref().map(|s| s as &dyn EffectSpec))),*]
+                    .into_iter()
+                    .filter_map(|(key, spec)| Some((key, spec?)))
+            }
+        }
+    };
+}
+
+effect_registry! {
+    intrinsic: [
+        drag::Drag,
+    ],
+    optional: {
+        /// Gravity in the plane of the rotor (absent: none, e.g. a vertical axis).
+        gravity: gravity::Gravity,
+        /// Contact between neighbouring weights of finite size (absent: weights
+        /// pass through each other, as the analytic theory assumes).
+        contact: contact::ContactSpec,
+    },
 }
 
 impl Effects {
-    /// Build the enabled effects for these cargoes at nominal speed `omega`;
-    /// an effect that would add nothing is left out.
+    /// Check the parameters of every enabled effect; the first problem found is returned.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        for (key, spec) in self.enabled() {
+            spec.validate(&format!("effects.{key}"))?;
+        }
+        Ok(())
+    }
+
+    /// Build the effects for these cargoes at nominal speed `omega`, intrinsic
+    /// ones first; an effect that would add nothing is left out.
     pub fn build(&self, cargo: &[Cargo], omega: f64) -> Vec<Box<dyn Effect>> {
-        let mut list: Vec<Box<dyn Effect>> = Vec::new();
-        if let Some(g) = &self.gravity
-            && g.in_plane() != 0.0
-        {
-            list.push(Box::new(g.clone()));
-        }
-        if let Some(c) = &self.contact
-            && let Some(effect) = contact::Contact::new(c, cargo, omega)
-        {
-            list.push(Box::new(effect));
-        }
+        let mut list = Vec::new();
+        build_intrinsic(cargo, omega, &mut list);
+        list.extend(
+            self.enabled()
+                .filter_map(|(_, spec)| spec.build(cargo, omega)),
+        );
         list
+    }
+
+    /// Why an enabled effect rules out the rotating-frame formulation, if one does.
+    pub fn rotating_frame_obstacle(&self) -> Option<&'static str> {
+        self.enabled()
+            .find_map(|(_, spec)| spec.rotating_frame_obstacle())
     }
 }

@@ -19,8 +19,8 @@
 //! m R² terms of eqs 22–23 (their axial motion when the disc tilts) are left
 //! out, about m R²/J = 4 m/M of the tilt inertia.
 
-use super::{DofVec, MAX_DOF, Rotor};
-use crate::model::scene::{SceneError, finite, non_negative, positive};
+use super::{DofVec, MAX_DOF, Rotor, RotorParams};
+use crate::model::validate::{SceneError, finite, non_negative, positive};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the flexible rotor (SI or dimensionless).
@@ -93,19 +93,6 @@ impl FlexibleShaft {
         let (ei, l) = (self.ei, self.length);
         (12.0 * ei / l.powi(3), -6.0 * ei / (l * l), 4.0 * ei / l)
     }
-
-    /// Check every parameter (field names prefixed `rotor.`).
-    pub fn validate(&self) -> Result<(), SceneError> {
-        positive("rotor.mass", self.mass)?;
-        positive("rotor.transverse_inertia", self.transverse_inertia)?;
-        positive("rotor.polar_inertia", self.polar_inertia)?;
-        positive("rotor.ei", self.ei)?;
-        positive("rotor.length", self.length)?;
-        non_negative("rotor.c_t", self.c_t)?;
-        non_negative("rotor.c_r", self.c_r)?;
-        non_negative("rotor.eccentricity", self.eccentricity)?;
-        finite("rotor.unbalance_angle", self.unbalance_angle)
-    }
 }
 
 impl Rotor for FlexibleShaft {
@@ -173,5 +160,28 @@ impl Rotor for FlexibleShaft {
 
     fn unbalance_size(&self, f: &DofVec) -> f64 {
         f[0].hypot(f[1])
+    }
+}
+
+impl RotorParams for FlexibleShaft {
+    fn validate(&self) -> Result<(), SceneError> {
+        positive("rotor.mass", self.mass)?;
+        positive("rotor.transverse_inertia", self.transverse_inertia)?;
+        positive("rotor.polar_inertia", self.polar_inertia)?;
+        positive("rotor.ei", self.ei)?;
+        positive("rotor.length", self.length)?;
+        non_negative("rotor.c_t", self.c_t)?;
+        non_negative("rotor.c_r", self.c_r)?;
+        non_negative("rotor.eccentricity", self.eccentricity)?;
+        finite("rotor.unbalance_angle", self.unbalance_angle)
+    }
+
+    fn set_unbalance(&mut self, unbalance: f64, direction: f64) {
+        self.eccentricity = unbalance / self.mass;
+        self.unbalance_angle = direction;
+    }
+
+    fn clear_unbalance(&mut self) {
+        self.eccentricity = 0.0;
     }
 }

@@ -7,6 +7,10 @@
 //! row coupled only to that block. [`crate::model::system`] eliminates the
 //! cargo rows and solves the head block, so a rotor model only has to say
 //! what its own mass, forces, unbalance and balancer planes are.
+//!
+//! To add a model: write one file implementing [`Rotor`] and [`RotorParams`],
+//! declare it (`pub mod …;`) and add one line
+//! to the `rotor_registry!` call below.
 
 pub mod flexible;
 pub mod plane;
@@ -16,7 +20,9 @@ pub use flexible::FlexibleShaft;
 pub use plane::PlaneRotor;
 pub use two_support::TwoSupportRotor;
 
+use crate::model::validate::SceneError;
 use serde::{Deserialize, Serialize};
+use std::any::Any;
 
 /// Largest number of rotor coordinates a model may have (x, y and two tilts).
 pub const MAX_DOF: usize = 4;
@@ -30,7 +36,7 @@ pub type DofVec = [f64; MAX_DOF];
 /// that turn like the vector (x, y) under a rotation about the spin axis (the
 /// rotating-frame linearisation in [`crate::model::linear`] relies on it), and
 /// `forces` is linear in q and q̇ (the forced response relies on it).
-pub trait Rotor: Send + Sync + std::fmt::Debug {
+pub trait Rotor: Any + Send + Sync + std::fmt::Debug {
     /// Short name used in output rows.
     fn name(&self) -> &'static str;
     /// Number of rotor coordinates k (2 for the plane rotor: x, y).
@@ -65,132 +71,151 @@ pub trait Rotor: Send + Sync + std::fmt::Debug {
     fn unbalance_size(&self, f: &DofVec) -> f64;
 }
 
-/// The registered rotor models, chosen in files by `model = "…"` in the
-/// `[rotor]` table (`"plane"` when absent, so older files stay valid).
-/// A new model: one file implementing [`Rotor`] plus a variant here.
-#[derive(Debug, Clone, PartialEq)]
-pub enum RotorModel {
+/// What a registered model adds to its equations: its parameters, as a file
+/// gives them, can be checked and their unbalance replaced. (Separate from
+/// [`Rotor`] so that a system can also be built from a rotor no file names,
+/// such as a test's wrapper around a model.)
+pub trait RotorParams: Rotor {
+    /// Check every parameter (field names prefixed `rotor.`).
+    fn validate(&self) -> Result<(), SceneError>;
+    /// Replace the rotor's own unbalance by a sampled one of size U (kg·m) at
+    /// direction θ: for one balancer plane the rotor's M e, for several a
+    /// point unbalance U in every plane (what each plane's balancer must take).
+    fn set_unbalance(&mut self, unbalance: f64, direction: f64);
+    /// Remove the rotor's own unbalance (its direction kept where it is a field).
+    fn clear_unbalance(&mut self);
+}
+
+/// Declares every rotor model once: its enum variant, its type and its name
+/// in files (`model = "…"`, equal to the model's [`Rotor::name`]). Emits
+/// [`RotorModel`] with every dispatch, the `From` impls and the serde names.
+macro_rules! rotor_registry {
+    ($( $(#[$doc:meta])* $variant:ident($model:ty) = $name:literal ),* $(,)?) => {
+        /// The registered rotor models, chosen in files by `model = "…"` in the
+        /// `[rotor]` table (`"plane"` when absent, so older files stay valid).
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum RotorModel {
+            $( $(#[$doc])* $variant($model), )*
+        }
+
+        /// The models' names as written in files, in registry order.
+        const NAMES: &[&str] = &[$($name),*];
+
+        impl RotorModel {
+            /// The model behind the [`RotorParams`] (and so [`Rotor`]) interface.
+            pub fn as_params(&self) -> &dyn RotorParams {
+                match self {
+                    $( RotorModel::$variant(r) => r, )*
+                }
+            }
+
+            /// The model behind the [`RotorParams`] interface, to change its parameters.
+            pub fn as_params_mut(&mut self) -> &mut dyn RotorParams {
+                match self {
+                    $( RotorModel::$variant(r) => r, )*
+                }
+            }
+
+            /// A boxed copy for the ODE system.
+            pub fn build(&self) -> Box<dyn Rotor> {
+                match self {
+                    $(
+                        RotorModel::$variant(r) => {
+                            debug_assert_eq!(r.name(), $name, "registry name of {}", stringify!($model));
+                            Box::new(r.clone())
+                        }
+                    )*
+                }
+            }
+
+            /// The model called `name` read from `value`; `None` for an unknown name.
+            fn from_toml(name: &str, value: toml::Value) -> Option<Result<Self, toml::de::Error>> {
+                match name {
+                    $( $name => Some(value.try_into().map(RotorModel::$variant)), )*
+                    _ => None,
+                }
+            }
+        }
+
+        $(
+            impl From<$model> for RotorModel {
+                fn from(r: $model) -> Self {
+                    RotorModel::$variant(r)
+                }
+            }
+        )*
+
+        /// How a model is written: its fields plus `model = "name"`.
+        #[derive(Serialize)]
+        #[serde(tag = "model")]
+        enum Tagged<'a> {
+            $( #[serde(rename = $name)] $variant(&'a $model), )*
+        }
+
+        impl Serialize for RotorModel {
+            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                match self {
+                    $( RotorModel::$variant(r) => Tagged::$variant(r), )*
+                }
+                .serialize(serializer)
+            }
+        }
+    };
+}
+
+rotor_registry! {
     /// The plane rotor of seed 004 ([`plane`]).
-    Plane(PlaneRotor),
+    Plane(PlaneRotor) = "plane",
     /// The rigid rotor on two elastic supports of seed 003 ([`two_support`]).
-    TwoSupport(TwoSupportRotor),
+    TwoSupport(TwoSupportRotor) = "two_support",
     /// The flexible (Stodola–Green) shaft of seed 002 ([`flexible`]).
-    Flexible(FlexibleShaft),
+    Flexible(FlexibleShaft) = "flexible",
 }
 
 impl RotorModel {
+    /// The model behind the [`Rotor`] interface.
+    pub fn as_rotor(&self) -> &dyn Rotor {
+        self.as_params()
+    }
+
     /// The model's name as written in files.
     pub fn name(&self) -> &'static str {
         self.as_rotor().name()
     }
 
-    /// The model behind the [`Rotor`] interface.
-    pub fn as_rotor(&self) -> &dyn Rotor {
-        match self {
-            RotorModel::Plane(r) => r,
-            RotorModel::TwoSupport(r) => r,
-            RotorModel::Flexible(r) => r,
-        }
-    }
-
-    /// A boxed copy for the ODE system.
-    pub fn build(&self) -> Box<dyn Rotor> {
-        match self {
-            RotorModel::Plane(r) => Box::new(r.clone()),
-            RotorModel::TwoSupport(r) => Box::new(r.clone()),
-            RotorModel::Flexible(r) => Box::new(r.clone()),
-        }
+    /// The model as its concrete type `T`, or `None` when it is another
+    /// model: how code that only applies to one model asks for it without
+    /// naming the registry's variants.
+    pub fn downcast_ref<T: Rotor>(&self) -> Option<&T> {
+        (self.as_rotor() as &dyn Any).downcast_ref::<T>()
     }
 
     /// Check every parameter (field names prefixed `rotor.`).
-    pub fn validate(&self) -> Result<(), crate::model::scene::SceneError> {
-        match self {
-            RotorModel::Plane(r) => r.validate(),
-            RotorModel::TwoSupport(r) => r.validate(),
-            RotorModel::Flexible(r) => r.validate(),
-        }
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.as_params().validate()
     }
 
     /// Replace the rotor's own unbalance by a sampled one of size U (kg·m) at
-    /// direction θ: the plane rotor's M e; for several balancer planes, a
-    /// point unbalance U in every plane (what each plane's balancer must take).
+    /// direction θ (see [`RotorParams::set_unbalance`]).
     pub fn set_unbalance(&mut self, unbalance: f64, direction: f64) {
-        match self {
-            RotorModel::Plane(r) => {
-                r.eccentricity = unbalance / r.mass;
-                r.unbalance_angle = direction;
-            }
-            RotorModel::Flexible(r) => {
-                r.eccentricity = unbalance / r.mass;
-                r.unbalance_angle = direction;
-            }
-            RotorModel::TwoSupport(r) => {
-                r.static_unbalance = 0.0;
-                r.moment_unbalance = 0.0;
-                r.unbalances = r
-                    .planes
-                    .iter()
-                    .map(|&z| two_support::PointUnbalance {
-                        s: unbalance,
-                        z,
-                        angle: direction,
-                    })
-                    .collect();
-            }
-        }
+        self.as_params_mut().set_unbalance(unbalance, direction);
     }
 
     /// The same rotor without its own unbalance (direction kept where it is a field).
     pub fn without_unbalance(&self) -> Self {
         let mut r = self.clone();
-        match &mut r {
-            RotorModel::Plane(p) => p.eccentricity = 0.0,
-            RotorModel::Flexible(f) => f.eccentricity = 0.0,
-            RotorModel::TwoSupport(t) => {
-                t.static_unbalance = 0.0;
-                t.moment_unbalance = 0.0;
-                t.unbalances.clear();
-            }
-        }
+        r.as_params_mut().clear_unbalance();
         r
     }
 }
 
-impl From<PlaneRotor> for RotorModel {
-    fn from(r: PlaneRotor) -> Self {
-        RotorModel::Plane(r)
-    }
-}
-
-impl From<FlexibleShaft> for RotorModel {
-    fn from(r: FlexibleShaft) -> Self {
-        RotorModel::Flexible(r)
-    }
-}
-
-impl From<TwoSupportRotor> for RotorModel {
-    fn from(r: TwoSupportRotor) -> Self {
-        RotorModel::TwoSupport(r)
-    }
-}
-
-/// How a model is written: its fields plus `model = "name"`.
-#[derive(Serialize)]
-#[serde(tag = "model", rename_all = "snake_case")]
-enum Tagged<'a> {
-    Plane(&'a PlaneRotor),
-    TwoSupport(&'a TwoSupportRotor),
-    Flexible(&'a FlexibleShaft),
-}
-
-impl Serialize for RotorModel {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        match self {
-            RotorModel::Plane(r) => Tagged::Plane(r),
-            RotorModel::TwoSupport(r) => Tagged::TwoSupport(r),
-            RotorModel::Flexible(r) => Tagged::Flexible(r),
-        }
-        .serialize(serializer)
+/// `"a", "b" or "c"`: the registered names for error messages.
+fn names_list() -> String {
+    let quoted: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+    match quoted.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        Some((last, _)) => last.clone(),
+        None => String::new(),
     }
 }
 
@@ -205,21 +230,61 @@ impl<'de> Deserialize<'de> for RotorModel {
             Some(toml::Value::String(s)) => s,
             Some(other) => {
                 return Err(D::Error::custom(format!(
-                    "rotor.model = {other}: expected a name such as \"plane\", \"two_support\" or \"flexible\""
+                    "rotor.model = {other}: expected a name such as {}",
+                    names_list()
                 )));
             }
         };
-        let value = toml::Value::Table(table);
-        match model.as_str() {
-            "plane" => value.try_into().map(RotorModel::Plane),
-            "two_support" => value.try_into().map(RotorModel::TwoSupport),
-            "flexible" => value.try_into().map(RotorModel::Flexible),
-            other => {
-                return Err(D::Error::custom(format!(
-                    "rotor.model = \"{other}\": expected \"plane\", \"two_support\" or \"flexible\""
-                )));
-            }
+        let Some(result) = RotorModel::from_toml(&model, toml::Value::Table(table)) else {
+            return Err(D::Error::custom(format!(
+                "rotor.model = \"{model}\": expected {}",
+                names_list()
+            )));
+        };
+        result.map_err(|e| D::Error::custom(format!("rotor ({model}): {}", e.message())))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<RotorModel, String> {
+        toml::from_str::<RotorModel>(text).map_err(|e| e.message().to_string())
+    }
+
+    #[test]
+    fn registry_names_are_the_models_names_and_survive_a_round_trip() {
+        let plane = RotorModel::from(PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1));
+        let flexible = RotorModel::from(FlexibleShaft::dimensionless(2.0, 0.1, 0.1, 0.01));
+        for model in [plane, flexible] {
+            let text = toml::to_string(&model).unwrap();
+            assert!(text.starts_with(&format!("model = \"{}\"", model.name())));
+            assert!(NAMES.contains(&model.name()));
+            assert_eq!(parse(&text).unwrap(), model);
         }
-        .map_err(|e| D::Error::custom(format!("rotor ({model}): {}", e.message())))
+        assert_eq!(
+            parse("mass = 1.0\nkx = 1.0\nky = 1.0\nbx = 0.0\nby = 0.0")
+                .unwrap()
+                .name(),
+            "plane"
+        );
+    }
+
+    #[test]
+    fn unknown_models_are_named_with_the_registered_ones() {
+        assert_eq!(
+            parse("model = \"gyro\"").unwrap_err(),
+            "rotor.model = \"gyro\": expected \"plane\", \"two_support\" or \"flexible\""
+        );
+        assert_eq!(
+            parse("model = 3").unwrap_err(),
+            "rotor.model = 3: expected a name such as \"plane\", \"two_support\" or \"flexible\""
+        );
+        assert!(
+            parse("model = \"plane\"\nmass = 1.0")
+                .unwrap_err()
+                .starts_with("rotor (plane): ")
+        );
     }
 }

@@ -2,8 +2,8 @@
 //! viscoelastic supports (k_x, k_y, b_x, b_y); one balancer plane at the
 //! shaft centre. Coordinates x, y of the shaft centre from static equilibrium.
 
-use super::{DofVec, MAX_DOF, Rotor};
-use crate::model::scene::{SceneError, invalid, non_negative, positive};
+use super::{DofVec, MAX_DOF, Rotor, RotorParams};
+use crate::model::validate::{SceneError, invalid, non_negative, positive};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the plane rotor (any consistent units, SI in study files).
@@ -50,27 +50,6 @@ impl PlaneRotor {
             bx: b,
             by: b,
         }
-    }
-}
-
-impl PlaneRotor {
-    /// Check every parameter (field names prefixed `rotor.`).
-    pub fn validate(&self) -> Result<(), SceneError> {
-        positive("rotor.mass", self.mass)?;
-        non_negative("rotor.eccentricity", self.eccentricity)?;
-        positive("rotor.inertia", self.inertia)?;
-        positive("rotor.kx", self.kx)?;
-        positive("rotor.ky", self.ky)?;
-        non_negative("rotor.bx", self.bx)?;
-        non_negative("rotor.by", self.by)?;
-        if !self.unbalance_angle.is_finite() {
-            return Err(invalid(
-                "rotor.unbalance_angle",
-                self.unbalance_angle,
-                "must be finite",
-            ));
-        }
-        Ok(())
     }
 }
 
@@ -130,5 +109,34 @@ impl Rotor for PlaneRotor {
 
     fn unbalance_size(&self, f: &DofVec) -> f64 {
         f[0].hypot(f[1])
+    }
+}
+
+impl RotorParams for PlaneRotor {
+    fn validate(&self) -> Result<(), SceneError> {
+        positive("rotor.mass", self.mass)?;
+        non_negative("rotor.eccentricity", self.eccentricity)?;
+        positive("rotor.inertia", self.inertia)?;
+        positive("rotor.kx", self.kx)?;
+        positive("rotor.ky", self.ky)?;
+        non_negative("rotor.bx", self.bx)?;
+        non_negative("rotor.by", self.by)?;
+        if !self.unbalance_angle.is_finite() {
+            return Err(invalid(
+                "rotor.unbalance_angle",
+                self.unbalance_angle,
+                "must be finite",
+            ));
+        }
+        Ok(())
+    }
+
+    fn set_unbalance(&mut self, unbalance: f64, direction: f64) {
+        self.eccentricity = unbalance / self.mass;
+        self.unbalance_angle = direction;
+    }
+
+    fn clear_unbalance(&mut self) {
+        self.eccentricity = 0.0;
     }
 }

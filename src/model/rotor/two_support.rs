@@ -23,8 +23,8 @@
 //! The rotor's own unbalance: static S and moment I (eq 6) as point
 //! unbalances s at z and angle θ, or directly as |S|, arg S, |I|, arg I.
 
-use super::{DofVec, MAX_DOF, Rotor};
-use crate::model::scene::{SceneError, finite, invalid, non_negative, positive};
+use super::{DofVec, MAX_DOF, Rotor, RotorParams};
+use crate::model::validate::{SceneError, finite, invalid, non_negative, positive};
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
@@ -128,52 +128,6 @@ impl TwoSupportRotor {
     }
 }
 
-impl TwoSupportRotor {
-    /// Check every parameter (field names prefixed `rotor.`).
-    pub fn validate(&self) -> Result<(), SceneError> {
-        positive("rotor.mass", self.mass)?;
-        positive("rotor.transverse_inertia", self.transverse_inertia)?;
-        positive("rotor.polar_inertia", self.polar_inertia)?;
-        positive("rotor.k1", self.k1)?;
-        positive("rotor.k2", self.k2)?;
-        non_negative("rotor.b1", self.b1)?;
-        non_negative("rotor.b2", self.b2)?;
-        non_negative("rotor.static_unbalance", self.static_unbalance)?;
-        non_negative("rotor.moment_unbalance", self.moment_unbalance)?;
-        for (name, v) in [
-            ("rotor.l1", self.l1),
-            ("rotor.l2", self.l2),
-            ("rotor.static_angle", self.static_angle),
-            ("rotor.moment_angle", self.moment_angle),
-        ] {
-            finite(name, v)?;
-        }
-        if self.l1 + self.l2 <= 0.0 {
-            return Err(invalid(
-                "rotor.l2",
-                self.l2,
-                "the supports must be apart: l1 + l2 > 0",
-            ));
-        }
-        if self.planes.is_empty() {
-            return Err(SceneError::Invalid {
-                field: "rotor.planes".into(),
-                value: "[]".into(),
-                reason: "give the axial position of at least one balancer plane".into(),
-            });
-        }
-        for (p, &z) in self.planes.iter().enumerate() {
-            finite(&format!("rotor.planes[{p}]"), z)?;
-        }
-        for (j, u) in self.unbalances.iter().enumerate() {
-            non_negative(&format!("rotor.unbalances[{j}].s"), u.s)?;
-            finite(&format!("rotor.unbalances[{j}].z"), u.z)?;
-            finite(&format!("rotor.unbalances[{j}].angle"), u.angle)?;
-        }
-        Ok(())
-    }
-}
-
 impl Rotor for TwoSupportRotor {
     fn name(&self) -> &'static str {
         "two_support"
@@ -255,5 +209,72 @@ impl Rotor for TwoSupportRotor {
         let i = Complex64::new(f[3], -f[2]);
         let (u1, u2) = self.bearing_unbalances(s, i);
         u1.norm().max(u2.norm())
+    }
+}
+
+impl RotorParams for TwoSupportRotor {
+    fn validate(&self) -> Result<(), SceneError> {
+        positive("rotor.mass", self.mass)?;
+        positive("rotor.transverse_inertia", self.transverse_inertia)?;
+        positive("rotor.polar_inertia", self.polar_inertia)?;
+        positive("rotor.k1", self.k1)?;
+        positive("rotor.k2", self.k2)?;
+        non_negative("rotor.b1", self.b1)?;
+        non_negative("rotor.b2", self.b2)?;
+        non_negative("rotor.static_unbalance", self.static_unbalance)?;
+        non_negative("rotor.moment_unbalance", self.moment_unbalance)?;
+        for (name, v) in [
+            ("rotor.l1", self.l1),
+            ("rotor.l2", self.l2),
+            ("rotor.static_angle", self.static_angle),
+            ("rotor.moment_angle", self.moment_angle),
+        ] {
+            finite(name, v)?;
+        }
+        if self.l1 + self.l2 <= 0.0 {
+            return Err(invalid(
+                "rotor.l2",
+                self.l2,
+                "the supports must be apart: l1 + l2 > 0",
+            ));
+        }
+        if self.planes.is_empty() {
+            return Err(SceneError::Invalid {
+                field: "rotor.planes".into(),
+                value: "[]".into(),
+                reason: "give the axial position of at least one balancer plane".into(),
+            });
+        }
+        for (p, &z) in self.planes.iter().enumerate() {
+            finite(&format!("rotor.planes[{p}]"), z)?;
+        }
+        for (j, u) in self.unbalances.iter().enumerate() {
+            non_negative(&format!("rotor.unbalances[{j}].s"), u.s)?;
+            finite(&format!("rotor.unbalances[{j}].z"), u.z)?;
+            finite(&format!("rotor.unbalances[{j}].angle"), u.angle)?;
+        }
+        Ok(())
+    }
+
+    /// A point unbalance U in every balancer plane: what each plane's
+    /// balancer must take.
+    fn set_unbalance(&mut self, unbalance: f64, direction: f64) {
+        self.static_unbalance = 0.0;
+        self.moment_unbalance = 0.0;
+        self.unbalances = self
+            .planes
+            .iter()
+            .map(|&z| PointUnbalance {
+                s: unbalance,
+                z,
+                angle: direction,
+            })
+            .collect();
+    }
+
+    fn clear_unbalance(&mut self) {
+        self.static_unbalance = 0.0;
+        self.moment_unbalance = 0.0;
+        self.unbalances.clear();
     }
 }

@@ -1,0 +1,162 @@
+#!/usr/bin/env python3
+"""Import cycles and layer violations between the modules of src/model.
+
+A "unit" is a direct child of `model` (a file such as scene.rs, or a folder
+such as rotor/ together with everything below it): edges inside a unit (a
+model file using its folder's mod.rs and the re-exports back) are how Rust
+folders work and are not counted. Every `use` tree and every inline
+`crate::…`/`super::…` path outside comments and strings is an edge.
+
+Exits 1 when the unit graph has a cycle or a lower layer imports an upper
+one, so it can run in CI: python3 scripts/module-cycles.py
+"""
+
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent / "src"
+MODEL = ROOT / "model"
+
+# Lower layers may be imported by anything; they must not import the upper ones.
+LOWER = {"validate", "cargo", "speed", "rotor", "effect", "balancer"}
+UPPER = {"system", "frame", "scene"}
+
+CODE_NOISE = re.compile(
+    r'//[^\n]*|/\*.*?\*/|r#*"(?:.|\n)*?"#*|"(?:\\.|[^"\\])*"|\'(?:\\.|[^\'\\])\'',
+    re.S,
+)
+USE = re.compile(r"\buse\s+([^;]+);")
+INLINE = re.compile(r"\b(?:crate|super|self)(?:\s*::\s*\w+)+")
+
+
+def module_path(file: Path) -> tuple:
+    rel = file.relative_to(ROOT).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "mod":
+        parts.pop()
+    return tuple(parts)
+
+
+def expand(tree: str) -> list:
+    """All leaf paths of a use tree such as `super::{a::{self, B}, c}`."""
+    tree = re.sub(r"\s+", "", tree)
+    depth, start = 0, None
+    for i, ch in enumerate(tree):
+        if ch == "{":
+            if depth == 0:
+                start = i
+            depth += 1
+        elif ch == "}":
+            depth -= 1
+            if depth == 0:
+                prefix, inner, rest = tree[:start], tree[start + 1 : i], tree[i + 1 :]
+                out, depth2, last = [], 0, 0
+                for j, c in enumerate(inner + ","):
+                    if c in "{":
+                        depth2 += 1
+                    elif c in "}":
+                        depth2 -= 1
+                    elif c == "," and depth2 == 0:
+                        piece = inner[last:j]
+                        last = j + 1
+                        if piece:
+                            out += expand(prefix + piece + rest)
+                return out
+    return [tree.split(" as ")[0]]
+
+
+def resolve(path: str, here: tuple, modules: set):
+    parts = [p for p in path.split("::") if p]
+    # The module a relative path starts from: a file's own module for self,
+    # its parent for super (mod.rs files are their folder's module).
+    base = list(here)
+    if parts[0] == "crate":
+        base, parts = [], parts[1:]
+    elif parts[0] in ("super", "self"):
+        while parts and parts[0] in ("super", "self"):
+            if parts[0] == "super":
+                base = base[:-1]
+            parts = parts[1:]
+    else:
+        return None
+    full = tuple(base + parts)
+    for n in range(len(full), 0, -1):
+        if full[:n] in modules:
+            return full[:n]
+    return None
+
+
+def main() -> int:
+    files = sorted(MODEL.rglob("*.rs"))
+    modules = {module_path(f) for f in files} | {("model",)}
+    edges = {}
+    for f in files:
+        here = module_path(f)
+        code = CODE_NOISE.sub(" ", f.read_text())
+        paths = [p for tree in USE.findall(code) for p in expand(tree)]
+        code_wo_use = USE.sub(" ", code)
+        paths += [re.sub(r"\s+", "", m) for m in INLINE.findall(code_wo_use)]
+        for p in paths:
+            target = resolve(p, here, modules)
+            if not target or target[0] != "model" or len(target) < 2 or len(here) < 2:
+                continue
+            a, b = here[1], target[1]
+            if a != b:
+                edges.setdefault(a, {}).setdefault(b, set()).add(
+                    "/".join(f.relative_to(ROOT).parts)
+                )
+    units = sorted({module_path(f)[1] for f in files if len(module_path(f)) > 1})
+
+    print("model unit -> units it imports")
+    for u in units:
+        print(f"  {u:13} -> {', '.join(sorted(edges.get(u, {}))) or '-'}")
+
+    # Tarjan's strongly connected components.
+    index, low, stack, on, sccs, counter = {}, {}, [], set(), [], [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in edges.get(v, {}):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                sccs.append(sorted(comp))
+
+    for u in units:
+        if u not in index:
+            visit(u)
+
+    bad = 0
+    for comp in sccs:
+        bad += 1
+        print(f"CYCLE among: {', '.join(comp)}")
+        for a in comp:
+            for b in comp:
+                if b in edges.get(a, {}):
+                    print(f"  {a} -> {b}  ({', '.join(sorted(edges[a][b]))})")
+    for a in sorted(LOWER):
+        for b in sorted(edges.get(a, {})):
+            if b in UPPER:
+                bad += 1
+                print(f"LAYER: lower {a} imports upper {b}  ({', '.join(sorted(edges[a][b]))})")
+    print("no cycles, layers respected" if not bad else f"{bad} problem(s)")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
