@@ -310,16 +310,9 @@ pub fn run(config: &BenchConfig) -> BenchReport {
     }
 }
 
-/// Median of a non-empty slice (sorted copy; mean of the middle pair when even).
+/// Median of timings, of which every series has at least one.
 pub fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    }
+    crate::stats::quantile::median(values).expect("every series times at least once")
 }
 
 /// Time per RHS call for each cargo count, batches interleaved across counts.
@@ -946,12 +939,6 @@ mod tests {
         assert!((fit.slope_ns_per_cargo - 2.0).abs() < 1e-12);
         assert!((fit.r_squared - 1.0).abs() < 1e-12);
         assert!(linear_fit(&[(1.0, 2.0)]).is_none());
-    }
-
-    #[test]
-    fn median_of_odd_and_even() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
     }
 }
 

@@ -7,9 +7,10 @@
 
 use super::holm::holm_adjust;
 use super::ks::ks_two_sample;
-use super::median::{median, mood_median_test};
+use super::median::mood_median_test;
 use super::proportion::fisher_two_proportions;
 use super::samples::DesignSample;
+use crate::stats::quantile::median;
 use serde::Serialize;
 
 /// Family-wise false-alarm rate used when none is given.

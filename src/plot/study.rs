@@ -4,6 +4,7 @@
 
 use super::style::{self, Figure, Swatch, TICK, colour, linear_label, log_ticks, short, text};
 use super::{Format, PlotError};
+use crate::stats::quantile::{Interpolation, quantile_sorted};
 use crate::study::io::read_parquet;
 use crate::study::record::{RunRecord, from_dataframe};
 use plotters::coord::Shift;
@@ -210,16 +211,6 @@ fn label_width(labels: &[String]) -> u32 {
     (longest * TICK * 58 / 100 + 24).max(60)
 }
 
-/// Linear-interpolated quantile of sorted values.
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    let pos = q * (sorted.len() - 1) as f64;
-    let (i, frac) = (pos.floor() as usize, pos.fract());
-    match sorted.get(i + 1) {
-        Some(next) => sorted[i] + frac * (next - sorted[i]),
-        None => sorted[i],
-    }
-}
-
 /// Box-plot numbers: whiskers to the furthest point within 1.5 IQR, and the outliers.
 struct BoxStats {
     q1: f64,
@@ -236,7 +227,8 @@ fn box_stats(values: &[f64]) -> Option<BoxStats> {
     }
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
-    let (q1, median, q3) = (quantile(&v, 0.25), quantile(&v, 0.5), quantile(&v, 0.75));
+    let quartile = |q| quantile_sorted(&v, q, Interpolation::Linear);
+    let (q1, median, q3) = (quartile(0.25)?, quartile(0.5)?, quartile(0.75)?);
     let iqr = q3 - q1;
     let (lo_fence, hi_fence) = (q1 - 1.5 * iqr, q3 + 1.5 * iqr);
     let inside = || {

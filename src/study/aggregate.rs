@@ -8,6 +8,7 @@
 use super::config::StudyPlan;
 use super::record::{RunRecord, to_dataframe};
 use super::sample::{Purpose, stream};
+use crate::stats::quantile::{Interpolation, quantile_sorted};
 use polars::prelude::*;
 use rand::RngExt;
 
@@ -45,9 +46,17 @@ pub fn bootstrap_mean_ci(values: &[f64], seed: u64, design: u32) -> Option<(f64,
     Some((at(0.025), at(0.975)))
 }
 
-/// Quantile of a column with linear interpolation (None when empty).
-fn quantile(ca: &Float64Chunked, q: f64) -> PolarsResult<Option<f64>> {
-    ca.quantile(q, QuantileMethod::Linear)
+/// Non-null values of a column, sorted for [`quantile_sorted`].
+///
+/// The quantiles were polars's `QuantileMethod::Linear` (and its `median`),
+/// which [`Interpolation::Linear`] reproduces bit for bit: same position,
+/// same formula. Polars orders −0.0 with +0.0 and every NaN last, where
+/// `f64::total_cmp` does not; neither value occurs here, as settling times
+/// are (t − t₀)/T with t ≥ t₀ and residuals are RMS/A_ref of finite runs.
+fn sorted_values(ca: &Float64Chunked) -> Vec<f64> {
+    let mut v: Vec<f64> = ca.iter().flatten().collect();
+    v.sort_by(f64::total_cmp);
+    v
 }
 
 /// One row per design, in design order.
@@ -87,16 +96,20 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         rows.settled_hi.push(hi);
         rows.ts_mean.push(ts.mean());
         rows.ts_std.push(ts.std(1));
-        rows.ts_median.push(ts.median());
-        rows.ts_p10.push(quantile(&ts, 0.10)?);
-        rows.ts_p90.push(quantile(&ts, 0.90)?);
-        rows.ts_p95.push(quantile(&ts, 0.95)?);
+        let ts_sorted = sorted_values(&ts);
+        let ts_q = |q| quantile_sorted(&ts_sorted, q, Interpolation::Linear);
+        rows.ts_median.push(ts_q(0.5));
+        rows.ts_p10.push(ts_q(0.10));
+        rows.ts_p90.push(ts_q(0.90));
+        rows.ts_p95.push(ts_q(0.95));
         rows.ts_max.push(ts.max());
         rows.ts_ci_lo.push(ci.map(|c| c.0));
         rows.ts_ci_hi.push(ci.map(|c| c.1));
         rows.res_mean.push(residual.mean());
-        rows.res_median.push(residual.median());
-        rows.res_p95.push(quantile(&residual, 0.95)?);
+        let res_sorted = sorted_values(&residual);
+        let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
+        rows.res_median.push(res_q(0.5));
+        rows.res_p95.push(res_q(0.95));
         rows.not_settled.push(count("not_settled"));
         rows.diverged.push(count("diverged"));
         rows.solver_failed.push(count("solver_failed"));
