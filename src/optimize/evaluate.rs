@@ -5,10 +5,11 @@ use super::spec::{Objective, OptimizeSpec};
 use crate::design::transient::a_tilde;
 use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
+use crate::stats::bootstrap;
 use crate::stats::quantile::{Interpolation, quantile};
-use crate::study::aggregate::bootstrap_std_error;
 use crate::study::config::{Design, StudyPlan};
 use crate::study::run::run_design_sample;
+use crate::study::sample::{Purpose, stream};
 use rayon::prelude::*;
 
 /// A point of the design space.
@@ -157,7 +158,11 @@ impl Evaluator<'_> {
                 };
                 (
                     p90(&censored),
-                    bootstrap_std_error(&censored, p90, self.plan.file.seed),
+                    bootstrap::std_error(
+                        &censored,
+                        p90,
+                        &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
+                    ),
                 )
             }
             Objective::SettledFraction => {

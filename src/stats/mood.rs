@@ -1,6 +1,6 @@
 //! Mood's median test with Fisher's exact p-value.
 //!
-//! The question is whether the typical residual vibration moved, i.e. the
+//! A regression check asks whether the typical residual vibration moved, i.e. the
 //! median, so the test is the one whose null hypothesis is exactly "equal
 //! medians": count the values above the grand median in each sample and
 //! compare the two proportions (a 2×2 table) with Fisher's exact test.
@@ -12,7 +12,7 @@
 //! The price is power: about 2/3 of Mann–Whitney's for a normal shift.
 
 use super::proportion::fisher_two_proportions;
-use crate::stats::quantile::median;
+use super::quantile::median;
 
 /// Outcome of Mood's median test.
 #[derive(Debug, Clone, Copy, PartialEq)]
