@@ -28,7 +28,6 @@
 // chains over several parallel arrays would hide them.
 #![allow(clippy::needless_range_loop)]
 
-pub mod bench;
 pub mod check;
 pub mod claims;
 pub mod design;
