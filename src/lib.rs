@@ -16,7 +16,8 @@
 //!   outcome — defined once.
 //! - [`simulation`]: one run at a chosen fidelity.
 //! - [`study`]: many runs on all cores, statistics with polars, Parquet.
-//! - Analyses on top: [`optimize`], [`claims`], [`tradeoff`], [`check`], [`plot`].
+//! - Analyses on top: [`optimize`], [`claims`], [`tradeoff`], [`check`], [`plot`],
+//!   sharing one set of statistics ([`stats`]).
 //!
 //! Start reading at [`simulation::Simulation::run`] and [`study::run::run_study`].
 //!
@@ -27,7 +28,6 @@
 // chains over several parallel arrays would hide them.
 #![allow(clippy::needless_range_loop)]
 
-pub mod bench;
 pub mod check;
 pub mod claims;
 pub mod design;
@@ -38,5 +38,6 @@ pub mod optimize;
 pub mod plot;
 pub mod scene_file;
 pub mod simulation;
+pub mod stats;
 pub mod study;
 pub mod tradeoff;

@@ -10,6 +10,7 @@ use crate::integrate::Method;
 use crate::metrics::RunMetrics;
 use crate::model::frame::rotating_frame_obstacle;
 use crate::simulation::{Fidelity, MethodChoice, Simulation};
+use crate::stats::quantile::{Interpolation, quantile_sorted};
 use crate::study::config::StudyPlan;
 use crate::study::io::{Provenance, write_parquet};
 use crate::study::sample::draw_sample;
@@ -74,7 +75,7 @@ pub struct TradeoffRow {
 pub struct SettingSummary {
     /// The setting.
     pub setting: Setting,
-    /// Median |Δt_s| over the runs where both settled (revolutions).
+    /// Upper median |Δt_s| (the higher middle value) over the runs where both settled (revolutions).
     pub median_error_revs: Option<f64>,
     /// Largest |Δt_s| (revolutions).
     pub max_error_revs: Option<f64>,
@@ -224,7 +225,7 @@ pub fn summarize(rows: &[TradeoffRow]) -> Vec<SettingSummary> {
         let n = mine.len() as f64;
         out.push(SettingSummary {
             setting: s,
-            median_error_revs: (!errs.is_empty()).then(|| errs[errs.len() / 2]),
+            median_error_revs: quantile_sorted(&errs, 0.5, Interpolation::Higher),
             max_error_revs: errs.last().copied(),
             max_residual_error: mine.iter().map(|r| r.residual_error).fold(0.0, f64::max),
             outcome_agreement: mine.iter().filter(|r| r.outcome_agrees).count() as f64 / n,

@@ -4,10 +4,16 @@
 //! `#[global_allocator]` replaces the allocator of the whole binary, and in
 //! `tests/it` it would sit under every integration test.
 
-use autobal::bench::{BenchProblem, CARGO_COUNTS};
+// The benchmark's reference problem lives in the `study` binary, which a
+// test cannot link against; its file uses the library only, so it is compiled in.
+#[allow(dead_code)]
+#[path = "../src/bin/study/bench/problem.rs"]
+mod problem;
+
 use autobal::integrate::{Method, OdeSystem, Status};
 use autobal::model::effect::gravity::Gravity;
 use autobal::model::start::{StartMode, initial_state};
+use problem::{BenchProblem, CARGO_COUNTS};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -77,7 +83,7 @@ fn rhs_never_allocates() {
 
 #[test]
 fn rhs_with_gravity_never_allocates() {
-    let mut scene = autobal::bench::reference_scene(3);
+    let mut scene = problem::reference_scene(3);
     scene.effects.gravity = Some(Gravity {
         g: 9.81,
         axis_inclination_deg: 0.0,

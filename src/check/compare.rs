@@ -5,11 +5,12 @@
 //! after a change nobody meant to make is as much a sign that the physics or
 //! numerics moved as slower settling is.
 
-use super::holm::holm_adjust;
-use super::ks::ks_two_sample;
-use super::median::{median, mood_median_test};
-use super::proportion::fisher_two_proportions;
 use super::samples::DesignSample;
+use crate::stats::holm::holm_adjust;
+use crate::stats::ks::ks_two_sample;
+use crate::stats::mood::mood_median_test;
+use crate::stats::proportion::fisher_two_proportions;
+use crate::stats::quantile::median;
 use serde::Serialize;
 
 /// Family-wise false-alarm rate used when none is given.

@@ -3,10 +3,11 @@
 //!
 //! Monte Carlo output is noisy, so the check is a set of hypothesis tests,
 //! not a byte comparison: per design, a two-sample Kolmogorov–Smirnov test
-//! on the settling times of settled runs ([`ks`]), Fisher's exact test on
-//! the settled fraction ([`proportion`]) and Mood's median test on residual
-//! vibration ([`median`]); all p-values of a study are corrected together
-//! with Holm's method ([`holm`]) and judged in a verdict table ([`compare`]).
+//! on the settling times of settled runs ([`crate::stats::ks`]), Fisher's
+//! exact test on the settled fraction ([`crate::stats::proportion`]) and
+//! Mood's median test on residual vibration ([`crate::stats::mood`]); all
+//! p-values of a study are corrected together with Holm's method
+//! ([`crate::stats::holm`]) and judged in a verdict table ([`compare`]).
 //!
 //! - [`baseline`]: the baseline folder (runs, summary, manifest with provenance).
 //! - [`samples`]: the per-design samples read from a runs table.
@@ -16,9 +17,5 @@
 
 pub mod baseline;
 pub mod compare;
-pub mod holm;
-pub mod ks;
-pub mod median;
-pub mod proportion;
 pub mod samples;
 pub mod study;

@@ -5,9 +5,11 @@ use super::spec::{Objective, OptimizeSpec};
 use crate::design::transient::a_tilde;
 use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
-use crate::study::aggregate::bootstrap_std_error;
+use crate::stats::bootstrap;
+use crate::stats::quantile::{Interpolation, quantile};
 use crate::study::config::{Design, StudyPlan};
 use crate::study::run::run_design_sample;
+use crate::study::sample::{Purpose, stream};
 use rayon::prelude::*;
 
 /// A point of the design space.
@@ -151,10 +153,16 @@ impl Evaluator<'_> {
         match objective {
             Objective::SettlingMean => mean_se(&censored),
             Objective::SettlingP90 => {
-                let p90 = quantile(&censored, 0.9);
+                let p90 = |v: &[f64]| {
+                    quantile(v, 0.9, Interpolation::Linear).expect("at least one sample")
+                };
                 (
-                    p90,
-                    bootstrap_std_error(&censored, |v| quantile(v, 0.9), self.plan.file.seed),
+                    p90(&censored),
+                    bootstrap::std_error(
+                        &censored,
+                        p90,
+                        &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
+                    ),
                 )
             }
             Objective::SettledFraction => {
@@ -169,13 +177,4 @@ impl Evaluator<'_> {
             }
         }
     }
-}
-
-/// Linear-interpolation quantile of unsorted values.
-pub fn quantile(values: &[f64], q: f64) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let pos = q * (v.len() - 1) as f64;
-    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-    v[lo] + (v[hi] - v[lo]) * (pos - lo as f64)
 }

@@ -8,46 +8,22 @@
 use super::config::StudyPlan;
 use super::record::{RunRecord, to_dataframe};
 use super::sample::{Purpose, stream};
+use crate::stats::bootstrap;
+use crate::stats::interval::wilson_interval;
+use crate::stats::quantile::{Interpolation, quantile_sorted};
 use polars::prelude::*;
-use rand::RngExt;
 
-/// Bootstrap resamples for the confidence interval of the mean settling time.
-pub const BOOTSTRAP_RESAMPLES: usize = 2000;
-
-/// Normal quantile for 95 % two-sided intervals.
-const Z95: f64 = 1.959_963_984_540_054;
-
-/// Wilson score interval (95 %) of a proportion `successes / trials`.
-pub fn wilson_interval(successes: u64, trials: u64) -> (f64, f64) {
-    if trials == 0 {
-        return (0.0, 1.0);
-    }
-    let n = trials as f64;
-    let p = successes as f64 / n;
-    let z2 = Z95 * Z95;
-    let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
-    let half = Z95 * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / (1.0 + z2 / n);
-    ((centre - half).max(0.0), (centre + half).min(1.0))
-}
-
-/// Percentile bootstrap 95 % interval of the mean of `values`, seeded per design.
-pub fn bootstrap_mean_ci(values: &[f64], seed: u64, design: u32) -> Option<(f64, f64)> {
-    if values.len() < 2 {
-        return None;
-    }
-    let mut rng = stream(seed, Some(design), 0, Purpose::Bootstrap);
-    let n = values.len();
-    let mut means: Vec<f64> = (0..BOOTSTRAP_RESAMPLES)
-        .map(|_| (0..n).map(|_| values[rng.random_range(0..n)]).sum::<f64>() / n as f64)
-        .collect();
-    means.sort_by(f64::total_cmp);
-    let at = |q: f64| means[((q * (BOOTSTRAP_RESAMPLES - 1) as f64).round()) as usize];
-    Some((at(0.025), at(0.975)))
-}
-
-/// Quantile of a column with linear interpolation (None when empty).
-fn quantile(ca: &Float64Chunked, q: f64) -> PolarsResult<Option<f64>> {
-    ca.quantile(q, QuantileMethod::Linear)
+/// Non-null values of a column, sorted for [`quantile_sorted`].
+///
+/// The quantiles were polars's `QuantileMethod::Linear` (and its `median`),
+/// which [`Interpolation::Linear`] reproduces bit for bit: same position,
+/// same formula. Polars orders −0.0 with +0.0 and every NaN last, where
+/// `f64::total_cmp` does not; neither value occurs here, as settling times
+/// are (t − t₀)/T with t ≥ t₀ and residuals are RMS/A_ref of finite runs.
+fn sorted_values(ca: &Float64Chunked) -> Vec<f64> {
+    let mut v: Vec<f64> = ca.iter().flatten().collect();
+    v.sort_by(f64::total_cmp);
+    v
 }
 
 /// One row per design, in design order.
@@ -68,7 +44,8 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         let settled_n = settled.height() as u64;
         let (lo, hi) = wilson_interval(settled_n, runs_n);
         let ts_values: Vec<f64> = ts.into_no_null_iter().collect();
-        let ci = bootstrap_mean_ci(&ts_values, plan.file.seed, design.id);
+        let mut rng = stream(plan.file.seed, Some(design.id), 0, Purpose::Bootstrap);
+        let ci = bootstrap::mean_ci(&ts_values, &mut rng);
 
         rows.design_id.push(design.id);
         rows.kind.push(design.spec.kind.name().to_string());
@@ -87,16 +64,20 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         rows.settled_hi.push(hi);
         rows.ts_mean.push(ts.mean());
         rows.ts_std.push(ts.std(1));
-        rows.ts_median.push(ts.median());
-        rows.ts_p10.push(quantile(&ts, 0.10)?);
-        rows.ts_p90.push(quantile(&ts, 0.90)?);
-        rows.ts_p95.push(quantile(&ts, 0.95)?);
+        let ts_sorted = sorted_values(&ts);
+        let ts_q = |q| quantile_sorted(&ts_sorted, q, Interpolation::Linear);
+        rows.ts_median.push(ts_q(0.5));
+        rows.ts_p10.push(ts_q(0.10));
+        rows.ts_p90.push(ts_q(0.90));
+        rows.ts_p95.push(ts_q(0.95));
         rows.ts_max.push(ts.max());
         rows.ts_ci_lo.push(ci.map(|c| c.0));
         rows.ts_ci_hi.push(ci.map(|c| c.1));
         rows.res_mean.push(residual.mean());
-        rows.res_median.push(residual.median());
-        rows.res_p95.push(quantile(&residual, 0.95)?);
+        let res_sorted = sorted_values(&residual);
+        let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
+        rows.res_median.push(res_q(0.5));
+        rows.res_p95.push(res_q(0.95));
         rows.not_settled.push(count("not_settled"));
         rows.diverged.push(count("diverged"));
         rows.solver_failed.push(count("solver_failed"));
@@ -170,25 +151,4 @@ impl SummaryColumns {
             ],
         )
     }
-}
-
-/// Bootstrap standard error of a statistic of `values` (200 resamples, seeded).
-pub fn bootstrap_std_error(values: &[f64], statistic: impl Fn(&[f64]) -> f64, seed: u64) -> f64 {
-    const RESAMPLES: usize = 200;
-    if values.len() < 2 {
-        return 0.0;
-    }
-    let mut rng = stream(seed, None, 0, Purpose::Bootstrap);
-    let n = values.len();
-    let mut buf = vec![0.0; n];
-    let stats: Vec<f64> = (0..RESAMPLES)
-        .map(|_| {
-            for b in buf.iter_mut() {
-                *b = values[rng.random_range(0..n)];
-            }
-            statistic(&buf)
-        })
-        .collect();
-    let mean = stats.iter().sum::<f64>() / RESAMPLES as f64;
-    (stats.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (RESAMPLES - 1) as f64).sqrt()
 }

@@ -9,12 +9,12 @@
 
 use autobal::check::baseline::{BaselineError, read_baseline, write_baseline};
 use autobal::check::compare::{Metric, Verdict, compare};
-use autobal::check::holm::{holm_adjust, holm_reject};
-use autobal::check::ks::ks_two_sample;
-use autobal::check::median::mood_median_test;
-use autobal::check::proportion::fisher_two_proportions;
 use autobal::check::samples::design_samples;
 use autobal::check::study::{CheckError, CheckOptions, check_study, record_baseline};
+use autobal::stats::holm::{holm_adjust, holm_reject};
+use autobal::stats::ks::ks_two_sample;
+use autobal::stats::mood::mood_median_test;
+use autobal::stats::proportion::fisher_two_proportions;
 use autobal::study::config::{StudyFile, StudyPlan};
 use autobal::study::io::read_parquet;
 use autobal::study::record::to_dataframe;

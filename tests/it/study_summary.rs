@@ -2,9 +2,12 @@
 
 use crate::fixtures::SI_SCENE;
 use autobal::metrics::{Outcome, RunMetrics};
-use autobal::study::aggregate::{bootstrap_mean_ci, summarize, wilson_interval};
+use autobal::stats::bootstrap;
+use autobal::stats::interval::wilson_interval;
+use autobal::study::aggregate::summarize;
 use autobal::study::config::StudyFile;
 use autobal::study::record::RunRecord;
+use autobal::study::sample::{Purpose, stream};
 
 fn plan() -> autobal::study::config::StudyPlan {
     let text = &[
@@ -128,13 +131,15 @@ fn wilson_interval_matches_closed_forms() {
 #[test]
 fn bootstrap_is_seeded_and_brackets_the_mean() {
     let values: Vec<f64> = (1..=50).map(f64::from).collect();
-    let a = bootstrap_mean_ci(&values, 1, 0).unwrap();
-    assert_eq!(a, bootstrap_mean_ci(&values, 1, 0).unwrap());
-    assert_ne!(a, bootstrap_mean_ci(&values, 2, 0).unwrap());
+    // The stream summarize() uses for design 0 of a study seeded `seed`.
+    let ci = |seed| bootstrap::mean_ci(&values, &mut stream(seed, Some(0), 0, Purpose::Bootstrap));
+    let a = ci(1).unwrap();
+    assert_eq!(a, ci(1).unwrap());
+    assert_ne!(a, ci(2).unwrap());
     // Normal approximation: 25.5 ± 1.96·σ/√n with σ ≈ 14.58 → half-width ≈ 4.04.
     assert!(
         (a.0 - (25.5 - 4.04)).abs() < 1.0 && (a.1 - (25.5 + 4.04)).abs() < 1.0,
         "{a:?}"
     );
-    assert!(bootstrap_mean_ci(&[1.0], 1, 0).is_none());
+    assert!(bootstrap::mean_ci(&[1.0], &mut stream(1, Some(0), 0, Purpose::Bootstrap)).is_none());
 }

@@ -3,10 +3,10 @@
 //! small study at 1 and 2 threads, and print the figures.
 
 use crate::UserError;
+use crate::bench::peer::{PeerConfig, PeerReport};
+use crate::bench::threads::{ThreadConfig, ThreadScaling};
+use crate::bench::{self, BenchConfig, BenchReport};
 use crate::output::text_table;
-use autobal::bench::{
-    self, BenchConfig, BenchReport, PeerConfig, PeerReport, ThreadConfig, ThreadScaling,
-};
 use clap::Args;
 
 /// Examples shown under `study bench --help`.
@@ -58,7 +58,7 @@ pub struct BenchArgs {
 pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     if args.fidelity {
         let revs = if args.quick { 1000.0 } else { 10_000.0 };
-        let rows = autobal::bench::measure_fidelities(revs, 1e-6, if args.quick { 1 } else { 5 });
+        let rows = bench::fidelity::measure_fidelities(revs, 1e-6, if args.quick { 1 } else { 5 });
         if args.json {
             println!("{}", serde_json::to_string_pretty(&rows)?);
             return Ok(());
@@ -155,7 +155,7 @@ fn run_peer_cases(args: &BenchArgs) -> Result<(), UserError> {
     if let Some(repeats) = args.repeats {
         config.repeats = repeats;
     }
-    let report = bench::peer_cases(&config);
+    let report = bench::peer::peer_cases(&config);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -219,7 +219,7 @@ fn run_thread_scaling(args: &BenchArgs) -> Result<(), UserError> {
         config.samples = samples;
     }
     let dir = std::env::temp_dir().join(format!("autobal-bench-threads-{}", std::process::id()));
-    let result = bench::measure_threads(&config, &dir);
+    let result = bench::threads::measure_threads(&config, &dir);
     // The study's files are scratch: remove them whatever happened.
     let _ = std::fs::remove_dir_all(&dir);
     let report = result.map_err(|e| UserError::internal(e.to_string()))?;

@@ -2,6 +2,7 @@
 //! library, prints results on stdout and errors on stderr (exit code 2 for
 //! bad input).
 
+mod bench;
 mod bench_cmd;
 mod check_cmd;
 mod claims_cmd;

@@ -1,6 +1,6 @@
 //! Mood's median test with Fisher's exact p-value.
 //!
-//! The question is whether the typical residual vibration moved, i.e. the
+//! A regression check asks whether the typical residual vibration moved, i.e. the
 //! median, so the test is the one whose null hypothesis is exactly "equal
 //! medians": count the values above the grand median in each sample and
 //! compare the two proportions (a 2×2 table) with Fisher's exact test.
@@ -12,6 +12,7 @@
 //! The price is power: about 2/3 of Mann–Whitney's for a normal shift.
 
 use super::proportion::fisher_two_proportions;
+use super::quantile::median;
 
 /// Outcome of Mood's median test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,21 +27,6 @@ pub struct MedianResult {
     pub above: [u64; 2],
     /// Two-sided p-value (Fisher's exact test on the above/not-above table).
     pub p_value: f64,
-}
-
-/// Median (mean of the two middle values for an even count); None when empty.
-pub fn median(values: &[f64]) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
 }
 
 /// Mood's median test; None when either sample is empty or holds a NaN.

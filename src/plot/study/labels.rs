@@ -1,0 +1,129 @@
+//! How a study's designs are told apart in its figures: labels naming only
+//! the parameters that vary, colours or panels shared by one geometry, and
+//! the category axis that lists designs top to bottom.
+
+use super::DesignStats;
+use crate::plot::style::{TICK, short};
+
+/// How designs are told apart: the parameters that vary, and those that do not.
+pub(super) struct Labels {
+    /// One label per design, naming what varies.
+    pub per_design: Vec<String>,
+    /// What every design shares, for the caption.
+    pub common: String,
+}
+
+/// Per-design labels and the common part, from what varies across `designs`.
+pub(super) fn labels(designs: &[DesignStats]) -> Labels {
+    let varies = |f: &dyn Fn(&DesignStats) -> String| {
+        let first = f(&designs[0]);
+        designs.iter().any(|d| f(d) != first)
+    };
+    let weights = |d: &DesignStats| weight_count(d.n, &d.kind);
+    let rho = |d: &DesignStats| format!("ρ = {}", short(d.rho));
+    let drag = |d: &DesignStats| format!("β = {} N·s/m", short(d.drag));
+    let parts: [&dyn Fn(&DesignStats) -> String; 3] = [&weights, &rho, &drag];
+    let (vary, fixed): (Vec<_>, Vec<_>) = parts.iter().partition(|f| varies(**f));
+    let per_design = designs
+        .iter()
+        .map(|d| {
+            if vary.is_empty() {
+                format!("design {}", d.design_id)
+            } else {
+                vary.iter()
+                    .map(|f: &&dyn Fn(&DesignStats) -> String| f(d))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        })
+        .collect();
+    let common = fixed
+        .iter()
+        .map(|f| f(&designs[0]))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Labels { per_design, common }
+}
+
+/// "3 balls", "1 roller".
+pub(super) fn weight_count(n: u32, kind: &str) -> String {
+    if n == 1 {
+        format!("1 {kind}")
+    } else {
+        format!("{n} {kind}s")
+    }
+}
+
+/// Index of each design's geometry (kind, n, ρ): designs sharing it share a colour or panel.
+pub(super) fn geometries(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
+    let mut keys: Vec<(String, u32, f64)> = Vec::new();
+    let index = designs
+        .iter()
+        .map(|d| {
+            let key = (d.kind.clone(), d.n, d.rho);
+            match keys.iter().position(|k| *k == key) {
+                Some(i) => i,
+                None => {
+                    keys.push(key);
+                    keys.len() - 1
+                }
+            }
+        })
+        .collect();
+    let names = keys
+        .iter()
+        .map(|(kind, n, rho)| format!("{}, ρ = {}", weight_count(*n, kind), short(*rho)))
+        .collect();
+    (index, names)
+}
+
+/// Width in pixels to reserve for category labels of this many characters.
+pub(super) fn label_width(labels: &[String]) -> u32 {
+    let longest = labels.iter().map(|l| l.chars().count()).max().unwrap_or(4) as u32;
+    (longest * TICK * 58 / 100 + 24).max(60)
+}
+
+/// Figure height that gives every design a row.
+pub(super) fn category_height(count: usize) -> u32 {
+    (180 + 34 * count as u32).max(480)
+}
+
+/// Category axis: design i sits at y = count − 1 − i, so the first design is on top.
+pub(super) fn category_y(i: usize, count: usize) -> f64 {
+    (count - 1 - i) as f64
+}
+
+/// Tick labels of the category axis: the design's label at whole positions.
+pub(super) fn category_label(labels: &[String]) -> impl Fn(&f64) -> String + '_ {
+    move |v: &f64| {
+        let count = labels.len();
+        let k = v.round();
+        if (v - k).abs() > 1e-6 || k < 0.0 || k as usize >= count {
+            return String::new();
+        }
+        labels[count - 1 - k as usize].clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_name_only_what_varies() {
+        let d = |id, rho, drag| DesignStats {
+            design_id: id,
+            kind: "ball".into(),
+            n: 3,
+            rho,
+            drag,
+            runs: 10,
+            settled_fraction: 1.0,
+            settled_lo: 0.7,
+            settled_hi: 1.0,
+        };
+        let l = labels(&[d(0, 0.25, 2.0), d(1, 0.25, 5.0)]);
+        assert_eq!(l.per_design, vec!["β = 2 N·s/m", "β = 5 N·s/m"]);
+        assert_eq!(l.common, "3 balls, ρ = 0.25");
+    }
+}

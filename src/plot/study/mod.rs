@@ -1,0 +1,198 @@
+//! One study's figures, one file per figure: settling-time distributions
+//! per design ([`settling_time`]), the settled fraction with its Wilson
+//! intervals ([`settled_fraction`]), and settling time against the unbalance
+//! as a fraction of capacity ([`settling_vs_unbalance`]). This file reads the
+//! study's data and lists the figures; `labels.rs` names and groups designs.
+
+mod labels;
+pub mod settled_fraction;
+pub mod settling_time;
+pub mod settling_vs_unbalance;
+
+pub use settled_fraction::plot_settled_fraction;
+pub use settling_time::plot_settling_times;
+pub use settling_vs_unbalance::plot_settling_vs_unbalance;
+
+use super::{Format, PlotError};
+use crate::study::io::read_parquet;
+use crate::study::record::{RunRecord, from_dataframe};
+use polars::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// One row of `summary.parquet`, as much of it as the figures use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignStats {
+    /// Design index in grid order.
+    pub design_id: u32,
+    /// Balancer kind.
+    pub kind: String,
+    /// Number of weights.
+    pub n: u32,
+    /// Radius ratio ρ.
+    pub rho: f64,
+    /// Drag coefficient β (N·s/m).
+    pub drag: f64,
+    /// Runs of this design.
+    pub runs: u64,
+    /// Fraction of runs that settled.
+    pub settled_fraction: f64,
+    /// Lower end of its Wilson 95 % interval.
+    pub settled_lo: f64,
+    /// Upper end of its Wilson 95 % interval.
+    pub settled_hi: f64,
+}
+
+/// The rows of a summary DataFrame written by `study run`.
+pub fn design_stats(summary: &DataFrame) -> Result<Vec<DesignStats>, PlotError> {
+    let f64s = |name: &str| -> Result<Vec<f64>, PlotError> {
+        let c = summary.column(name)?.cast(&DataType::Float64)?;
+        c.f64()?
+            .iter()
+            .map(|v| v.ok_or_else(|| PlotError::invalid(name, "null value in summary")))
+            .collect()
+    };
+    let ids = summary.column("design_id")?.cast(&DataType::UInt32)?;
+    let ns = summary.column("n")?.cast(&DataType::UInt32)?;
+    let runs = summary.column("runs")?.cast(&DataType::UInt64)?;
+    let kinds = summary.column("kind")?.str()?.clone();
+    let (rho, drag) = (f64s("rho")?, f64s("drag")?);
+    let (frac, lo, hi) = (
+        f64s("settled_fraction")?,
+        f64s("settled_fraction_lo")?,
+        f64s("settled_fraction_hi")?,
+    );
+    let (ids, ns, runs) = (ids.u32()?, ns.u32()?, runs.u64()?);
+    (0..summary.height())
+        .map(|i| {
+            Ok(DesignStats {
+                design_id: ids
+                    .get(i)
+                    .ok_or_else(|| PlotError::invalid("design_id", "null"))?,
+                kind: kinds.get(i).unwrap_or_default().to_string(),
+                n: ns.get(i).ok_or_else(|| PlotError::invalid("n", "null"))?,
+                rho: rho[i],
+                drag: drag[i],
+                runs: runs.get(i).unwrap_or(0),
+                settled_fraction: frac[i],
+                settled_lo: lo[i],
+                settled_hi: hi[i],
+            })
+        })
+        .collect()
+}
+
+/// A study's runs and per-design statistics.
+#[derive(Debug, Clone)]
+pub struct StudyData {
+    /// The study's name (its folder name), used in titles.
+    pub name: String,
+    /// Every run, from `runs.parquet`.
+    pub runs: Vec<RunRecord>,
+    /// One entry per design, from `summary.parquet`.
+    pub designs: Vec<DesignStats>,
+}
+
+impl StudyData {
+    /// Read `runs.parquet` and `summary.parquet` from a study's output folder.
+    pub fn read(dir: &Path) -> Result<Self, PlotError> {
+        let open = |file: &str| {
+            let path = dir.join(file);
+            if !path.is_file() {
+                return Err(PlotError::invalid(
+                    path.display().to_string(),
+                    "not found: give the output folder of `study run`",
+                ));
+            }
+            read_parquet(&path)
+                .map_err(|e| PlotError::invalid(path.display().to_string(), e.to_string()))
+        };
+        let runs = from_dataframe(&open("runs.parquet")?)?;
+        let designs = design_stats(&open("summary.parquet")?)?;
+        let name = dir
+            .canonicalize()
+            .unwrap_or_else(|_| dir.to_path_buf())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "study".into());
+        Ok(StudyData {
+            name,
+            runs,
+            designs,
+        })
+    }
+
+    /// Refuse a study without designs or runs.
+    fn check(&self) -> Result<(), PlotError> {
+        if self.designs.is_empty() {
+            return Err(PlotError::NoData("the summary has no designs".into()));
+        }
+        if self.runs.is_empty() {
+            return Err(PlotError::NoData("the study has no runs".into()));
+        }
+        Ok(())
+    }
+
+    /// Settling times (revolutions) of the settled runs of one design.
+    fn settling_revs(&self, design_id: u32) -> Vec<f64> {
+        self.runs
+            .iter()
+            .filter(|r| r.design_id == design_id && r.metrics.settled)
+            .filter_map(|r| r.metrics.settling_revs)
+            .filter(|v| v.is_finite())
+            .collect()
+    }
+}
+
+/// The three figures of a study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StudyFigure {
+    /// Settling-time box plots per design.
+    SettlingTime,
+    /// Settled fraction per design with Wilson intervals.
+    SettledFraction,
+    /// Settling time against unbalance / capacity.
+    SettlingVsUnbalance,
+}
+
+impl StudyFigure {
+    /// All three, in the order [`plot_study`] writes them.
+    pub const ALL: [StudyFigure; 3] = [
+        StudyFigure::SettlingTime,
+        StudyFigure::SettledFraction,
+        StudyFigure::SettlingVsUnbalance,
+    ];
+
+    /// The file name without extension.
+    pub fn file_stem(self) -> &'static str {
+        match self {
+            StudyFigure::SettlingTime => "settling_time",
+            StudyFigure::SettledFraction => "settled_fraction",
+            StudyFigure::SettlingVsUnbalance => "settling_vs_unbalance",
+        }
+    }
+
+    /// Draw this figure of `data` into `path` (.svg or .png).
+    pub fn plot(self, data: &StudyData, path: &Path) -> Result<(), PlotError> {
+        match self {
+            StudyFigure::SettlingTime => plot_settling_times(data, path),
+            StudyFigure::SettledFraction => plot_settled_fraction(data, path),
+            StudyFigure::SettlingVsUnbalance => plot_settling_vs_unbalance(data, path),
+        }
+    }
+}
+
+/// Write `figures` into `out_dir` as `<file_stem>.<format>`; returns their paths.
+pub fn plot_study(
+    data: &StudyData,
+    out_dir: &Path,
+    format: Format,
+    figures: &[StudyFigure],
+) -> Result<Vec<PathBuf>, PlotError> {
+    figures
+        .iter()
+        .map(|figure| {
+            let path = out_dir.join(format!("{}.{}", figure.file_stem(), format.extension()));
+            figure.plot(data, &path).map(|()| path)
+        })
+        .collect()
+}

@@ -1,0 +1,123 @@
+//! Settled fraction per design with its Wilson 95 % interval.
+
+use super::StudyData;
+use super::labels::{
+    Labels, category_height, category_label, category_y, geometries, label_width, labels,
+};
+use crate::plot::PlotError;
+use crate::plot::style::{self, Figure, TICK, colour, linear_label, text};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Settled fraction per design with Wilson 95 % intervals.
+struct SettledFraction<'a> {
+    data: &'a StudyData,
+    labels: Labels,
+}
+
+/// Write the settled fraction per design, with intervals, to `path` (.svg or .png).
+pub fn plot_settled_fraction(data: &StudyData, path: &Path) -> Result<(), PlotError> {
+    data.check()?;
+    for d in &data.designs {
+        let ok = |v: f64| (0.0..=1.0).contains(&v);
+        if !(ok(d.settled_fraction) && ok(d.settled_lo) && ok(d.settled_hi)) {
+            return Err(PlotError::invalid(
+                format!("design {} settled_fraction", d.design_id),
+                "fractions and their interval must lie in [0, 1]",
+            ));
+        }
+    }
+    let figure = SettledFraction {
+        data,
+        labels: labels(&data.designs),
+    };
+    style::render(&figure, path)
+}
+
+impl Figure for SettledFraction<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1100, category_height(self.data.designs.len()))
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
+        let designs = &self.data.designs;
+        let count = designs.len();
+        let lowest = designs.iter().map(|d| d.settled_lo).fold(1.0f64, f64::min);
+        // Zoom in when every design settles nearly always, or the intervals vanish.
+        let x_lo = ((lowest - 0.02) * 10.0).floor().max(0.0) / 10.0;
+        let x_lo = if x_lo > 0.9 {
+            ((lowest - 0.005) * 100.0).floor() / 100.0
+        } else {
+            x_lo
+        };
+        let runs: Vec<u64> = designs.iter().map(|d| d.runs).collect();
+        let runs_text = if runs.iter().all(|r| *r == runs[0]) {
+            format!("{} runs per design", runs[0])
+        } else {
+            "runs per design vary".to_string()
+        };
+        let caption = format!(
+            "{}{}dot: fraction settled, bar: Wilson 95 % interval; {runs_text}",
+            self.labels.common,
+            if self.labels.common.is_empty() {
+                ""
+            } else {
+                ";  "
+            }
+        );
+        let title = format!("{}: fraction of runs that settled", self.data.name);
+        let body = root.titled(&title, text(style::TITLE))?;
+        let key_points: Vec<f64> = (0..count).map(|i| i as f64).collect();
+        let label = category_label(&self.labels.per_design);
+        let mut chart = ChartBuilder::on(&body)
+            .caption(caption, text(TICK))
+            .margin(16)
+            .margin_right(30)
+            .x_label_area_size(52)
+            .y_label_area_size(label_width(&self.labels.per_design))
+            .build_cartesian_2d(
+                x_lo..1.0 + (1.0 - x_lo) * 0.02,
+                style::fixed_ticks(-0.6..count as f64 - 0.4, key_points),
+            )?;
+        chart
+            .configure_mesh()
+            .x_desc("settled fraction  (–)")
+            .y_desc("design")
+            .axis_desc_style(text(style::AXIS))
+            .label_style(text(TICK))
+            .x_label_formatter(&|v| {
+                if *v > 1.0 {
+                    String::new()
+                } else {
+                    linear_label(v)
+                }
+            })
+            .y_label_formatter(&label)
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.08))
+            .draw()?;
+        let (group, _) = geometries(designs);
+        for (i, d) in designs.iter().enumerate() {
+            let y = category_y(i, count);
+            let c = colour(group[i]);
+            let h = 0.22;
+            chart.draw_series([
+                PathElement::new(
+                    vec![(d.settled_lo, y), (d.settled_hi, y)],
+                    c.stroke_width(2),
+                ),
+                PathElement::new(
+                    vec![(d.settled_lo, y - h), (d.settled_lo, y + h)],
+                    c.stroke_width(2),
+                ),
+                PathElement::new(
+                    vec![(d.settled_hi, y - h), (d.settled_hi, y + h)],
+                    c.stroke_width(2),
+                ),
+            ])?;
+            chart.draw_series([Circle::new((d.settled_fraction, y), 5, c.filled())])?;
+        }
+        Ok(())
+    }
+}

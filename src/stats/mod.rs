@@ -1,0 +1,16 @@
+//! General-purpose statistics, each defined once: quantiles and the median
+//! ([`quantile`]), intervals of a proportion ([`interval`]), the bootstrap
+//! ([`bootstrap`]), and the two-sample tests and multiple-testing correction
+//! that regression checks are built from ([`ks`], [`proportion`], [`mood`],
+//! [`holm`]).
+//!
+//! Nothing here knows about rotors or studies; the analyses (`study`,
+//! `check`, `optimize`, `plot`, `tradeoff`) bring the data.
+
+pub mod bootstrap;
+pub mod holm;
+pub mod interval;
+pub mod ks;
+pub mod mood;
+pub mod proportion;
+pub mod quantile;
