@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
-"""Import cycles and layer violations between the modules of src/model.
+"""Import cycles and layer violations between the modules of the library.
 
-A "unit" is a direct child of `model` (a file such as scene.rs, or a folder
-such as rotor/ together with everything below it): edges inside a unit (a
-model file using its folder's mod.rs and the re-exports back) are how Rust
-folders work and are not counted. Every `use` tree and every inline
-`crate::…`/`super::…` path outside comments and strings is an edge.
+Two levels are checked: the crate's top modules (design, model, integrate,
+study, ...), and the units inside `model`. A "unit" is a direct child of its
+parent (a file such as scene.rs, or a folder such as rotor/ together with
+everything below it): edges inside a unit (a file using its folder's mod.rs
+and the re-exports back) are how Rust folders work and are not counted.
+Every `use` tree and every inline `crate::…`/`super::…` path outside
+comments and strings is an edge.
 
-Exits 1 when the unit graph has a cycle or a lower layer imports an upper
-one, so it can run in CI: python3 scripts/module-cycles.py
+Exits 1 when either graph has a cycle or a module imports one from a higher
+layer, so it can run in CI: python3 scripts/module-cycles.py
 """
 
 import re
@@ -16,11 +18,21 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent / "src"
-MODEL = ROOT / "model"
 
-# Lower layers may be imported by anything; they must not import the upper ones.
-LOWER = {"validate", "cargo", "speed", "rotor", "effect", "balancer"}
-UPPER = {"system", "frame", "scene"}
+# Layers, lowest first: a module may import its own layer and the ones below.
+CRATE_LAYERS = [
+    {"stats", "design", "integrate"},
+    {"model"},
+    {"metrics"},
+    {"simulation", "scene_file"},
+    {"study"},
+    {"optimize", "claims", "tradeoff", "check", "plot"},
+]
+MODEL_LAYERS = [
+    {"validate", "cargo", "speed", "rotor", "effect", "balancer"},
+    {"system", "frame", "scene", "forced", "invariants", "linear", "quasi_static", "start",
+     "unbalance", "zero_approx"},
+]
 
 CODE_NOISE = re.compile(
     r'//[^\n]*|/\*.*?\*/|r#*"(?:.|\n)*?"#*|"(?:\\.|[^"\\])*"|\'(?:\\.|[^\'\\])\'',
@@ -87,9 +99,8 @@ def resolve(path: str, here: tuple, modules: set):
     return None
 
 
-def main() -> int:
-    files = sorted(MODEL.rglob("*.rs"))
-    modules = {module_path(f) for f in files} | {("model",)}
+def analyse(files, modules, depth: int, title: str, layers) -> int:
+    """Edges between the units at `depth` (0: crate modules, 1: inside one)."""
     edges = {}
     for f in files:
         here = module_path(f)
@@ -99,16 +110,18 @@ def main() -> int:
         paths += [re.sub(r"\s+", "", m) for m in INLINE.findall(code_wo_use)]
         for p in paths:
             target = resolve(p, here, modules)
-            if not target or target[0] != "model" or len(target) < 2 or len(here) < 2:
+            if not target or len(target) <= depth or len(here) <= depth:
                 continue
-            a, b = here[1], target[1]
+            if target[:depth] != here[:depth]:
+                continue
+            a, b = here[depth], target[depth]
             if a != b:
                 edges.setdefault(a, {}).setdefault(b, set()).add(
                     "/".join(f.relative_to(ROOT).parts)
                 )
-    units = sorted({module_path(f)[1] for f in files if len(module_path(f)) > 1})
+    units = sorted({module_path(f)[depth] for f in files if len(module_path(f)) > depth})
 
-    print("model unit -> units it imports")
+    print(f"{title} -> units it imports")
     for u in units:
         print(f"  {u:13} -> {', '.join(sorted(edges.get(u, {}))) or '-'}")
 
@@ -141,7 +154,12 @@ def main() -> int:
         if u not in index:
             visit(u)
 
+    level = {u: i for i, layer in enumerate(layers) for u in layer}
     bad = 0
+    for u in units:
+        if u not in level and u not in ("lib", "main"):
+            bad += 1
+            print(f"UNPLACED: {u} is in no layer (add it to the script's layer list)")
     for comp in sccs:
         bad += 1
         print(f"CYCLE among: {', '.join(comp)}")
@@ -149,12 +167,21 @@ def main() -> int:
             for b in comp:
                 if b in edges.get(a, {}):
                     print(f"  {a} -> {b}  ({', '.join(sorted(edges[a][b]))})")
-    for a in sorted(LOWER):
-        for b in sorted(edges.get(a, {})):
-            if b in UPPER:
+    for a in sorted(edges):
+        for b in sorted(edges[a]):
+            if a in level and b in level and level[b] > level[a]:
                 bad += 1
-                print(f"LAYER: lower {a} imports upper {b}  ({', '.join(sorted(edges[a][b]))})")
+                print(f"LAYER: {a} imports higher {b}  ({', '.join(sorted(edges[a][b]))})")
     print("no cycles, layers respected" if not bad else f"{bad} problem(s)")
+    return bad
+
+
+def main() -> int:
+    files = sorted(p for p in ROOT.rglob("*.rs") if "bin" not in p.relative_to(ROOT).parts)
+    modules = {module_path(f) for f in files}
+    bad = analyse(files, modules, 0, "crate module", CRATE_LAYERS)
+    model_files = [f for f in files if module_path(f)[:1] == ("model",)]
+    bad += analyse(model_files, modules, 1, "model unit", MODEL_LAYERS)
     return 1 if bad else 0
 
 

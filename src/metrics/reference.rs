@@ -6,17 +6,9 @@ use crate::model::rotor::MAX_DOF;
 use crate::model::start::is_plane_translation;
 use crate::model::system::RotorSystem;
 
-/// Reference unbalance U: the size of the rotor's own unbalance (M e for the
-/// plane rotor, the largest bearing-equivalent one on two supports), or
-/// Σ m l when the rotor has none.
-pub fn reference_unbalance(system: &RotorSystem) -> f64 {
-    let own = system.rotor().own_unbalance();
-    if own > 0.0 {
-        own
-    } else {
-        system.cargo().iter().map(|c| c.unbalance()).sum::<f64>()
-    }
-}
+// The unbalance measures are model quantities (the linear analysis needs
+// them too); they are defined there and named here with the other scales.
+pub use crate::model::unbalance::{balancing_error, reference_unbalance};
 
 /// A_ref at speed ω: the largest balancer-plane orbit radius of the locked
 /// response to the rotor's own unbalance (to U in plane 0 when it has none),
@@ -82,16 +74,4 @@ pub fn vibration(system: &RotorSystem, q: &[f64]) -> f64 {
                 acc.max(r)
             }
         })
-}
-
-/// Balancing error ε: size of the total unbalance of rotor and cargoes (at
-/// angles ψ relative to the rotor) over U; for the plane rotor
-/// |Σ m_j l_j e^{iψ_j} + M e e^{iψ₀}| / U.
-pub fn balancing_error(system: &RotorSystem, psi: &[f64], unbalance_ref: f64) -> f64 {
-    if is_plane_translation(system) {
-        let (ux, uy) = crate::model::start::total_unbalance(system, psi);
-        return ux.hypot(uy) / unbalance_ref;
-    }
-    let (fc, _) = unbalance_forcing(system, psi, true);
-    system.rotor().unbalance_size(&fc) / unbalance_ref
 }

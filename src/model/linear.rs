@@ -303,7 +303,7 @@ pub fn analyse(system: &RotorSystem, psi0: Option<&[f64]>) -> Result<LinearRepor
         });
     let lay = system.layout();
     let psi = &z[lay.rotor_dof..lay.nq()];
-    let u_ref = crate::metrics::reference::reference_unbalance(system);
+    let u_ref = crate::model::unbalance::reference_unbalance(system);
     Ok(LinearReport {
         omega: frame.omega,
         stable: decay > 0.0,
@@ -311,7 +311,7 @@ pub fn analyse(system: &RotorSystem, psi0: Option<&[f64]>) -> Result<LinearRepor
         slowest,
         eigenvalues: eig,
         neutral: neutral.len(),
-        balancing_error: crate::metrics::reference::balancing_error(system, psi, u_ref),
+        balancing_error: crate::model::unbalance::balancing_error(system, psi, u_ref),
         state: z,
     })
 }

@@ -26,5 +26,6 @@ pub mod scene;
 pub mod speed;
 pub mod start;
 pub mod system;
+pub mod unbalance;
 pub mod validate;
 pub mod zero_approx;

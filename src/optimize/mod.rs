@@ -9,7 +9,9 @@
 
 pub mod evaluate;
 pub mod search;
-pub mod spec;
+/// The `[optimize]` table is part of the study file, so it lives with the
+/// study schema; named here as well, where it is used.
+pub use crate::study::optimize_spec as spec;
 
 use crate::design::complete::{best_per_n_optimum, complete_optimization};
 use crate::study::config::StudyPlan;

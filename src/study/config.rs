@@ -47,7 +47,7 @@ pub struct StudyFile {
     pub metrics: MetricOptions,
     /// Settings of `study optimize` (ignored by `study run`).
     #[serde(default)]
-    pub optimize: Option<crate::optimize::spec::OptimizeSpec>,
+    pub optimize: Option<super::optimize_spec::OptimizeSpec>,
 }
 
 fn default_seed() -> u64 {

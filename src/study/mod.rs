@@ -15,6 +15,7 @@ pub mod aggregate;
 pub mod config;
 pub mod io;
 pub mod merge;
+pub mod optimize_spec;
 pub mod record;
 pub mod run;
 pub mod sample;
