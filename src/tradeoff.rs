@@ -100,16 +100,16 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
     let mut v = Vec::new();
     let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
     let mut frames = vec![
-        (Fidelity::Full, MethodChoice::Dp5),
-        (Fidelity::Full, MethodChoice::Dop853),
+        (Fidelity::Full, MethodChoice::Fixed(Method::Dp5)),
+        (Fidelity::Full, MethodChoice::Fixed(Method::Dop853)),
     ];
     // The estimates hold where the rotating frame is exact (isotropic, constant
     // speed, no in-plane gravity); elsewhere they do not apply at all.
     if rotating_frame_obstacle(&probe).is_none() {
         v.push(estimate(Fidelity::Analytic));
         v.push(estimate(Fidelity::Linear));
-        frames.push((Fidelity::Rotating, MethodChoice::Radau5));
-        frames.push((Fidelity::Rotating, MethodChoice::Dp5));
+        frames.push((Fidelity::Rotating, MethodChoice::Fixed(Method::Radau5)));
+        frames.push((Fidelity::Rotating, MethodChoice::Fixed(Method::Dp5)));
     }
     for (fidelity, method) in frames {
         for e in 3..=10 {
@@ -161,7 +161,7 @@ fn sorted_angles(m: &RunMetrics) -> Vec<f64> {
 pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
     let reference = Setting {
         fidelity: Fidelity::Full,
-        method: MethodChoice::Dop853,
+        method: MethodChoice::Fixed(Method::Dop853),
         rtol: 1e-11,
     };
     let mut rows = Vec::new();

@@ -383,6 +383,7 @@ impl Radau5 {
 
 impl Stepper for Radau5 {
     const METHOD: Method = Method::Radau5;
+    const IMPLICIT: bool = true;
 
     fn new(n: usize, options: &SolverOptions) -> Self {
         let k = Coeffs::new();

@@ -34,6 +34,8 @@ pub enum Trial {
 pub trait Stepper: Sized {
     /// The method this stepper implements.
     const METHOD: Method;
+    /// Implicit methods need no stiffness watch and are what explicit ones hand over to.
+    const IMPLICIT: bool = false;
 
     /// A stepper for a system of `dim` components with these options; every
     /// work vector is allocated here, once for the whole run.

@@ -10,7 +10,7 @@ pub mod settings;
 
 pub use settings::{Fidelity, MethodChoice, SolverSettings, scaled_atol};
 
-use crate::integrate::{Method, OdeSystem, SolverOptions, Stiffness, solve};
+use crate::integrate::{IMPLICIT_FALLBACK, OdeSystem, SolverOptions, Stiffness, solve};
 use crate::metrics::observer::{Series, SettlingObserver};
 use crate::metrics::{MetricOptions, RunMetrics};
 use crate::model::frame::{RotatingSystem, rotating_frame_obstacle};
@@ -97,7 +97,7 @@ impl Simulation {
         let omega = self.scene.speed.nominal_speed();
         let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
         let method = self.solver.method.resolve(frame.is_some());
-        let explicit = method != Method::Radau5;
+        let explicit = !method.is_implicit();
         let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);
         if let Some(w) = frame {
             observer = observer.in_rotating_frame(w);
@@ -118,7 +118,7 @@ impl Simulation {
         let (mut metrics, series) = observer.finish(&report);
         metrics.method = method.name().to_string();
         if let Some(switch) = &report.switched {
-            metrics.method = format!("{}→{}", switch.from.name(), Method::Radau5.name());
+            metrics.method = format!("{}→{}", switch.from.name(), IMPLICIT_FALLBACK.name());
             metrics.reason = format!(
                 "{} (switched to radau5 at t = {:.4}: {})",
                 metrics.reason, switch.t, switch.why

@@ -61,19 +61,15 @@ pub fn scaled_atol(system: &RotorSystem, atol: f64, a_ref: f64, omega: f64) -> V
     v
 }
 
-/// The integrator a study asks for.
+/// The integrator a study asks for: `"auto"` or any method's name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
+#[serde(try_from = "String", into = "String")]
 pub enum MethodChoice {
     /// dp5 for the inertial frame, radau5 for the rotating frame.
     #[default]
     Auto,
-    /// Dormand–Prince 5(4).
-    Dp5,
-    /// Dormand–Prince 8(5,3).
-    Dop853,
-    /// Radau IIA order 5.
-    Radau5,
+    /// That method in every frame.
+    Fixed(Method),
 }
 
 impl MethodChoice {
@@ -81,20 +77,40 @@ impl MethodChoice {
     pub fn resolve(self, rotating: bool) -> Method {
         match self {
             MethodChoice::Auto if rotating => Method::Radau5,
-            MethodChoice::Auto | MethodChoice::Dp5 => Method::Dp5,
-            MethodChoice::Dop853 => Method::Dop853,
-            MethodChoice::Radau5 => Method::Radau5,
+            MethodChoice::Auto => Method::Dp5,
+            MethodChoice::Fixed(method) => method,
         }
     }
 
-    /// snake_case name.
+    /// Name in files: "auto" or the method's.
     pub fn name(self) -> &'static str {
         match self {
             MethodChoice::Auto => "auto",
-            MethodChoice::Dp5 => "dp5",
-            MethodChoice::Dop853 => "dop853",
-            MethodChoice::Radau5 => "radau5",
+            MethodChoice::Fixed(method) => method.name(),
         }
+    }
+}
+
+impl TryFrom<String> for MethodChoice {
+    type Error = String;
+
+    fn try_from(name: String) -> Result<Self, String> {
+        if name == "auto" {
+            return Ok(MethodChoice::Auto);
+        }
+        name.parse().map(MethodChoice::Fixed).map_err(|_| {
+            let known: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            format!(
+                "unknown method `{name}`, expected `auto` or one of `{}`",
+                known.join("`, `")
+            )
+        })
+    }
+}
+
+impl From<MethodChoice> for String {
+    fn from(choice: MethodChoice) -> String {
+        choice.name().to_string()
     }
 }
 

@@ -8,6 +8,7 @@
 //! change regenerates them with `AUTOBAL_BLESS=1 cargo test golden` and lists
 //! the before/after figures in its commit message.
 
+use autobal::integrate::Method;
 use autobal::scene_file::SceneFile;
 use autobal::simulation::{Fidelity, MethodChoice};
 use autobal::study::aggregate::summarize;
@@ -98,9 +99,9 @@ fn scene_text(path: &Path) -> String {
     );
     for fidelity in [Fidelity::Rotating, Fidelity::Full] {
         for method in [
-            MethodChoice::Dp5,
-            MethodChoice::Dop853,
-            MethodChoice::Radau5,
+            MethodChoice::Fixed(Method::Dp5),
+            MethodChoice::Fixed(Method::Dop853),
+            MethodChoice::Fixed(Method::Radau5),
         ] {
             let mut variant = simulation.clone();
             variant.solver.fidelity = fidelity;
