@@ -9,12 +9,21 @@ use super::{Effect, EffectContext, Forces, IntrinsicEffect};
 use crate::model::cargo::Cargo;
 
 /// Viscous drag of every cargo relative to the rotor.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Drag;
+#[derive(Debug, Clone, PartialEq)]
+pub struct Drag {
+    /// β_j l_j² per cargo, computed once per run: (β·l)·l is exactly the
+    /// product the right-hand side used to form per call, so it is bit-identical.
+    coefficient: Vec<f64>,
+}
 
 impl IntrinsicEffect for Drag {
     fn from_cargo(cargo: &[Cargo], _omega: f64) -> Option<Self> {
-        cargo.iter().any(|c| c.drag != 0.0).then_some(Drag)
+        cargo.iter().any(|c| c.drag != 0.0).then(|| Drag {
+            coefficient: cargo
+                .iter()
+                .map(|c| c.drag * c.track_radius * c.track_radius)
+                .collect(),
+        })
     }
 }
 
@@ -24,12 +33,18 @@ impl Effect for Drag {
     }
 
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
-        for (j, c) in ctx.cargo.iter().enumerate() {
-            // Same products in the same order as before drag was an effect:
-            // results stay bit-identical.
-            let drag = c.drag * c.track_radius * c.track_radius * ctx.psi_rate[j];
-            forces.cargo[j] -= drag;
-            *forces.spin += drag;
+        // The reaction on the spin is summed in cargo order, as it always was.
+        let mut spin = *forces.spin;
+        for ((f, k), rate) in forces
+            .cargo
+            .iter_mut()
+            .zip(&self.coefficient)
+            .zip(ctx.psi_rate)
+        {
+            let drag = k * rate;
+            *f -= drag;
+            spin += drag;
         }
+        *forces.spin = spin;
     }
 }
