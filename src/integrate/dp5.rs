@@ -134,8 +134,10 @@ impl Stepper for Dp5 {
         stats: &mut Stats,
     ) -> Trial {
         let n = y.len();
-        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
-        let (ystage, y1) = (&mut self.ystage, &mut self.y1);
+        // Slices, not `&mut Vec`: their length and pointer stay in registers
+        // across the right-hand-side calls.
+        let [k1, k2, k3, k4, k5, k6, k7] = self.k.each_mut().map(|v| v.as_mut_slice());
+        let (ystage, y1) = (self.ystage.as_mut_slice(), self.y1.as_mut_slice());
         for i in 0..n {
             ystage[i] = y[i] + h * A21 * k1[i];
         }
@@ -164,7 +166,7 @@ impl Stepper for Dp5 {
         }
         system.rhs(t_new, y1, k7);
         stats.rhs_calls += 6;
-        let err = &mut self.err;
+        let err = self.err.as_mut_slice();
         for i in 0..n {
             err[i] =
                 h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);

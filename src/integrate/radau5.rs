@@ -256,9 +256,12 @@ impl Radau5 {
         let n = y.len();
         let k = &self.k;
         let t_new = t + h;
-        let [z1, z2, z3] = &mut self.z;
-        let [f1, f2, f3] = &mut self.f;
-        let tmp = &mut self.tmp;
+        // Slices, not `&mut Vec`: their length and pointer stay in registers
+        // across the right-hand-side calls.
+        let [z1, z2, z3] = self.z.each_mut().map(|v| v.as_mut_slice());
+        let [f1, f2, f3] = self.f.each_mut().map(|v| v.as_mut_slice());
+        let tmp = self.tmp.as_mut_slice();
+        let scal = self.scal.as_slice();
         if self.first {
             for v in [&mut *z1, &mut *z2, &mut *z3, &mut *f1, &mut *f2, &mut *f3] {
                 v.fill(0.0);
@@ -312,7 +315,6 @@ impl Radau5 {
             self.e2.solve(z2, z3);
             newt += 1;
             let dyno = {
-                let scal = &self.scal;
                 let s: f64 = (0..n)
                     .map(|i| {
                         let (a, b, c) = (z1[i] / scal[i], z2[i] / scal[i], z3[i] / scal[i]);
@@ -504,9 +506,9 @@ impl Stepper for Radau5 {
 
         // The embedded error estimate, filtered through (γ/h·I − J)⁻¹.
         let k = &self.k;
-        let [z1, z2, z3] = &self.z;
-        let [f1, f2, _] = &mut self.f;
-        let tmp = &mut self.tmp;
+        let [z1, z2, z3] = self.z.each_ref().map(|v| v.as_slice());
+        let [f1, f2, _] = self.f.each_mut().map(|v| v.as_mut_slice());
+        let tmp = self.tmp.as_mut_slice();
         let [d1, d2, d3] = [k.dd[0] / h, k.dd[1] / h, k.dd[2] / h];
         for i in 0..n {
             f2[i] = d1 * z1[i] + d2 * z2[i] + d3 * z3[i];
