@@ -30,7 +30,7 @@ CRATE_LAYERS = [
 ]
 MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer"},
-    {"system", "frame", "scene", "forced", "invariants", "linear", "quasi_static", "start",
+    {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "quasi_static", "start",
      "unbalance", "zero_approx"},
 ]
 

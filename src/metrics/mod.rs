@@ -128,6 +128,12 @@ pub struct RunMetrics {
     pub method: String,
     /// Formulation that produced it ("rotating", "full", "analytic").
     pub fidelity: String,
+    /// Smallest gap between two weights of one plane over the sampled run
+    /// (rad of centre angle beyond touching, 2α); negative: they overlapped.
+    /// `None` for point masses, which have no size.
+    pub min_gap_rad: Option<f64>,
+    /// The same gap at the end of the run.
+    pub final_min_gap_rad: Option<f64>,
 }
 
 impl RunMetrics {
@@ -156,6 +162,8 @@ impl RunMetrics {
             rhs_calls: 0,
             method: method.to_string(),
             fidelity: String::new(),
+            min_gap_rad: None,
+            final_min_gap_rad: None,
         }
     }
 }

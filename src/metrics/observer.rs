@@ -5,6 +5,7 @@ use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, SolveReport, Status, Step, StepObserver};
+use crate::model::gap::GapGauge;
 use crate::model::system::RotorSystem;
 use std::f64::consts::PI;
 
@@ -74,6 +75,8 @@ pub struct SettlingObserver<'a> {
     r_hold: Hold,
     eps_hold: Hold,
     peak_r: f64,
+    gap: Option<GapGauge>,
+    min_gap: f64,
     diverged: Option<String>,
     series: Option<Series>,
     frame: Option<f64>,
@@ -109,6 +112,8 @@ impl<'a> SettlingObserver<'a> {
             r_hold: Hold::default(),
             eps_hold: Hold::default(),
             peak_r: 0.0,
+            gap: GapGauge::new(system.cargo()),
+            min_gap: f64::INFINITY,
             diverged: None,
             series: record.then(|| Series {
                 psi: vec![Vec::new(); system.cargo().len()],
@@ -136,6 +141,9 @@ impl<'a> SettlingObserver<'a> {
             return Flow::Stop;
         }
         self.peak_r = self.peak_r.max(r);
+        if let Some(gauge) = &self.gap {
+            self.min_gap = self.min_gap.min(gauge.min_gap(psi));
+        }
         if r > self.options.divergence_factor * self.a_ref {
             self.diverged = Some(format!(
                 "r = {r:.3e} exceeded {} A_ref at t = {t:.4}",
@@ -252,6 +260,8 @@ impl<'a> SettlingObserver<'a> {
             rhs_calls: report.stats.rhs_calls,
             method: String::new(),
             fidelity: String::new(),
+            min_gap_rad: self.gap.as_ref().map(|_| self.min_gap),
+            final_min_gap_rad: self.gap.as_ref().map(|g| g.min_gap(psi)),
         };
         (metrics, self.series)
     }

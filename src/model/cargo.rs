@@ -46,6 +46,16 @@ impl Cargo {
         self.mass * self.track_radius
     }
 
+    /// Half the smallest centre angle α = asin(r/l) at which this weight
+    /// touches a neighbour of its own size (0 for a point mass).
+    pub fn contact_half_angle(&self) -> f64 {
+        if self.radius > 0.0 {
+            (self.radius / self.track_radius).min(1.0).asin()
+        } else {
+            0.0
+        }
+    }
+
     /// A pendulum-like cargo with a given κ and no rolling coupling (for tests and custom designs).
     pub fn point(mass: f64, track_radius: f64, drag: f64, kappa: f64) -> Self {
         Cargo {

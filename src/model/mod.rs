@@ -18,6 +18,7 @@ pub mod cargo;
 pub mod effect;
 pub mod forced;
 pub mod frame;
+pub mod gap;
 pub mod invariants;
 pub mod linear;
 pub mod quasi_static;

@@ -81,6 +81,11 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         rows.not_settled.push(count("not_settled"));
         rows.diverged.push(count("diverged"));
         rows.solver_failed.push(count("solver_failed"));
+        // Whether the weights were solid, and how close they came in the
+        // worst run (negative: they overlapped).
+        let contact = mine.column("contact")?.bool()?.clone();
+        rows.contact.push(contact.all());
+        rows.min_gap.push(mine.column("min_gap_rad")?.f64()?.min());
     }
     rows.into_dataframe()
 }
@@ -114,6 +119,8 @@ struct SummaryColumns {
     not_settled: Vec<u64>,
     diverged: Vec<u64>,
     solver_failed: Vec<u64>,
+    contact: Vec<bool>,
+    min_gap: Vec<Option<f64>>,
 }
 
 impl SummaryColumns {
@@ -148,6 +155,8 @@ impl SummaryColumns {
                 Column::new("not_settled".into(), self.not_settled),
                 Column::new("diverged".into(), self.diverged),
                 Column::new("solver_failed".into(), self.solver_failed),
+                Column::new("contact".into(), self.contact),
+                Column::new("min_gap_rad".into(), self.min_gap),
             ],
         )
     }

@@ -39,6 +39,9 @@ pub struct RunRecord {
     pub metrics: RunMetrics,
     /// Integrator used.
     pub method: String,
+    /// Whether contact between the weights was on (it is unless the study
+    /// switched it off; off, weights may pass through each other).
+    pub contact: bool,
     /// Wall-clock time of the run (s); excluded from determinism checks.
     pub wall_time_s: f64,
 }
@@ -104,6 +107,11 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("rhs_calls", |r: &RunRecord| r.metrics.rhs_calls),
         col!("method", |r: &RunRecord| r.method.clone()),
         col!("fidelity", |r: &RunRecord| r.metrics.fidelity.clone()),
+        col!("contact", |r: &RunRecord| r.contact),
+        col!("min_gap_rad", |r: &RunRecord| r.metrics.min_gap_rad),
+        col!("final_min_gap_rad", |r: &RunRecord| r
+            .metrics
+            .final_min_gap_rad),
         col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
     ];
     DataFrame::new(rows.len(), columns)
@@ -213,6 +221,8 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     );
     let (steps, rhs, wall) = (u64s("steps")?, u64s("rhs_calls")?, req("wall_time_s")?);
     let fidelity = strs("fidelity")?;
+    let contact = bools("contact")?;
+    let (min_gap, final_gap) = (f64s("min_gap_rad")?, f64s("final_min_gap_rad")?);
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -251,7 +261,10 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 rhs_calls: rhs[i],
                 method: method[i].clone(),
                 fidelity: fidelity[i].clone(),
+                min_gap_rad: min_gap[i],
+                final_min_gap_rad: final_gap[i],
             },
+            contact: contact[i],
             method: method[i].clone(),
             wall_time_s: wall[i],
         });

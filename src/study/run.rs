@@ -179,8 +179,10 @@ pub fn run_design_sample(
     run_id: u64,
 ) -> RunRecord {
     let sample = draw_sample(plan, design, sample_id);
+    let scene = plan.scene(design, sample.unbalance, sample.direction);
+    let contact = scene.effects.contact.as_ref().is_some_and(|c| c.enabled);
     let simulation = Simulation {
-        scene: plan.scene(design, sample.unbalance, sample.direction),
+        scene,
         start: plan.file.scene.start,
         initial_angles: sample.initial_angles.clone(),
         solver: plan.file.solver.clone(),
@@ -225,6 +227,7 @@ pub fn run_design_sample(
             metrics.method.clone()
         },
         metrics,
+        contact,
         wall_time_s: clock.elapsed().as_secs_f64(),
     }
 }

@@ -5,6 +5,7 @@ mod check;
 mod claims;
 mod cli_design;
 mod cli_simulate;
+mod contact;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;

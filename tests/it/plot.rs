@@ -274,8 +274,11 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     rhs_calls: 600,
                     method: "dp5".into(),
                     fidelity: "full".into(),
+                    min_gap_rad: None,
+                    final_min_gap_rad: None,
                 },
                 method: "dp5".into(),
+                contact: true,
                 wall_time_s: 0.001,
             });
         }

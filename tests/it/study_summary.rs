@@ -68,8 +68,11 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             rhs_calls: 600,
             method: "dp5".into(),
             fidelity: "full".into(),
+            min_gap_rad: None,
+            final_min_gap_rad: None,
         },
         method: "dp5".into(),
+        contact: true,
         wall_time_s: 0.001,
     }
 }

@@ -215,5 +215,35 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             "residual/A_ref",
         ],
         &rows,
-    ) + "(settling times in revolutions; residual: median RMS vibration over the last hold window)\n")
+    ) + "(settling times in revolutions; residual: median RMS vibration over the last hold window)\n"
+        + &contact_line(summary)?)
+}
+
+/// Whether the weights were solid, said under every ranking: a study that
+/// switched contact off prints numbers for weights that pass through each other.
+fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
+    let contact = summary.column("contact")?.bool()?;
+    let gap = summary
+        .column("min_gap_rad")?
+        .f64()?
+        .iter()
+        .flatten()
+        .reduce(f64::min);
+    let closest = gap.map_or(String::new(), |g| {
+        if g < 0.0 {
+            format!("; weights overlapped by up to {:.2}°", -g.to_degrees())
+        } else {
+            format!("; closest approach {:.2}° beyond touching", g.to_degrees())
+        }
+    });
+    let off = contact.iter().filter(|c| *c == Some(false)).count();
+    Ok(if off == 0 {
+        format!("contact between the weights: on{closest}\n")
+    } else {
+        format!(
+            "contact between the weights: OFF in {} of {} designs (the study switched it off: weights may pass through each other){closest}\n",
+            off,
+            summary.height()
+        )
+    })
 }

@@ -76,7 +76,7 @@ fn describe(m: &RunMetrics) -> String {
         .map(|a| format!("{a:.1}"))
         .collect();
     format!(
-        "outcome            {}\nreason             {}\nsettled            {}\nsettling time      {} s ({} rev, ± {:.4} s)\nsettling time (ε)  {} s\nresidual           {:.4e} ({:.4} A_ref)\nA_ref              {:.4e}\nbalancing error ε  {:.4e}\npeak r             {:.4e}\nfinal angles       [{}] deg\np final            {:.4}\nsteps, RHS calls   {}, {}\n",
+        "outcome            {}\nreason             {}\nsettled            {}\nsettling time      {} s ({} rev, ± {:.4} s)\nsettling time (ε)  {} s\nresidual           {:.4e} ({:.4} A_ref)\nA_ref              {:.4e}\nbalancing error ε  {:.4e}\npeak r             {:.4e}\nfinal angles       [{}] deg\np final            {:.4}\nsteps, RHS calls   {}, {}\nclosest weights    {}\n",
         m.outcome.name(),
         m.reason,
         m.settled,
@@ -92,6 +92,14 @@ fn describe(m: &RunMetrics) -> String {
         angles.join(", "),
         m.p_final,
         m.steps,
-        m.rhs_calls
+        m.rhs_calls,
+        match (m.min_gap_rad, m.final_min_gap_rad) {
+            (Some(low), Some(end)) => format!(
+                "{:.3}° beyond touching at the closest, {:.3}° at the end (negative: overlap)",
+                low.to_degrees(),
+                end.to_degrees()
+            ),
+            _ => "– (point masses)".to_string(),
+        }
     )
 }

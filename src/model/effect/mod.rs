@@ -78,6 +78,11 @@ pub trait IntrinsicEffect: Effect + Sized + 'static {
     fn from_cargo(cargo: &[Cargo], omega: f64) -> Option<Self>;
 }
 
+/// Serde default of an effect that every scene has unless its file says otherwise.
+fn effect_on<T: Default>() -> Option<T> {
+    Some(T::default())
+}
+
 /// Declares every effect once: the intrinsic ones (built from the cargoes)
 /// and the optional ones, each with its scene key and parameter type. The
 /// right-hand side applies them in this order, which is the order of the
@@ -97,14 +102,22 @@ macro_rules! effect_registry {
         }
 
         /// Which optional effects a scene enables, with their parameters.
-        #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         #[serde(deny_unknown_fields)]
         pub struct Effects {
             $(
                 $(#[$doc])*
-                #[serde(default)]
                 pub $key: Option<$spec>,
             )*
+        }
+
+        impl Default for Effects {
+            /// What a file that names no effect gets: each registry line's
+            /// serde default, read from an empty table so that code and
+            /// files cannot disagree.
+            fn default() -> Self {
+                toml::from_str("").expect("an empty effects table is valid")
+            }
         }
 
         impl Effects {
@@ -124,9 +137,12 @@ effect_registry! {
     ],
     optional: {
         /// Gravity in the plane of the rotor (absent: none, e.g. a vertical axis).
+        #[serde(default)]
         gravity: gravity::Gravity,
-        /// Contact between neighbouring weights of finite size (absent: weights
-        /// pass through each other, as the analytic theory assumes).
+        /// Contact between neighbouring weights of finite size: on unless a
+        /// file says `enabled = false` (then weights pass through each
+        /// other, as the analytic theory assumes).
+        #[serde(default = "effect_on")]
         contact: contact::ContactSpec,
     },
 }
