@@ -4,6 +4,7 @@
 use crate::metrics::MetricOptions;
 use crate::model::cargo::Cargo;
 use crate::model::effect::Effects;
+use crate::model::gap::start_clash;
 use crate::model::rotor::RotorModel;
 use crate::model::scene::{DesignSpec, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
@@ -123,10 +124,35 @@ impl SceneFile {
         };
         scene.validate().map_err(invalid)?;
         let n = scene.cargoes().map_err(invalid)?.len();
-        let initial_angles = match &self.start.angles_deg {
+        let initial_angles: Vec<f64> = match &self.start.angles_deg {
             Some(a) => a.iter().map(|d| d.to_radians()).collect(),
             None => evenly_spaced(n),
         };
+        if initial_angles.len() == n {
+            let cargo = scene.cargoes().map_err(invalid)?;
+            if let Some(clash) = start_clash(&cargo, &initial_angles) {
+                let reason = if clash.touching > 0.0 {
+                    format!(
+                        "weights {} and {} start {:.3}° apart, closer than their touching angle 2α = {:.3}°: solid weights cannot overlap",
+                        clash.first + 1,
+                        clash.second + 1,
+                        clash.apart.to_degrees(),
+                        clash.touching.to_degrees()
+                    )
+                } else {
+                    format!(
+                        "weights {} and {} start at the same angle: that symmetric state is an equilibrium and they would never separate; start them apart",
+                        clash.first + 1,
+                        clash.second + 1
+                    )
+                };
+                return Err(invalid(SceneError::Invalid {
+                    field: "start.angles_deg".into(),
+                    value: format!("{:?}", self.start.angles_deg.as_deref().unwrap_or(&[])),
+                    reason,
+                }));
+            }
+        }
         let m = &self.metrics;
         let checks = [
             ("metrics.delta", m.delta),

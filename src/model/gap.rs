@@ -58,3 +58,48 @@ impl GapGauge {
         smallest
     }
 }
+
+/// Two weights of one plane that start closer than they may: their indices
+/// (from 0), their centre angle and the angle at which they touch (rad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartClash {
+    /// First weight.
+    pub first: usize,
+    /// Second weight.
+    pub second: usize,
+    /// Their centre angle |Δψ| about the race centre.
+    pub apart: f64,
+    /// The smallest centre angle they may have: 2α for sized weights; for
+    /// point masses, anything but zero.
+    pub touching: f64,
+}
+
+/// The first pair of weights in one plane whose start angles overlap (sized
+/// weights) or coincide (point masses, to within 1e-9 rad, where the
+/// symmetric state is an equilibrium they would never leave).
+pub fn start_clash(cargo: &[Cargo], angles: &[f64]) -> Option<StartClash> {
+    for j in 0..cargo.len() {
+        for k in j + 1..cargo.len() {
+            if cargo[j].plane != cargo[k].plane {
+                continue;
+            }
+            let apart = wrapped(angles[k] - angles[j]).abs();
+            let touching = cargo[j].contact_half_angle() + cargo[k].contact_half_angle();
+            // Touching exactly is allowed: a pressed start; allow for rounding.
+            let clash = if touching > 0.0 {
+                apart < touching * (1.0 - 1e-9)
+            } else {
+                apart < 1e-9
+            };
+            if clash {
+                return Some(StartClash {
+                    first: j,
+                    second: k,
+                    apart,
+                    touching,
+                });
+            }
+        }
+    }
+    None
+}

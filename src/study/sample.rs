@@ -119,7 +119,10 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         InitialSpec::BalancedForShift(shift) => {
             let old = direction - shift.to_radians();
             balanced_fan(n, design.weight_mass * design.track_radius, unbalance, old)
-                // Beyond what the point cargoes can cancel: press them together opposite.
+                // Solid weights cannot take a fan step below their touching
+                // angle 2α: such an unbalance exceeds what they can cancel.
+                .filter(|fan| n < 2 || fan_step(fan) >= 2.0 * half_angle(design.rho).unwrap_or(0.0))
+                // Beyond what the cargoes can cancel: press them together opposite.
                 .unwrap_or_else(|| cluster(design, old + PI))
         }
     };
@@ -131,11 +134,22 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     }
 }
 
-/// The weights pressed together, centred on `centre`.
+/// The equal angular step between neighbours of a balanced fan.
+fn fan_step(fan: &[f64]) -> f64 {
+    (fan[1] - fan[0]).abs()
+}
+
+/// The weights pressed together, centred on `centre`. A design whose radius
+/// leaves no touching angle (never a valid one) gets an even spread rather
+/// than coincident weights: the symmetric state is an equilibrium of the
+/// model and coincident weights would never separate.
 fn cluster(design: &Design, centre: f64) -> Vec<f64> {
+    let n = design.spec.n as usize;
     match pressed_angles(design.spec.n, design.rho) {
         Ok(angles) => angles.into_iter().map(|a| a + centre).collect(),
-        Err(_) => vec![centre; design.spec.n as usize],
+        Err(_) => (0..n)
+            .map(|j| centre + 2.0 * PI * j as f64 / n as f64)
+            .collect(),
     }
 }
 

@@ -140,3 +140,123 @@ fn contact_cost_table() {
         }
     }
 }
+
+/// Sampled starts never place two weights closer than their touching angle,
+/// whatever the start rule: the clustered start presses them to touching,
+/// the uniform one spaces them without overlap, the even one is a regular
+/// polygon, and a balanced fan that would need steps below 2α falls back to
+/// the pressed cluster.
+#[test]
+fn sampled_starts_never_overlap() {
+    use autobal::model::gap::start_clash;
+    use autobal::study::config::InitialSpec;
+    use autobal::study::sample::draw_sample;
+    for name in STUDIES {
+        for initial in [
+            InitialSpec::Clustered,
+            InitialSpec::Uniform,
+            InitialSpec::Even,
+            InitialSpec::BalancedForShift(90.0),
+            InitialSpec::BalancedForShift(10.0),
+        ] {
+            let mut p = plan(name, 6, None);
+            p.file.sampling.initial = initial.clone();
+            for design in &p.designs {
+                for sample in 0..6 {
+                    let s = draw_sample(&p, design, sample);
+                    let scene = p.scene(design, s.unbalance, s.direction);
+                    let cargo = scene.cargoes().expect("cargoes");
+                    assert_eq!(
+                        start_clash(&cargo, &s.initial_angles),
+                        None,
+                        "{name}, {initial:?}, design {}, sample {sample}: {:?}",
+                        design.id,
+                        s.initial_angles
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn simulate_scene(text: &str) -> std::process::Output {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg("simulate")
+        .arg(&path)
+        .output()
+        .unwrap()
+}
+
+const POINT_SCENE: &str = r#"
+[rotor]
+mass = 1.0
+eccentricity = 0.01
+kx = 1.0
+ky = 1.0
+bx = 0.1
+by = 0.1
+[[cargo]]
+mass = 0.01
+track_radius = 1.0
+drag = 0.01
+kappa = 1.4
+[[cargo]]
+mass = 0.01
+track_radius = 1.0
+drag = 0.01
+kappa = 1.4
+[speed]
+mode = "constant"
+omega = 4.0
+"#;
+
+#[test]
+fn coincident_point_weights_are_refused_naming_the_key_and_the_weights() {
+    let out = simulate_scene(&format!("{POINT_SCENE}[start]\nangles_deg = [30, 30]\n"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("start.angles_deg"), "{err}");
+    assert!(err.contains("weights 1 and 2"), "{err}");
+    // A start apart is fine.
+    let ok = simulate_scene(&format!("{POINT_SCENE}[start]\nangles_deg = [30, 31]\n"));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+}
+
+#[test]
+fn overlapping_solid_weights_are_refused_with_their_touching_angle() {
+    let scene = r#"
+[rotor]
+mass = 10.0
+eccentricity = 0.001
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[balancer]
+kind = "ball"
+n = 3
+rho = 0.3
+race_radius = 0.05
+density = 7850.0
+drag = 5.0
+[speed]
+mode = "constant"
+omega = 300.0
+[start]
+angles_deg = [0, 20, 200]
+"#;
+    let out = simulate_scene(scene);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("start.angles_deg"), "{err}");
+    assert!(err.contains("weights 1 and 2"), "{err}");
+    // 2α = 2 asin(0.3/0.7) = 50.754°.
+    assert!(err.contains("2α = 50.754°"), "{err}");
+}

@@ -84,7 +84,9 @@ fn effect_on<T: Default>() -> Option<T> {
 }
 
 /// Declares every effect once: the intrinsic ones (built from the cargoes)
-/// and the optional ones, each with its scene key and parameter type. The
+/// and the optional ones, each with its scene key, parameter type and serde
+/// default (`#[serde(default)]`: off unless a file asks; `#[serde(default =
+/// "effect_on")]`: on in every scene unless a file switches it off). The
 /// right-hand side applies them in this order, which is the order of the
 /// floating-point additions into each force, so a new effect goes last.
 macro_rules! effect_registry {
