@@ -171,6 +171,7 @@ impl SceneFile {
                 }));
             }
         }
+        self.metrics.check_horizon(&scene.speed).map_err(invalid)?;
         Ok(Simulation {
             scene,
             start: self.start.mode,

@@ -78,7 +78,7 @@ pub fn design_samples(df: &DataFrame) -> PolarsResult<Vec<DesignSample>> {
                 s.settling_revs.push(t);
             }
         }
-        if matches!(outcome.get(i), Some("settled" | "not_settled"))
+        if matches!(outcome.get(i), Some("settled" | "censored" | "not_settled"))
             && let Some(r) = residual.get(i)
         {
             s.residual_rel.push(r);

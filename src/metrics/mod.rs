@@ -10,15 +10,20 @@
 //!   rotors); ε(t) = |Σ m_j l_j e^{iψ_j} + M e e^{iψ₀}| / U (the size of the
 //!   total unbalance, e.g. the largest bearing-equivalent one, over U).
 //! - Settling time t_s: the start of the first stretch during which
-//!   r ≤ δ·A_ref holds continuously for W revolutions or until the end of the
-//!   run, checked on dense output at `samples_per_rev` points per revolution
-//!   (≥ 32). A run stops early once the hold is satisfied. The same rule on
-//!   ε ≤ δ gives t_s(ε). t_s is resolved to one sampling interval, reported
-//!   as `settling_time_err`.
+//!   r ≤ δ·A_ref holds continuously for W revolutions, judged only once the
+//!   rotor runs at its operating speed (after a ramp; for a motor or a free
+//!   rotor, once φ̇ is within δ of the nominal speed), checked on dense output
+//!   at `samples_per_rev` points per revolution (≥ 32). A run stops early
+//!   once the hold is satisfied. The same rule on ε ≤ δ gives t_s(ε). t_s is
+//!   resolved to one sampling interval, reported as `settling_time_err`.
+//!   A run that reaches its end without a complete hold is censored: its
+//!   t_s is only known to exceed `censoring_revs`.
 //! - Residual vibration: RMS of r over the last W revolutions simulated,
 //!   absolute and relative to A_ref.
-//! - Outcome: settled, not_settled, diverged (non-finite state or r beyond
-//!   `divergence_factor`·A_ref) or solver_failed, each with a reason.
+//! - Outcome: settled, censored (simulated to the end without settling),
+//!   not_settled (an estimate that predicts no settling), diverged
+//!   (non-finite state or r beyond `divergence_factor`·A_ref) or
+//!   solver_failed, each with a reason.
 //!
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
 //! the ramp's final speed or the motor's synchronous speed).
@@ -26,6 +31,8 @@
 pub mod observer;
 pub mod reference;
 
+use crate::model::speed::SpeedLaw;
+use crate::model::validate::SceneError;
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the metric definitions above.
@@ -63,9 +70,12 @@ impl Default for MetricOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
-    /// r stayed within δ·A_ref for the hold window (or until the end).
+    /// r stayed within δ·A_ref for the whole hold window at the operating speed.
     Settled,
-    /// The run ended without settling.
+    /// The run reached its end without a complete hold: t_s exceeds the
+    /// censoring time; never counted as settled.
+    Censored,
+    /// A closed-form or linear estimate that predicts no settling.
     NotSettled,
     /// The state became non-finite or r exceeded the divergence bound.
     Diverged,
@@ -78,6 +88,7 @@ impl Outcome {
     pub fn name(self) -> &'static str {
         match self {
             Outcome::Settled => "settled",
+            Outcome::Censored => "censored",
             Outcome::NotSettled => "not_settled",
             Outcome::Diverged => "diverged",
             Outcome::SolverFailed => "solver_failed",
@@ -134,6 +145,10 @@ pub struct RunMetrics {
     pub min_gap_rad: Option<f64>,
     /// The same gap at the end of the run.
     pub final_min_gap_rad: Option<f64>,
+    /// For a censored run: its settling time is known to exceed this many
+    /// revolutions (the end of the run less the hold window, and no earlier
+    /// than the operating point).
+    pub censoring_revs: Option<f64>,
 }
 
 impl RunMetrics {
@@ -164,6 +179,31 @@ impl RunMetrics {
             fidelity: String::new(),
             min_gap_rad: None,
             final_min_gap_rad: None,
+            censoring_revs: None,
         }
+    }
+}
+
+impl MetricOptions {
+    /// A run must be long enough to show settling at its operating point:
+    /// t_end ≥ (end of the speed ramp) + hold window. Checked before any run.
+    pub fn check_horizon(&self, speed: &SpeedLaw) -> Result<(), SceneError> {
+        let omega = speed.nominal_speed();
+        let rev = 2.0 * std::f64::consts::PI / omega;
+        let t_op = speed.operating_time().unwrap_or(0.0);
+        let needed = t_op + self.hold_revs * rev;
+        let t_end = self.t_end_revs * rev;
+        if omega > 0.0 && t_end < needed {
+            return Err(SceneError::Invalid {
+                field: "metrics.t_end_revs".into(),
+                value: self.t_end_revs.to_string(),
+                reason: format!(
+                    "the run would end at t = {t_end:.4} s, before the speed reaches its operating value (t = {t_op} s) plus the hold window ({:.4} s): settling could not be judged; use t_end_revs ≥ {}",
+                    self.hold_revs * rev,
+                    (needed / rev).ceil()
+                ),
+            });
+        }
+        Ok(())
     }
 }

@@ -77,6 +77,11 @@ pub struct SettlingObserver<'a> {
     peak_r: f64,
     gap: Option<GapGauge>,
     min_gap: f64,
+    /// When the speed reaches its operating value, if known in advance.
+    t_op: Option<f64>,
+    /// The first sample at the operating speed (settling is judged from here).
+    operating_since: Option<f64>,
+    omega: f64,
     diverged: Option<String>,
     series: Option<Series>,
     frame: Option<f64>,
@@ -114,6 +119,9 @@ impl<'a> SettlingObserver<'a> {
             peak_r: 0.0,
             gap: GapGauge::new(system.cargo()),
             min_gap: f64::INFINITY,
+            t_op: system.speed().operating_time(),
+            operating_since: None,
+            omega,
             diverged: None,
             series: record.then(|| Series {
                 psi: vec![Vec::new(); system.cargo().len()],
@@ -129,8 +137,29 @@ impl<'a> SettlingObserver<'a> {
         self.a_ref
     }
 
+    /// Whether the rotor runs at its operating speed at sample time t (the
+    /// scratch state): after the ramp, or for a motor or free rotor once φ̇
+    /// is within δ of the nominal speed. Once reached, it stays reached.
+    fn at_operating_speed(&mut self, t: f64) -> bool {
+        if self.operating_since.is_none() {
+            let reached = match self.t_op {
+                // Samples sit on a grid: allow for rounding in t = t0 + k·dt.
+                Some(t_op) => t >= t_op - 1e-9 * self.dt,
+                None => {
+                    let (_, rate) = self.system.spin(t, &self.scratch);
+                    (rate - self.omega).abs() <= self.options.delta * self.omega
+                }
+            };
+            if reached {
+                self.operating_since = Some(t);
+            }
+        }
+        self.operating_since.is_some()
+    }
+
     /// Process one sample; returns Stop when the run should end.
     fn sample(&mut self, t: f64) -> Flow {
+        let operating = self.at_operating_speed(t);
         let lay = self.system.layout();
         let y = &self.scratch;
         let r = vibration(self.system, y);
@@ -154,9 +183,10 @@ impl<'a> SettlingObserver<'a> {
         self.ring[self.ring_pos] = r * r;
         self.ring_pos = (self.ring_pos + 1) % self.ring.len();
         self.ring_filled = (self.ring_filled + 1).min(self.ring.len());
-        self.r_hold.update(t, r <= self.band, self.window);
+        self.r_hold
+            .update(t, operating && r <= self.band, self.window);
         self.eps_hold
-            .update(t, eps <= self.options.delta, self.window);
+            .update(t, operating && eps <= self.options.delta, self.window);
         if let Some(series) = &mut self.series {
             series.t.push(t);
             // The rotating frame integrates (u, v): report inertial (x, y).
@@ -214,20 +244,23 @@ impl<'a> SettlingObserver<'a> {
                     ),
                 ),
                 Some(t) => (
-                    Outcome::Settled,
+                    Outcome::Censored,
                     format!(
-                        "r ≤ {} A_ref from t = {t:.4} until the end of the run (hold window not complete)",
-                        self.options.delta
+                        "censored: r ≤ {} A_ref from t = {t:.4} until the end of the run, shorter than the hold window of {} revolutions",
+                        self.options.delta, self.options.hold_revs
                     ),
                 ),
                 None => (
-                    Outcome::NotSettled,
-                    format!(
-                        "r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
-                        vibration(self.system, &report.y) / self.a_ref,
-                        self.options.delta,
-                        rms / self.a_ref
-                    ),
+                    Outcome::Censored,
+                    match self.operating_since {
+                        Some(_) => format!(
+                            "censored: r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
+                            vibration(self.system, &report.y) / self.a_ref,
+                            self.options.delta,
+                            rms / self.a_ref
+                        ),
+                        None => "censored: the speed never reached its operating value".to_string(),
+                    },
                 ),
             },
         };
@@ -261,6 +294,10 @@ impl<'a> SettlingObserver<'a> {
             method: String::new(),
             fidelity: String::new(),
             min_gap_rad: self.gap.as_ref().map(|_| self.min_gap),
+            censoring_revs: (outcome == Outcome::Censored).then(|| {
+                let t_op = self.operating_since.unwrap_or(report.t);
+                ((report.t - self.window).max(t_op) - self.t0) / rev
+            }),
             final_min_gap_rad: self.gap.as_ref().map(|g| g.min_gap(psi)),
         };
         (metrics, self.series)

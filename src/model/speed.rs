@@ -91,8 +91,21 @@ impl SpeedLaw {
         }
     }
 
+    /// When the speed reaches its operating value, if the law says so in
+    /// advance: at once for a constant speed, at the end of a ramp; `None`
+    /// for a motor or a free rotor, whose speed only approaches it (the
+    /// observer then watches φ̇).
+    pub fn operating_time(&self) -> Option<f64> {
+        match *self {
+            SpeedLaw::Constant { .. } => Some(0.0),
+            SpeedLaw::Ramp { duration, .. } => Some(duration),
+            SpeedLaw::Motor { .. } | SpeedLaw::Free { .. } => None,
+        }
+    }
+
     /// The operating speed that defines a "revolution" for metrics: ω, the
-    /// ramp's end speed, the motor's synchronous speed, or the free start speed.
+    /// ramp's end speed, the motor's synchronous speed, or the free start
+    /// speed; settling is judged there (see `operating_time`).
     pub fn nominal_speed(&self) -> f64 {
         match *self {
             SpeedLaw::Constant { omega } => omega,

@@ -38,7 +38,9 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         let settled_mask = mine.column("settled")?.bool()?.clone();
         let settled = mine.filter(&settled_mask)?;
         let ts = settled.column("settling_revs")?.f64()?.clone();
-        let simulated = mine.filter(&(outcome.equal("settled") | outcome.equal("not_settled")))?;
+        let simulated = mine.filter(
+            &(outcome.equal("settled") | outcome.equal("censored") | outcome.equal("not_settled")),
+        )?;
         let residual = simulated.column("residual_rel")?.f64()?.clone();
         let runs_n = mine.height() as u64;
         let settled_n = settled.height() as u64;
@@ -78,6 +80,7 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
         rows.res_median.push(res_q(0.5));
         rows.res_p95.push(res_q(0.95));
+        rows.censored.push(count("censored"));
         rows.not_settled.push(count("not_settled"));
         rows.diverged.push(count("diverged"));
         rows.solver_failed.push(count("solver_failed"));
@@ -116,6 +119,7 @@ struct SummaryColumns {
     res_mean: Vec<Option<f64>>,
     res_median: Vec<Option<f64>>,
     res_p95: Vec<Option<f64>>,
+    censored: Vec<u64>,
     not_settled: Vec<u64>,
     diverged: Vec<u64>,
     solver_failed: Vec<u64>,
@@ -152,6 +156,7 @@ impl SummaryColumns {
                 Column::new("residual_rel_mean".into(), self.res_mean),
                 Column::new("residual_rel_median".into(), self.res_median),
                 Column::new("residual_rel_p95".into(), self.res_p95),
+                Column::new("censored".into(), self.censored),
                 Column::new("not_settled".into(), self.not_settled),
                 Column::new("diverged".into(), self.diverged),
                 Column::new("solver_failed".into(), self.solver_failed),

@@ -421,6 +421,14 @@ impl StudyFile {
         if self.solver.max_steps == 0 {
             return Err(invalid("solver.max_steps", "0".into(), "must be positive"));
         }
+        if let Err(crate::model::validate::SceneError::Invalid {
+            field,
+            value,
+            reason,
+        }) = self.metrics.check_horizon(&self.scene.speed)
+        {
+            return Err(invalid(&field, value, &reason));
+        }
         let designs = self
             .resolve_designs()
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;

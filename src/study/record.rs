@@ -85,6 +85,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("settling_time_eps", |r: &RunRecord| r
             .metrics
             .settling_time_eps),
+        col!("censoring_revs", |r: &RunRecord| r.metrics.censoring_revs),
         col!("hold_complete", |r: &RunRecord| r.metrics.hold_complete),
         col!("residual_abs", |r: &RunRecord| r.metrics.residual_abs),
         col!("residual_rel", |r: &RunRecord| r.metrics.residual_rel),
@@ -130,6 +131,7 @@ fn outcome_from(name: &str) -> PolarsResult<Outcome> {
     Ok(match name {
         "settled" => Outcome::Settled,
         "not_settled" => Outcome::NotSettled,
+        "censored" => Outcome::Censored,
         "diverged" => Outcome::Diverged,
         "solver_failed" => Outcome::SolverFailed,
         other => polars_bail!(ComputeError: "unknown outcome '{other}' in runs file"),
@@ -223,6 +225,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let fidelity = strs("fidelity")?;
     let contact = bools("contact")?;
     let (min_gap, final_gap) = (f64s("min_gap_rad")?, f64s("final_min_gap_rad")?);
+    let censoring = f64s("censoring_revs")?;
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -263,6 +266,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 fidelity: fidelity[i].clone(),
                 min_gap_rad: min_gap[i],
                 final_min_gap_rad: final_gap[i],
+                censoring_revs: censoring[i],
             },
             contact: contact[i],
             method: method[i].clone(),

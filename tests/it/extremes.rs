@@ -84,7 +84,7 @@ fn one_cargo_heavier_than_the_unbalance_overshoots_opposite() {
         &[90.0],
         400.0,
     ));
-    assert_eq!(m.outcome, Outcome::NotSettled);
+    assert_eq!(m.outcome, Outcome::Censored);
     // Opposite the unbalance, shifted by the rotor's phase lag
     // atan(bω/(Mω² − k)) = 1.5° here.
     let lag = (0.1f64 * 4.0).atan2(1.0 * 16.0 - 1.0).to_degrees();
@@ -128,7 +128,7 @@ fn tiny_weights_gather_opposite_an_unbalance_they_cannot_cancel() {
     }
     let total: f64 = cargo.iter().map(Cargo::unbalance).sum();
     let m = run(&sim(rotor(0.01), cargo, 4.0, &[60.0, 90.0, 120.0], 400.0));
-    assert_eq!(m.outcome, Outcome::NotSettled);
+    assert_eq!(m.outcome, Outcome::Censored);
     assert!(
         (m.balancing_error - (1.0 - total / 0.01)).abs() < 1e-9,
         "ε = {}",
@@ -214,7 +214,7 @@ fn nearly_undamped_weights_settle_slower_than_damped_ones() {
             t > 3.0 * damped.settling_revs.unwrap(),
             "β = 1e-6 settled in {t} rev"
         ),
-        None => assert_eq!(undamped.outcome, Outcome::NotSettled),
+        None => assert_eq!(undamped.outcome, Outcome::Censored),
     }
 }
 
@@ -271,7 +271,7 @@ fn at_resonance_no_balancing_far_above_it_balancing() {
         &angles,
         400.0,
     ));
-    assert_eq!(at.outcome, Outcome::NotSettled, "{}", at.reason);
+    assert_eq!(at.outcome, Outcome::Censored, "{}", at.reason);
     let far = run(&sim(
         rotor(0.01),
         vec![point(0.01, 0.01); 3],
@@ -337,7 +337,7 @@ fn ten_times_capacity_cannot_balance() {
         &[60.0, 90.0, 120.0],
         400.0,
     ));
-    assert_eq!(m.outcome, Outcome::NotSettled);
+    assert_eq!(m.outcome, Outcome::Censored);
     assert!(!m.reason.is_empty());
     assert!(
         (m.balancing_error - 0.9).abs() < 0.01,

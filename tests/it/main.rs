@@ -18,6 +18,7 @@ mod model_flexible;
 mod model_linear;
 mod model_physics;
 mod model_two_support;
+mod operating_point;
 mod optimize;
 mod plot;
 mod study_input;

@@ -169,7 +169,7 @@ fn stability_map_at_the_papers_values_and_nonlinear_runs_agree() {
         let expected = if stable {
             Outcome::Settled
         } else {
-            Outcome::NotSettled
+            Outcome::Censored
         };
         assert_eq!(run.outcome, expected, "ω = {omega}: {}", run.reason);
         if !stable {

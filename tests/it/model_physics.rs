@@ -154,7 +154,7 @@ fn supercritical_rotor_settles_and_subcritical_does_not() {
         .unwrap();
     assert_eq!(
         slow.metrics.outcome,
-        Outcome::NotSettled,
+        Outcome::Censored,
         "{}",
         slow.metrics.reason
     );
@@ -374,7 +374,7 @@ fn weights_in_contact_carry_the_capacity_of_seed_000() {
             sim.scene.effects.contact = contact.then(ContactSpec::default);
             sim.metrics.t_end_revs = 300.0;
             let m = sim.run(false).unwrap().metrics;
-            assert_eq!(m.outcome, Outcome::NotSettled, "{}", m.reason);
+            assert_eq!(m.outcome, Outcome::Censored, "{}", m.reason);
             let psi: Vec<f64> = m
                 .final_rel_angles_deg
                 .iter()

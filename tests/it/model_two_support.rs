@@ -341,7 +341,7 @@ fn static_balancing_occurs_inside_the_criterions_ranges_and_not_outside() {
     for omega in [0.6 * w1, 0.5 * (wt + w2)] {
         assert!(!ranges.contains(omega));
         let m = single_plane_run(z, omega);
-        assert_eq!(m.outcome, Outcome::NotSettled, "ω = {omega}: {}", m.reason);
+        assert_eq!(m.outcome, Outcome::Censored, "ω = {omega}: {}", m.reason);
         assert!(
             m.balancing_error > 1.0,
             "ω = {omega}: ε = {}",
@@ -381,7 +381,7 @@ fn two_planes_balance_dynamically_above_omega2_only() {
         .run(false)
         .unwrap()
         .metrics;
-    assert_eq!(slow.outcome, Outcome::NotSettled, "{}", slow.reason);
+    assert_eq!(slow.outcome, Outcome::Censored, "{}", slow.reason);
 }
 
 #[test]
@@ -430,6 +430,7 @@ omega = 6.0
 
 [metrics]
 t_end_revs = 5
+hold_revs = 2
 "#;
     let file = SceneFile::parse(text, "two.toml").unwrap();
     assert_eq!(file.rotor.name(), "two_support");
@@ -548,6 +549,7 @@ samples = 2
 unbalance = {{ distribution = "uniform", min = 0.2, max = 0.6 }}
 [metrics]
 t_end_revs = 20
+hold_revs = 10
 "#,
         tmp.path().join("results").display()
     );

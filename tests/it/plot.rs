@@ -276,6 +276,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     fidelity: "full".into(),
                     min_gap_rad: None,
                     final_min_gap_rad: None,
+                    censoring_revs: None,
                 },
                 method: "dp5".into(),
                 contact: true,

@@ -39,7 +39,7 @@ samples = {samples}
 unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
 
 [metrics]
-t_end_revs = 400
+t_end_revs = 800
 {extra}
 "#,
         output.display()

@@ -70,6 +70,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             fidelity: "full".into(),
             min_gap_rad: None,
             final_min_gap_rad: None,
+            censoring_revs: None,
         },
         method: "dp5".into(),
         contact: true,
