@@ -159,8 +159,6 @@ impl SceneFile {
             ("metrics.hold_revs", m.hold_revs),
             ("metrics.t_end_revs", m.t_end_revs),
             ("metrics.divergence_factor", m.divergence_factor),
-            ("solver.rtol", self.solver.rtol),
-            ("solver.atol", self.solver.atol),
         ];
         for (field, value) in checks {
             if !(value.is_finite() && value > 0.0) {
@@ -170,6 +168,13 @@ impl SceneFile {
                     reason: "must be positive and finite".into(),
                 }));
             }
+        }
+        if let Err((field, value, reason)) = self.solver.validate() {
+            return Err(invalid(SceneError::Invalid {
+                field: field.into(),
+                value,
+                reason,
+            }));
         }
         self.metrics.check_horizon(&scene.speed).map_err(invalid)?;
         Ok(Simulation {

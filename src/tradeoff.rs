@@ -133,7 +133,7 @@ fn simulate(plan: &StudyPlan, run_id: u64, setting: Setting) -> (RunMetrics, f64
     solver.method = setting.method;
     if setting.rtol > 0.0 {
         solver.rtol = setting.rtol;
-        solver.atol = setting.rtol * 1e-2;
+        solver.atol = None;
     }
     let sim = Simulation {
         scene: plan.scene(design, sample.unbalance, sample.direction),

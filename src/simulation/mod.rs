@@ -104,7 +104,7 @@ impl Simulation {
         }
         let options = SolverOptions {
             rtol: self.solver.rtol,
-            atol: scaled_atol(system, self.solver.atol, observer.a_ref(), omega),
+            atol: scaled_atol(system, self.solver.atol(), observer.a_ref(), omega),
             h0: None,
             h_max: f64::INFINITY,
             max_steps: self.solver.max_steps,

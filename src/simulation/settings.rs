@@ -10,8 +10,12 @@ use serde::{Deserialize, Serialize};
 /// `atol` is relative to the problem's scales: displacements get atol·A_ref,
 /// velocities atol·A_ref·ω, angles atol (rad), angular rates atol·ω. The
 /// settled amplitude sits at a noise floor of roughly 10–300 × the absolute
-/// tolerance, so atol·A_ref must stay far below δ·A_ref: the default 1e-8
-/// keeps the floor below 3e-6 A_ref, four decades under δ = 0.05.
+/// tolerance, so atol·A_ref must stay far below δ·A_ref. Unless a file sets
+/// it, atol = rtol/100 (1e-8 at the default rtol = 1e-6, four decades under
+/// δ = 0.05): tightening rtol then tightens atol with it, so the answer
+/// converges. A fixed atol with a much smaller rtol would leave the residual
+/// at the absolute tolerance's noise floor, and Radau5, which maps its
+/// tolerances as Hairer does (atol/rtol kept), would even loosen it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
@@ -23,8 +27,9 @@ pub struct SolverSettings {
     pub method: MethodChoice,
     /// Relative tolerance.
     pub rtol: f64,
-    /// Absolute tolerance relative to the problem's scales (see above).
-    pub atol: f64,
+    /// Absolute tolerance relative to the problem's scales (see above);
+    /// `None`: rtol/100.
+    pub atol: Option<f64>,
     /// Step budget (accepted plus rejected).
     pub max_steps: u64,
     /// When an explicit method finds the problem stiff, runs out of steps or
@@ -39,7 +44,7 @@ impl Default for SolverSettings {
             fidelity: Fidelity::Auto,
             method: MethodChoice::Auto,
             rtol: 1e-6,
-            atol: 1e-8,
+            atol: None,
             max_steps: 5_000_000,
             implicit_fallback: true,
         }
@@ -59,6 +64,48 @@ pub fn scaled_atol(system: &RotorSystem, atol: f64, a_ref: f64, omega: f64) -> V
         v[nq + i] = atol * omega;
     }
     v
+}
+
+/// Accepted relative tolerances: tighter than 1e-13 is below what double
+/// precision resolves over a long run; looser than 1e-2 is no answer.
+pub const RTOL_RANGE: (f64, f64) = (1e-13, 1e-2);
+
+/// Accepted absolute tolerances (relative to the problem's scales).
+pub const ATOL_RANGE: (f64, f64) = (1e-16, 1e-2);
+
+impl SolverSettings {
+    /// The absolute tolerance in effect: as given, or rtol/100.
+    pub fn atol(&self) -> f64 {
+        self.atol.unwrap_or(self.rtol / 100.0)
+    }
+
+    /// Check the tolerances and budget; on failure the key, the value and the rule.
+    pub fn validate(&self) -> Result<(), (&'static str, String, String)> {
+        let (lo, hi) = RTOL_RANGE;
+        if !(lo..=hi).contains(&self.rtol) {
+            return Err((
+                "solver.rtol",
+                self.rtol.to_string(),
+                format!("must lie in [{lo:e}, {hi:e}]"),
+            ));
+        }
+        let (lo, hi) = ATOL_RANGE;
+        if let Some(atol) = self.atol
+            && !(lo..=hi).contains(&atol)
+        {
+            return Err((
+                "solver.atol",
+                atol.to_string(),
+                format!(
+                    "must lie in [{lo:e}, {hi:e}] (relative to the problem's scales; leave it out for rtol/100)"
+                ),
+            ));
+        }
+        if self.max_steps == 0 {
+            return Err(("solver.max_steps", "0".into(), "must be positive".into()));
+        }
+        Ok(())
+    }
 }
 
 /// The integrator a study asks for: `"auto"` or any method's name.

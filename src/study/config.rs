@@ -403,8 +403,6 @@ impl StudyFile {
             ));
         }
         for (key, value) in [
-            ("solver.rtol", self.solver.rtol),
-            ("solver.atol", self.solver.atol),
             ("metrics.delta", self.metrics.delta),
             ("metrics.hold_revs", self.metrics.hold_revs),
             ("metrics.t_end_revs", self.metrics.t_end_revs),
@@ -418,8 +416,8 @@ impl StudyFile {
                 ));
             }
         }
-        if self.solver.max_steps == 0 {
-            return Err(invalid("solver.max_steps", "0".into(), "must be positive"));
+        if let Err((key, value, reason)) = self.solver.validate() {
+            return Err(invalid(key, value, &reason));
         }
         if let Err(crate::model::validate::SceneError::Invalid {
             field,

@@ -6,6 +6,7 @@ mod claims;
 mod cli_design;
 mod cli_simulate;
 mod contact;
+mod convergence;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;

@@ -174,7 +174,7 @@ fn compare_with_settling(s: Scene, perturb: &[f64]) {
         initial_angles: angles,
         solver: SolverSettings {
             rtol: 1e-9,
-            atol: 1e-11,
+            atol: Some(1e-11),
             ..SolverSettings::default()
         },
         metrics: MetricOptions {

@@ -277,7 +277,7 @@ fn tightening_the_tolerance_tenfold_does_not_change_the_result() {
     let base = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start);
     let mut tight = base.clone();
     tight.solver.rtol /= 10.0;
-    tight.solver.atol /= 10.0;
+    tight.solver.atol = Some(base.solver.atol() / 10.0);
     let (a, b) = (
         base.run(false).unwrap().metrics,
         tight.run(false).unwrap().metrics,

@@ -40,7 +40,7 @@ pub fn measure_fidelities(revolutions: f64, rtol: f64, repeats: usize) -> Vec<Fi
                 solver: SolverSettings {
                     fidelity,
                     rtol,
-                    atol: rtol * 1e-2,
+                    atol: Some(rtol * 1e-2),
                     ..SolverSettings::default()
                 },
                 metrics: MetricOptions {
