@@ -26,6 +26,23 @@ fn sorted_values(ca: &Float64Chunked) -> Vec<f64> {
     v
 }
 
+/// The median settling time over every run of a design, a run that did not
+/// settle counting as "later than any settled one": censored runs are only
+/// known to settle after t_end − W, which no settled run's t_s exceeds (its
+/// hold had to complete by t_end), and diverged or failed runs never settle.
+/// With such censoring this is exactly the Kaplan–Meier median. `None` when
+/// half the runs or more did not settle: the median is then beyond the run.
+fn median_counting_unsettled(settled_sorted: &[f64], runs: u64) -> Option<f64> {
+    let runs = runs as usize;
+    if runs == 0 {
+        return None;
+    }
+    // Lower and upper middle order statistics of all runs (unsettled = +∞).
+    let (lo, hi) = ((runs - 1) / 2, runs / 2);
+    let at = |i: usize| settled_sorted.get(i).copied();
+    Some(0.5 * (at(lo)? + at(hi)?))
+}
+
 /// One row per design, in design order.
 pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame> {
     let df = to_dataframe(runs)?;
@@ -69,6 +86,8 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         let ts_sorted = sorted_values(&ts);
         let ts_q = |q| quantile_sorted(&ts_sorted, q, Interpolation::Linear);
         rows.ts_median.push(ts_q(0.5));
+        rows.ts_median_all
+            .push(median_counting_unsettled(&ts_sorted, runs_n));
         rows.ts_p10.push(ts_q(0.10));
         rows.ts_p90.push(ts_q(0.90));
         rows.ts_p95.push(ts_q(0.95));
@@ -110,6 +129,7 @@ struct SummaryColumns {
     ts_mean: Vec<Option<f64>>,
     ts_std: Vec<Option<f64>>,
     ts_median: Vec<Option<f64>>,
+    ts_median_all: Vec<Option<f64>>,
     ts_p10: Vec<Option<f64>>,
     ts_p90: Vec<Option<f64>>,
     ts_p95: Vec<Option<f64>>,
@@ -147,6 +167,7 @@ impl SummaryColumns {
                 Column::new("settling_revs_mean".into(), self.ts_mean),
                 Column::new("settling_revs_std".into(), self.ts_std),
                 Column::new("settling_revs_median".into(), self.ts_median),
+                Column::new("settling_revs_median_all_runs".into(), self.ts_median_all),
                 Column::new("settling_revs_p10".into(), self.ts_p10),
                 Column::new("settling_revs_p90".into(), self.ts_p90),
                 Column::new("settling_revs_p95".into(), self.ts_p95),

@@ -100,6 +100,9 @@ fn summary_matches_a_hand_computation() {
     // Settled runs: 10, 20, 30, 40 revolutions.
     assert_eq!(f("settling_revs_mean"), 25.0);
     assert_eq!(f("settling_revs_median"), 25.0);
+    // Over all six runs, the two that did not settle counting as later than
+    // every settled one: [10, 20, 30, 40, ∞, ∞] → (30 + 40)/2.
+    assert_eq!(f("settling_revs_median_all_runs"), 35.0);
     assert!((f("settling_revs_std") - (500.0f64 / 3.0).sqrt()).abs() < 1e-12);
     assert!((f("settling_revs_p10") - 13.0).abs() < 1e-12);
     assert!((f("settling_revs_p90") - 37.0).abs() < 1e-12);
@@ -113,6 +116,46 @@ fn summary_matches_a_hand_computation() {
         lo < 25.0 && 25.0 < hi && lo >= 10.0 && hi <= 40.0,
         "[{lo}, {hi}]"
     );
+}
+
+#[test]
+fn median_over_all_runs_counts_runs_that_did_not_settle() {
+    let runs = |outcomes: &[(Outcome, Option<f64>)]| -> Vec<RunRecord> {
+        outcomes
+            .iter()
+            .enumerate()
+            .map(|(i, (o, t))| record(i as u64, *o, *t, 0.01))
+            .collect()
+    };
+    let median = |rs: &[RunRecord]| {
+        let p = plan();
+        let df = summarize(&p, rs).unwrap();
+        df.column("settling_revs_median_all_runs")
+            .unwrap()
+            .f64()
+            .unwrap()
+            .get(0)
+    };
+    let fast_but_flaky = runs(&[
+        (Outcome::Settled, Some(1.0)),
+        (Outcome::Settled, Some(1.0)),
+        (Outcome::Censored, None),
+        (Outcome::Censored, None),
+        (Outcome::Diverged, None),
+        (Outcome::SolverFailed, None),
+    ]);
+    // Half or more did not settle: the median lies beyond the run, although
+    // the settled runs alone have median 1.
+    assert_eq!(median(&fast_but_flaky), None);
+    let steady = runs(&[
+        (Outcome::Settled, Some(3.0)),
+        (Outcome::Settled, Some(4.0)),
+        (Outcome::Settled, Some(5.0)),
+        (Outcome::Settled, Some(6.0)),
+        (Outcome::Settled, Some(7.0)),
+        (Outcome::Censored, None),
+    ]);
+    assert_eq!(median(&steady), Some(5.5));
 }
 
 #[test]
