@@ -8,6 +8,7 @@
 use super::config::StudyPlan;
 use super::record::{RunRecord, to_dataframe};
 use super::sample::{Purpose, stream};
+use crate::model::gap::GapGauge;
 use crate::stats::bootstrap;
 use crate::stats::interval::wilson_interval;
 use crate::stats::quantile::{Interpolation, quantile_sorted};
@@ -107,7 +108,21 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         // worst run (negative: they overlapped).
         let contact = mine.column("contact")?.bool()?.clone();
         rows.contact.push(contact.all());
-        rows.min_gap.push(mine.column("min_gap_rad")?.f64()?.min());
+        let min_gap = mine.column("min_gap_rad")?.f64()?.min();
+        rows.min_gap.push(min_gap);
+        // The deepest overlap as a share of the touching angle 2α: what the
+        // penalty contact lets through (docs/model.md: below 2 % by default).
+        let touching = plan
+            .scene(design, 0.0, 0.0)
+            .cargoes()
+            .ok()
+            .and_then(|c| GapGauge::new(&c))
+            .map(|g| g.contact_angle());
+        rows.max_overlap.push(
+            min_gap
+                .zip(touching)
+                .map(|(gap, angle)| (-gap).max(0.0) / angle),
+        );
     }
     rows.into_dataframe()
 }
@@ -145,6 +160,7 @@ struct SummaryColumns {
     solver_failed: Vec<u64>,
     contact: Vec<bool>,
     min_gap: Vec<Option<f64>>,
+    max_overlap: Vec<Option<f64>>,
 }
 
 impl SummaryColumns {
@@ -183,6 +199,7 @@ impl SummaryColumns {
                 Column::new("solver_failed".into(), self.solver_failed),
                 Column::new("contact".into(), self.contact),
                 Column::new("min_gap_rad".into(), self.min_gap),
+                Column::new("max_overlap_fraction".into(), self.max_overlap),
             ],
         )
     }

@@ -226,18 +226,17 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
 /// switched contact off prints numbers for weights that pass through each other.
 fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
     let contact = summary.column("contact")?.bool()?;
-    let gap = summary
-        .column("min_gap_rad")?
+    let deepest = summary
+        .column("max_overlap_fraction")?
         .f64()?
         .iter()
         .flatten()
-        .reduce(f64::min);
-    let closest = gap.map_or(String::new(), |g| {
-        if g < 0.0 {
-            format!("; weights overlapped by up to {:.2}°", -g.to_degrees())
-        } else {
-            format!("; closest approach {:.2}° beyond touching", g.to_degrees())
-        }
+        .reduce(f64::max);
+    let closest = deepest.map_or(String::new(), |f| {
+        format!(
+            "; deepest overlap {:.2} % of the touching angle 2α",
+            100.0 * f
+        )
     });
     let off = contact.iter().filter(|c| *c == Some(false)).count();
     Ok(if off == 0 {
