@@ -9,6 +9,9 @@ use super::{
     Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step, StepObserver,
 };
 
+/// Attempts between two looks at the wall clock.
+const WALL_CHECK_EVERY: u64 = 256;
+
 /// Hairer's stiffness counting (DOPRI5, DOP853): this many accepted steps
 /// held by stability in a row mean the problem is stiff ...
 const STIFF_STEPS: u32 = 15;
@@ -24,6 +27,7 @@ pub(super) fn drive<St, S, O>(
     y0: &[f64],
     t_end: f64,
     options: &SolverOptions,
+    deadline: Option<std::time::Instant>,
     observer: &mut O,
 ) -> SolveReport
 where
@@ -54,6 +58,15 @@ where
 
     loop {
         if let Err(f) = check_step(t, h, &stats, options) {
+            return report(Status::Failed(f), t, y, stats);
+        }
+        // The clock is read every WALL_CHECK_EVERY attempts: a few ns per step.
+        if let Some(deadline) = deadline
+            && (stats.steps + stats.rejected).is_multiple_of(WALL_CHECK_EVERY)
+            && std::time::Instant::now() > deadline
+        {
+            let limit_s = options.max_wall.map_or(0.0, |d| d.as_secs_f64());
+            let f = Failure::WallTimeExceeded { t, limit_s };
             return report(Status::Failed(f), t, y, stats);
         }
         let last = t + stepper.end_stretch() * h >= t_end;

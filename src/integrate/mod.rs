@@ -117,6 +117,7 @@ macro_rules! method_registry {
         }
 
         /// Run `method` in the driver from (t0, y0).
+        #[allow(clippy::too_many_arguments)]
         fn drive_method<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
             method: Method,
             system: &S,
@@ -124,11 +125,12 @@ macro_rules! method_registry {
             y0: &[f64],
             t_end: f64,
             options: &SolverOptions,
+            deadline: Option<std::time::Instant>,
             observer: &mut O,
         ) -> SolveReport {
             match method {
                 $( Method::$variant => driver::drive::<$stepper, _, _>(
-                    system, t0, y0, t_end, options, observer,
+                    system, t0, y0, t_end, options, deadline, observer,
                 ), )*
             }
         }
@@ -191,6 +193,9 @@ pub struct SolverOptions {
     pub h_max: f64,
     /// Give up after this many steps (accepted plus rejected).
     pub max_steps: u64,
+    /// Give up when a run has taken this long (wall clock, all segments):
+    /// a budget against runs that crawl, checked every few hundred steps.
+    pub max_wall: Option<std::time::Duration>,
     /// What an explicit method does when its step size is held at the
     /// stability boundary (Hairer's test) instead of by accuracy.
     pub stiffness: Stiffness,
@@ -225,6 +230,7 @@ impl Default for SolverOptions {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: 10_000_000,
+            max_wall: None,
             stiffness: Stiffness::Ignore,
         }
     }
@@ -273,6 +279,14 @@ pub enum Failure {
         t: f64,
         /// The budget.
         max: u64,
+    },
+    /// The wall-time budget ran out.
+    #[error("wall-time budget of {limit_s} s exhausted at t = {t}")]
+    WallTimeExceeded {
+        /// Time reached.
+        t: f64,
+        /// The budget (s).
+        limit_s: f64,
     },
     /// The right-hand side or the state became NaN or infinite.
     #[error("non-finite state at t = {t}")]
@@ -358,7 +372,8 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
         return invalid(reason, t0, y0, Stats::default());
     }
     observer.start(t0, y0);
-    let first = drive_method(method, system, t0, y0, t_end, options, observer);
+    let deadline = options.max_wall.map(|d| std::time::Instant::now() + d);
+    let first = drive_method(method, system, t0, y0, t_end, options, deadline, observer);
     let switch = options.stiffness == Stiffness::SwitchToImplicit
         && !method.is_implicit()
         && driver::stalled(&first.status);
@@ -380,6 +395,7 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
         &first.y,
         t_end,
         options,
+        deadline,
         observer,
     );
     rest.stats += first.stats;

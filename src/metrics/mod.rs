@@ -79,7 +79,9 @@ pub enum Outcome {
     NotSettled,
     /// The state became non-finite or r exceeded the divergence bound.
     Diverged,
-    /// The integrator could not continue (step-size underflow, too many steps).
+    /// The run exhausted its step or wall-time budget.
+    BudgetExceeded,
+    /// The integrator could not continue (step-size underflow, Newton failure).
     SolverFailed,
 }
 
@@ -91,6 +93,7 @@ impl Outcome {
             Outcome::Censored => "censored",
             Outcome::NotSettled => "not_settled",
             Outcome::Diverged => "diverged",
+            Outcome::BudgetExceeded => "budget_exceeded",
             Outcome::SolverFailed => "solver_failed",
         }
     }

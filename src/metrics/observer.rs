@@ -234,6 +234,12 @@ impl<'a> SettlingObserver<'a> {
             (None, Status::Failed(Failure::NonFinite { t })) => {
                 (Outcome::Diverged, format!("non-finite state at t = {t}"))
             }
+            (
+                None,
+                Status::Failed(
+                    f @ (Failure::TooManySteps { .. } | Failure::WallTimeExceeded { .. }),
+                ),
+            ) => (Outcome::BudgetExceeded, f.to_string()),
             (None, Status::Failed(f)) => (Outcome::SolverFailed, f.to_string()),
             (None, _) => match t_s {
                 Some(t) if hold_complete => (

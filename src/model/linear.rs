@@ -37,6 +37,16 @@ pub enum LinearError {
         "the equations are not autonomous in the rotating frame (anisotropic supports or gravity): relative change {0:.2e}"
     )]
     NotAutonomous(f64),
+    /// The QR iteration of the eigenvalue solver hit its iteration bound.
+    #[error(
+        "the eigenvalues of the {dim} × {dim} Jacobian did not converge within {iterations} QR iterations"
+    )]
+    EigenvaluesDidNotConverge {
+        /// Size of the Jacobian.
+        dim: usize,
+        /// The bound that was reached.
+        iterations: usize,
+    },
     /// Newton did not find a steady state in the rotating frame.
     #[error("no steady state found near the balancing positions (residual {0:.2e})")]
     NoSteadyState(f64),
@@ -255,6 +265,10 @@ pub fn steady_state(frame: &RotatingFrame<'_>, psi0: &[f64]) -> Result<Vec<f64>,
     }
 }
 
+/// QR iterations allowed per eigenvalue: LAPACK's dhseqr allows 30; a few
+/// more cost nothing and leave room for clustered eigenvalues.
+const SCHUR_ITERATIONS_PER_EIGENVALUE: usize = 50;
+
 /// Linear stability of the balanced state of a constant-speed system, from
 /// the cargo angles `psi0` (the balancing fans when `None`).
 pub fn analyse(system: &RotorSystem, psi0: Option<&[f64]>) -> Result<LinearReport, LinearError> {
@@ -266,7 +280,18 @@ pub fn analyse(system: &RotorSystem, psi0: Option<&[f64]>) -> Result<LinearRepor
     let z = steady_state(&frame, &guess)?;
     check_autonomous(&frame, &z)?;
     let jac = frame.jacobian(&z);
-    let mut eig: Vec<(f64, f64)> = jac
+    // nalgebra's `complex_eigenvalues` iterates without a limit (and was seen
+    // to spin forever on small weights on a flexible shaft); the Schur form
+    // with a bounded QR iteration count either converges or says so.
+    let dim = jac.nrows();
+    let max_iterations = SCHUR_ITERATIONS_PER_EIGENVALUE * dim;
+    let schur = nalgebra::linalg::Schur::try_new(jac, f64::EPSILON, max_iterations).ok_or(
+        LinearError::EigenvaluesDidNotConverge {
+            dim,
+            iterations: max_iterations,
+        },
+    )?;
+    let mut eig: Vec<(f64, f64)> = schur
         .complex_eigenvalues()
         .iter()
         .map(|c| (c.re, c.im))

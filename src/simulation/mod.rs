@@ -108,6 +108,9 @@ impl Simulation {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: self.solver.max_steps,
+            max_wall: Some(std::time::Duration::from_secs_f64(
+                self.solver.max_wall_seconds,
+            )),
             stiffness: if explicit && self.solver.implicit_fallback {
                 Stiffness::SwitchToImplicit
             } else {

@@ -30,8 +30,11 @@ pub struct SolverSettings {
     /// Absolute tolerance relative to the problem's scales (see above);
     /// `None`: rtol/100.
     pub atol: Option<f64>,
-    /// Step budget (accepted plus rejected).
+    /// Step budget (accepted plus rejected) per integration segment.
     pub max_steps: u64,
+    /// Wall-time budget of one run (s): a run that takes longer is recorded
+    /// as `budget_exceeded` and the study goes on.
+    pub max_wall_seconds: f64,
     /// When an explicit method finds the problem stiff, runs out of steps or
     /// underflows its step size, re-run the whole simulation with Radau5 and
     /// record the switch (`method` becomes e.g. "dp5→radau5").
@@ -46,6 +49,7 @@ impl Default for SolverSettings {
             rtol: 1e-6,
             atol: None,
             max_steps: 5_000_000,
+            max_wall_seconds: 600.0,
             implicit_fallback: true,
         }
     }
@@ -103,6 +107,13 @@ impl SolverSettings {
         }
         if self.max_steps == 0 {
             return Err(("solver.max_steps", "0".into(), "must be positive".into()));
+        }
+        if !(self.max_wall_seconds.is_finite() && self.max_wall_seconds > 0.0) {
+            return Err((
+                "solver.max_wall_seconds",
+                self.max_wall_seconds.to_string(),
+                "must be a positive number of seconds".into(),
+            ));
         }
         Ok(())
     }

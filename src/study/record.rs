@@ -132,6 +132,7 @@ fn outcome_from(name: &str) -> PolarsResult<Outcome> {
         "settled" => Outcome::Settled,
         "not_settled" => Outcome::NotSettled,
         "censored" => Outcome::Censored,
+        "budget_exceeded" => Outcome::BudgetExceeded,
         "diverged" => Outcome::Diverged,
         "solver_failed" => Outcome::SolverFailed,
         other => polars_bail!(ComputeError: "unknown outcome '{other}' in runs file"),

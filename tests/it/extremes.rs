@@ -366,3 +366,22 @@ fn a_hundred_thousand_revolutions() {
     assert!(m.steps < 10_000, "{} steps for 1e5 revolutions", m.steps);
     assert!(m.residual_rel < 1e-3);
 }
+
+#[test]
+fn runs_that_exhaust_a_budget_are_recorded_as_such() {
+    use autobal::metrics::Outcome;
+    let angles = [60.0, 90.0, 120.0];
+    // A step budget the run cannot meet, with no fallback to switch to.
+    let mut s = sim(rotor(0.01), vec![point(0.01, 0.01); 3], 4.0, &angles, 300.0);
+    s.solver.max_steps = 50;
+    s.solver.implicit_fallback = false;
+    let m = run(&s);
+    assert_eq!(m.outcome, Outcome::BudgetExceeded, "{}", m.reason);
+    assert!(m.reason.contains("too many steps"), "{}", m.reason);
+    // A wall-time budget far below what the run needs.
+    let mut s = sim(rotor(0.01), vec![point(0.01, 0.01); 3], 4.0, &angles, 300.0);
+    s.solver.max_wall_seconds = 1e-9;
+    let m = run(&s);
+    assert_eq!(m.outcome, Outcome::BudgetExceeded, "{}", m.reason);
+    assert!(m.reason.contains("wall-time budget"), "{}", m.reason);
+}

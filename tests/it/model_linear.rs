@@ -300,3 +300,71 @@ fn decay_rate_predicts_the_settling_time_of_the_flexible_shaft() {
     let cargo = vec![Cargo::point(0.01, 1.0, 0.002, 1.0); 2];
     compare_with_settling(scene(shaft.into(), cargo, 1.5), &[0.04, -0.02]);
 }
+
+/// Small weights on a flexible shaft ("washer" scenes, ρ = 0.05, n = 6, 8,
+/// 14) once made the eigenvalue solver spin forever (nalgebra's Schur form
+/// without an iteration bound). Every point now ends: with the eigenvalues or
+/// with an error that says the QR iteration did not converge. A watchdog
+/// thread turns a hang into a failure instead of a stuck test run.
+#[test]
+fn washer_scenes_never_hang_the_linear_analysis() {
+    use autobal::model::linear::{LinearError, analyse};
+    use autobal::scene_file::SceneFile;
+    let (done, finished) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut outcomes = Vec::new();
+        for n in [6, 8, 14] {
+            for omega in [0.5, 1.0, 1.5, 3.0] {
+                let text = format!(
+                    r#"
+[rotor]
+model = "flexible"
+mass = 1.0
+transverse_inertia = 0.25
+polar_inertia = 0.5
+ei = 0.16666666666666666
+length = 2.0
+c_t = 0.01
+c_r = 0.005773502691896258
+eccentricity = 0.01
+[balancer]
+kind = "ball"
+n = {n}
+rho = 0.05
+race_radius = 1.0
+density = 20.0
+drag = 1.0e-4
+[speed]
+mode = "constant"
+omega = {omega}
+[metrics]
+t_end_revs = 3000
+"#
+                );
+                let sim = SceneFile::parse(&text, "washer.toml")
+                    .and_then(|f| f.simulation("washer.toml"))
+                    .expect("valid scene");
+                let system = sim.scene.build().expect("builds");
+                let outcome = match analyse(&system, None) {
+                    Ok(report) => format!("{}", report.stable),
+                    Err(e @ LinearError::EigenvaluesDidNotConverge { .. }) => e.to_string(),
+                    Err(other) => panic!("n = {n}, ω = {omega}: {other}"),
+                };
+                outcomes.push((n, omega, outcome));
+            }
+        }
+        done.send(outcomes).unwrap();
+    });
+    let outcomes = finished
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("the linear analysis of the washer scenes hung");
+    assert_eq!(outcomes.len(), 12);
+    // The cases that converge are the balanced, stable state (ω > 1 is
+    // supercritical); the others say what failed.
+    for (n, omega, outcome) in outcomes {
+        assert!(
+            outcome == "true" || outcome.contains("did not converge within"),
+            "n = {n}, ω = {omega}: {outcome}"
+        );
+    }
+}

@@ -1,7 +1,7 @@
 //! `study linear`: linear stability of a scene's balanced state.
 
 use crate::UserError;
-use autobal::model::linear::{LinearReport, analyse};
+use autobal::model::linear::{LinearError, LinearReport, analyse};
 use autobal::scene_file::SceneFile;
 use clap::Args;
 use std::path::PathBuf;
@@ -27,7 +27,14 @@ pub fn run(args: &LinearArgs) -> Result<(), UserError> {
     let file = SceneFile::read(&args.scene)?;
     let simulation = file.simulation(&shown)?;
     let system = simulation.scene.build()?;
-    let report = analyse(&system, None)?;
+    // A solver that could not converge is a failed run (exit 1), not bad
+    // input; either way the message names the scene.
+    let report = analyse(&system, None).map_err(|e| match e {
+        LinearError::EigenvaluesDidNotConverge { .. } | LinearError::NoSteadyState(_) => {
+            UserError::internal(format!("{shown}: {e}"))
+        }
+        _ => UserError(format!("{shown}: {e}"), 2),
+    })?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
