@@ -95,6 +95,13 @@ impl<T: Clone> OneOrMany<T> {
     }
 }
 
+/// Most weights one balancer may have (docs/running-at-scale.md).
+pub const MAX_WEIGHTS: u32 = 256;
+
+/// Most runs one study may hold: the summary keeps every run in memory
+/// (about 0.5 kB each, 5 GB at this limit; docs/running-at-scale.md).
+pub const MAX_TOTAL_RUNS: u64 = 10_000_000;
+
 /// The design grid: every combination of kind × n × ρ × drag.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -427,6 +434,21 @@ impl StudyFile {
         {
             return Err(invalid(&field, value, &reason));
         }
+        if let Some(n) = self
+            .designs
+            .n
+            .values()
+            .into_iter()
+            .find(|&n| n > MAX_WEIGHTS)
+        {
+            return Err(invalid(
+                "designs.n",
+                n.to_string(),
+                &format!(
+                    "at most {MAX_WEIGHTS} weights per balancer: the state and the implicit method's Jacobian grow with n (n² entries), and no race holds more weights of a useful size"
+                ),
+            ));
+        }
         let designs = self
             .resolve_designs()
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;
@@ -442,6 +464,18 @@ impl StudyFile {
                     ),
                 ));
             }
+        }
+        let total = designs.len() as u64 * u64::from(s.samples);
+        if total > MAX_TOTAL_RUNS {
+            return Err(invalid(
+                "sampling.samples",
+                s.samples.to_string(),
+                &format!(
+                    "{} designs × {} samples = {total} runs, more than the {MAX_TOTAL_RUNS} one study may hold (the summary keeps every run in memory, about 0.5 kB each); split the grid into several studies or use fewer samples",
+                    designs.len(),
+                    s.samples
+                ),
+            ));
         }
         Ok(StudyPlan {
             name,

@@ -205,3 +205,52 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn plans_too_large_to_run_are_refused_before_anything_is_written() {
+    // A million weights once aborted the process after study.toml was
+    // written; four billion samples aborted too.
+    rejects(
+        |t| t.replace("n = 3", "n = 1000000"),
+        &["designs.n", "1000000", "at most 256 weights"],
+    );
+    rejects(
+        |t| t.replace("samples = 2", "samples = 4000000000"),
+        &["sampling.samples", "4000000000", "more than the 10000000"],
+    );
+}
+
+#[test]
+fn zero_threads_is_refused_and_too_many_are_capped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let path = tmp.path().join("ok.toml");
+    std::fs::write(&path, valid(&results)).unwrap();
+    let zero = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", path.to_str().unwrap(), "--quiet", "--threads", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(zero.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&zero.stderr).contains("--threads 0"));
+    assert!(!results.exists());
+    let many = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--quiet",
+            "--threads",
+            "100000",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        many.status.success(),
+        "{}",
+        String::from_utf8_lossy(&many.stderr)
+    );
+    let err = String::from_utf8_lossy(&many.stderr);
+    assert!(
+        err.contains("warning: --threads 100000 is more than"),
+        "{err}"
+    );
+}

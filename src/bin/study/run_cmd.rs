@@ -93,7 +93,7 @@ impl Progress for Bar {
     fn advance(&self, record: &RunRecord) {
         if matches!(
             record.metrics.outcome,
-            Outcome::Diverged | Outcome::SolverFailed
+            Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded
         ) {
             let f = self.failures.fetch_add(1, Ordering::Relaxed) + 1;
             self.bar.set_message(format!("failures {f}"));
@@ -107,11 +107,29 @@ impl Progress for Bar {
 
 /// Run `study run`.
 pub fn run(args: &RunArgs) -> Result<(), UserError> {
+    let threads = match args.threads {
+        Some(0) => {
+            return Err(UserError(
+                "--threads 0: a study needs at least one worker thread".into(),
+                2,
+            ));
+        }
+        Some(asked) => {
+            let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+            if asked > cores {
+                eprintln!(
+                    "warning: --threads {asked} is more than the {cores} logical cores here; using {cores}"
+                );
+            }
+            Some(asked.min(cores))
+        }
+        None => None,
+    };
     let plan = load(&args.study)?;
     let options = RunOptions {
         resume: args.resume,
         shard: args.shard,
-        threads: args.threads,
+        threads,
         ..RunOptions::default()
     };
     let bar = Bar::new(args.quiet);
