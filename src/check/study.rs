@@ -92,7 +92,13 @@ pub fn record_baseline(
     run: &RunOptions,
     progress: &dyn Progress,
 ) -> Result<Manifest, CheckError> {
-    let output = run_study(plan, run, progress)?;
+    // Recording a baseline reruns the study on purpose: its results folder
+    // is replaced, as the documentation of `study baseline` says.
+    let run = RunOptions {
+        overwrite: true,
+        ..run.clone()
+    };
+    let output = run_study(plan, &run, progress)?;
     Ok(write_baseline(dir, plan, &output.runs)?)
 }
 
@@ -118,7 +124,12 @@ pub fn check_study(
                 .clone()
                 .unwrap_or_else(|| Path::new(&plan.file.output).join("check"));
             fresh.file.output = root.display().to_string();
-            let out = run_study(&fresh, &options.run, progress)?;
+            // The check's scratch folder is rewritten by every check.
+            let run = RunOptions {
+                overwrite: true,
+                ..options.run.clone()
+            };
+            let out = run_study(&fresh, &run, progress)?;
             (
                 design_samples(&to_dataframe(&out.runs)?)?,
                 fresh.file.seed,

@@ -166,7 +166,12 @@ fn run_variant(
     norm: Normalisation,
     progress: &dyn Progress,
 ) -> Result<Vec<DesignResult>, RunError> {
-    let out = run_study(plan, &RunOptions::default(), progress)?;
+    // Each variant's folder belongs to the claims verb, which recomputes it.
+    let options = RunOptions {
+        overwrite: true,
+        ..RunOptions::default()
+    };
+    let out = run_study(plan, &options, progress)?;
     let summary = out.summary.expect("unsharded runs have a summary");
     let f = |c: &str| -> PolarsResult<Vec<Option<f64>>> {
         Ok(summary.column(c)?.f64()?.iter().collect())

@@ -14,6 +14,7 @@
 pub mod aggregate;
 pub mod config;
 pub mod io;
+pub mod lock;
 pub mod merge;
 pub mod optimize_spec;
 pub mod record;

@@ -8,7 +8,8 @@
 
 use super::aggregate::summarize;
 use super::config::{Design, StudyPlan};
-use super::io::{Provenance, read_parquet, write_parquet, write_text};
+use super::io::{Provenance, read_parquet, sha256_hex, write_parquet, write_text};
+use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::sample::draw_sample;
 use crate::metrics::{Outcome, RunMetrics};
@@ -72,6 +73,9 @@ pub struct RunOptions {
     pub chunk_runs: usize,
     /// … or after this much time, whichever comes first.
     pub chunk_interval: Duration,
+    /// Replace the results already in the folder (otherwise a fresh run over
+    /// existing results is refused: they are never deleted silently).
+    pub overwrite: bool,
 }
 
 impl Default for RunOptions {
@@ -82,6 +86,7 @@ impl Default for RunOptions {
             threads: None,
             chunk_runs: 256,
             chunk_interval: Duration::from_secs(2),
+            overwrite: false,
         }
     }
 }
@@ -133,6 +138,37 @@ pub enum RunError {
         /// The folder.
         path: String,
     },
+    /// A fresh run over a folder that already holds results.
+    #[error(
+        "{path} already holds results of a study run; continue it with --resume, replace it with --overwrite, or choose another output folder"
+    )]
+    ResultsExist {
+        /// The folder.
+        path: String,
+    },
+    /// `--resume` on a folder with results but no record of their plan.
+    #[error(
+        "cannot resume in {path}: it holds results but no study.toml saying which plan made them; nothing was changed (move them away, or run with --overwrite to replace them)"
+    )]
+    NoPlan {
+        /// The folder.
+        path: String,
+    },
+    /// `--resume` on a folder written by another autobal build.
+    #[error(
+        "cannot resume in {path}: its runs were made by another autobal build (plan {found}, this one {expected}); mixing them would mix results of different code"
+    )]
+    PlanChanged {
+        /// The folder.
+        path: String,
+        /// The plan id stored in the folder.
+        found: String,
+        /// This run's plan id.
+        expected: String,
+    },
+    /// Another process is writing the folder.
+    #[error(transparent)]
+    Locked(#[from] LockError),
     /// Reading or writing Parquet failed.
     #[error("parquet: {0}")]
     Polars(#[from] PolarsError),
@@ -149,7 +185,12 @@ impl RunError {
     pub fn is_user_error(&self) -> bool {
         matches!(
             self,
-            RunError::NotWritable { .. } | RunError::StudyChanged { .. }
+            RunError::NotWritable { .. }
+                | RunError::StudyChanged { .. }
+                | RunError::ResultsExist { .. }
+                | RunError::NoPlan { .. }
+                | RunError::PlanChanged { .. }
+                | RunError::Locked(_)
         )
     }
 }
@@ -237,6 +278,19 @@ fn failed(reason: String) -> RunMetrics {
     RunMetrics::not_integrated(0.0, Outcome::SolverFailed, reason, "")
 }
 
+/// File holding the folder's plan id (see [`plan_id`]).
+pub const PLAN_ID_FILE: &str = "plan.sha256";
+
+/// What makes runs of one folder comparable: the study text (with its seed)
+/// and the autobal build that ran them (version and git commit).
+pub fn plan_id(plan: &StudyPlan) -> String {
+    let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
+    sha256_hex(&format!(
+        "autobal {}\ncommit {}\n{}",
+        provenance.version, provenance.git_commit, plan.text
+    ))
+}
+
 /// Label stored in provenance: "all" or "k/N".
 pub fn shard_label(shard: Option<Shard>) -> String {
     shard.map_or_else(|| "all".to_string(), |s| s.label())
@@ -259,9 +313,17 @@ pub fn run_study(
     std::fs::write(&probe, b"").map_err(not_writable)?;
     std::fs::remove_file(&probe)?;
 
+    let _lock = FolderLock::acquire(&dir)?;
+
     let manifest = dir.join("study.toml");
+    let plan_file = dir.join(PLAN_ID_FILE);
     let chunks = dir.join("chunks");
     let runs_path = dir.join("runs.parquet");
+    let summary_path = dir.join("summary.parquet");
+    let id = plan_id(plan);
+    let has_results = runs_path.exists()
+        || summary_path.exists()
+        || std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some());
     let mut done: Vec<RunRecord> = Vec::new();
     if options.resume && manifest.exists() {
         if std::fs::read_to_string(&manifest)? != plan.text {
@@ -269,12 +331,31 @@ pub fn run_study(
                 path: dir.display().to_string(),
             });
         }
+        if let Ok(found) = std::fs::read_to_string(&plan_file)
+            && found.trim() != id
+        {
+            return Err(RunError::PlanChanged {
+                path: dir.display().to_string(),
+                found: found.trim().to_string(),
+                expected: id,
+            });
+        }
         if runs_path.exists() {
             done.extend(from_dataframe(&read_parquet(&runs_path)?)?);
         }
         done.extend(read_chunks(&chunks)?);
     } else {
-        for stale in [&runs_path, &dir.join("summary.parquet")] {
+        if has_results && options.resume && !options.overwrite {
+            return Err(RunError::NoPlan {
+                path: dir.display().to_string(),
+            });
+        }
+        if has_results && !options.overwrite {
+            return Err(RunError::ResultsExist {
+                path: dir.display().to_string(),
+            });
+        }
+        for stale in [&runs_path, &summary_path] {
             if stale.exists() {
                 std::fs::remove_file(stale)?;
             }
@@ -283,6 +364,7 @@ pub fn run_study(
             std::fs::remove_dir_all(&chunks)?;
         }
         write_text(&manifest, &plan.text)?;
+        write_text(&plan_file, &id)?;
     }
     std::fs::create_dir_all(&chunks)?;
     let provenance = Provenance::new(&plan.text, plan.file.seed, &shard_label(options.shard));

@@ -281,7 +281,12 @@ fn planted_drag_change_of_five_percent_is_detected() {
     let mut after = plan(&small_study(&tmp.path().join("after"), 21.0));
     for seed in [11, 12] {
         after.file.seed = seed;
-        let out = run_study(&after, &RunOptions::default(), &NoProgress).unwrap();
+        // Both seeds write the same folder: the second replaces the first.
+        let replace = RunOptions {
+            overwrite: true,
+            ..RunOptions::default()
+        };
+        let out = run_study(&after, &replace, &NoProgress).unwrap();
         let now = design_samples(&to_dataframe(&out.runs).unwrap()).unwrap();
         let report = compare(&baseline.samples, &now, 0.01).unwrap();
         assert!(!report.passed(), "seed {seed}: not detected");

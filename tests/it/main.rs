@@ -22,6 +22,7 @@ mod model_two_support;
 mod operating_point;
 mod optimize;
 mod plot;
+mod results_folder;
 mod study_input;
 mod study_runner;
 mod study_summary;

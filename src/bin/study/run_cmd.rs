@@ -17,6 +17,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub const RUN_EXAMPLES: &str = "Examples:
   study run studies/three_balls.toml
   study run studies/three_balls.toml --resume        continue an interrupted run
+  study run studies/three_balls.toml --overwrite     replace the previous results
   study run studies/balls_vs_rollers.toml --shard 2/8 one of eight disjoint slices
   RAYON_NUM_THREADS=1 study run studies/three_balls.toml --quiet";
 
@@ -29,9 +30,12 @@ pub const MERGE_EXAMPLES: &str = "Examples:
 pub struct RunArgs {
     /// Study file (TOML).
     study: PathBuf,
-    /// Continue an interrupted run; fails if the study file changed since.
+    /// Continue an interrupted run; fails if the study file (or the autobal build) changed since.
     #[arg(long)]
     resume: bool,
+    /// Replace results already in the output folder (a run over existing results is refused otherwise).
+    #[arg(long, conflicts_with = "resume")]
+    overwrite: bool,
     /// Run only the k-th of N disjoint slices, e.g. 2/8 (merge them with `study merge`).
     #[arg(long, value_parser = Shard::parse)]
     shard: Option<Shard>,
@@ -128,6 +132,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
     let plan = load(&args.study)?;
     let options = RunOptions {
         resume: args.resume,
+        overwrite: args.overwrite,
         shard: args.shard,
         threads,
         ..RunOptions::default()

@@ -132,6 +132,7 @@ pub fn measure_threads(config: &ThreadConfig, output: &Path) -> Result<ThreadSca
         for i in order {
             let options = RunOptions {
                 threads: Some(counts[i].max(1)),
+                overwrite: true,
                 ..RunOptions::default()
             };
             let cpu_start = process_cpu_seconds();

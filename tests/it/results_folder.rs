@@ -1,0 +1,123 @@
+//! A results folder belongs to one plan and one writer: a rerun never
+//! deletes results unless asked (--overwrite), --resume refuses a folder
+//! whose plan is unknown or different, and a second writer is turned away
+//! with the holder's name. Each case exits 2 and leaves the results as they
+//! were.
+
+use autobal::study::lock::FolderLock;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn study_text(results: &Path) -> String {
+    format!(
+        r#"name = "folder"
+output = "{}"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.05
+drag = 10.0
+[sampling]
+samples = 2
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+[metrics]
+t_end_revs = 60
+"#,
+        results.display()
+    )
+}
+
+/// A study file in a fresh folder; returns (tempdir, study path, results folder).
+fn setup() -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let path = tmp.path().join("folder.toml");
+    std::fs::write(&path, study_text(&results)).unwrap();
+    let folder = results.join("folder");
+    (tmp, path, folder)
+}
+
+fn study(path: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", path.to_str().unwrap(), "--quiet"])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).to_string()
+}
+
+#[test]
+fn a_rerun_needs_overwrite_and_leaves_the_results_otherwise() {
+    let (_tmp, path, folder) = setup();
+    assert!(study(&path, &[]).status.success());
+    let runs = std::fs::read(folder.join("runs.parquet")).unwrap();
+    assert!(!folder.join(".lock").exists(), "lock file left behind");
+    let again = study(&path, &[]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(
+        stderr(&again).contains("already holds results"),
+        "{}",
+        stderr(&again)
+    );
+    assert_eq!(std::fs::read(folder.join("runs.parquet")).unwrap(), runs);
+    let replaced = study(&path, &["--overwrite"]);
+    assert!(replaced.status.success(), "{}", stderr(&replaced));
+}
+
+#[test]
+fn resume_refuses_results_without_a_plan_and_keeps_them() {
+    let (_tmp, path, folder) = setup();
+    assert!(study(&path, &[]).status.success());
+    std::fs::remove_file(folder.join("study.toml")).unwrap();
+    let runs = std::fs::read(folder.join("runs.parquet")).unwrap();
+    let out = study(&path, &["--resume"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("no study.toml"), "{}", stderr(&out));
+    assert_eq!(std::fs::read(folder.join("runs.parquet")).unwrap(), runs);
+}
+
+#[test]
+fn resume_refuses_runs_of_another_build() {
+    let (_tmp, path, folder) = setup();
+    assert!(study(&path, &[]).status.success());
+    std::fs::write(folder.join("plan.sha256"), "0123456789abcdef").unwrap();
+    let out = study(&path, &["--resume"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("another autobal build"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn a_second_writer_is_turned_away_with_the_holders_name() {
+    let (_tmp, path, folder) = setup();
+    std::fs::create_dir_all(&folder).unwrap();
+    let held = FolderLock::acquire(&folder).expect("first writer");
+    let out = study(&path, &["--resume"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("in use by another study run"), "{err}");
+    assert!(
+        err.contains(&format!("pid {}", std::process::id())),
+        "{err}"
+    );
+    drop(held);
+    assert!(!folder.join(".lock").exists());
+    // Released: the run goes ahead.
+    assert!(study(&path, &["--resume"]).status.success());
+}
