@@ -153,21 +153,12 @@ impl SceneFile {
                 }));
             }
         }
-        let m = &self.metrics;
-        let checks = [
-            ("metrics.delta", m.delta),
-            ("metrics.hold_revs", m.hold_revs),
-            ("metrics.t_end_revs", m.t_end_revs),
-            ("metrics.divergence_factor", m.divergence_factor),
-        ];
-        for (field, value) in checks {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(SceneError::Invalid {
-                    field: field.into(),
-                    value: value.to_string(),
-                    reason: "must be positive and finite".into(),
-                }));
-            }
+        if let Err((field, value, reason)) = self.metrics.validate() {
+            return Err(invalid(SceneError::Invalid {
+                field: field.into(),
+                value,
+                reason,
+            }));
         }
         if let Err((field, value, reason)) = self.solver.validate() {
             return Err(invalid(SceneError::Invalid {

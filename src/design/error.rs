@@ -53,6 +53,22 @@ pub enum DesignError {
     },
 }
 
+impl DesignError {
+    /// The design key the error is about, for messages that name it.
+    pub fn key(&self) -> &'static str {
+        match self {
+            DesignError::ZeroWeights => "n",
+            DesignError::RhoOutOfRange { .. }
+            | DesignError::DoesNotFit { .. }
+            | DesignError::UnknownRhoRule(_) => "rho",
+            DesignError::UnknownShape(_) => "kind",
+            DesignError::NotPositive { .. }
+            | DesignError::POutOfRange(_)
+            | DesignError::Optimizer { .. } => "",
+        }
+    }
+}
+
 /// Return `value` if it is positive and finite, else a [`DesignError::NotPositive`].
 pub fn require_positive(name: &'static str, value: f64) -> Result<f64, DesignError> {
     if value.is_finite() && value > 0.0 {

@@ -45,7 +45,7 @@ pub struct MetricOptions {
     pub hold_revs: f64,
     /// Run length T_end in revolutions.
     pub t_end_revs: f64,
-    /// Dense-output samples per revolution (at least 32).
+    /// Dense-output samples per revolution (at least [`MIN_SAMPLES_PER_REV`]).
     pub samples_per_rev: u32,
     /// Stop the run as soon as the hold is satisfied.
     pub stop_when_settled: bool,
@@ -65,6 +65,9 @@ impl Default for MetricOptions {
         }
     }
 }
+
+/// Fewest dense-output samples per revolution the settling rule accepts.
+pub const MIN_SAMPLES_PER_REV: u32 = 32;
 
 /// How a run ended, in physical terms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -188,6 +191,47 @@ impl RunMetrics {
 }
 
 impl MetricOptions {
+    /// Check each definition's parameter; on failure the key, the value and the rule.
+    pub fn validate(&self) -> Result<(), (&'static str, String, String)> {
+        let fail = |key, value: f64, rule: &str| Err((key, value.to_string(), rule.to_string()));
+        if !(self.delta > 0.0 && self.delta < 1.0) {
+            return fail(
+                "metrics.delta",
+                self.delta,
+                "must lie strictly between 0 and 1 (a fraction of A_ref)",
+            );
+        }
+        if !(self.hold_revs.is_finite() && self.hold_revs > 0.0) {
+            return fail(
+                "metrics.hold_revs",
+                self.hold_revs,
+                "must be a positive number of revolutions",
+            );
+        }
+        if !(self.t_end_revs.is_finite() && self.t_end_revs > 0.0) {
+            return fail(
+                "metrics.t_end_revs",
+                self.t_end_revs,
+                "must be a positive number of revolutions",
+            );
+        }
+        if !(self.divergence_factor.is_finite() && self.divergence_factor > 1.0) {
+            return fail(
+                "metrics.divergence_factor",
+                self.divergence_factor,
+                "must be a finite multiple of A_ref above 1",
+            );
+        }
+        if !(MIN_SAMPLES_PER_REV..=100_000).contains(&self.samples_per_rev) {
+            return fail(
+                "metrics.samples_per_rev",
+                f64::from(self.samples_per_rev),
+                "must lie in [32, 100000]: fewer samples cannot resolve the whirl, which turns once per revolution",
+            );
+        }
+        Ok(())
+    }
+
     /// A run must be long enough to show settling at its operating point:
     /// t_end ≥ (end of the speed ramp) + hold window. Checked before any run.
     pub fn check_horizon(&self, speed: &SpeedLaw) -> Result<(), SceneError> {

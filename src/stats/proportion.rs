@@ -35,7 +35,12 @@ pub fn fisher_two_proportions(
         successes_b,
         trials_b - successes_b,
     ];
-    let p_value = fishers_exact(&table, Alternative::TwoSided).ok()?;
+    // statrs forms the two-sided p as 1 − (the rest), which rounding can push
+    // just below 0 (−4.2e-13 seen for 500/500 against 447/500): a p-value is
+    // a probability, so keep it in [0, 1].
+    let p_value = fishers_exact(&table, Alternative::TwoSided)
+        .ok()?
+        .clamp(0.0, 1.0);
     let (a, b) = (
         successes_a as f64 / trials_a as f64,
         successes_b as f64 / trials_b as f64,
@@ -46,4 +51,20 @@ pub fn fisher_two_proportions(
         difference: b - a,
         p_value,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extreme_tables_give_probabilities() {
+        let raw = fishers_exact(&[500, 0, 447, 53], Alternative::TwoSided).unwrap();
+        let result = fisher_two_proportions(500, 500, 447, 500).unwrap();
+        assert!((0.0..=1.0).contains(&result.p_value), "{}", result.p_value);
+        // The clamp only removes rounding: the raw value was already ~0.
+        assert!(raw.abs() < 1e-9 && result.p_value < 1e-9, "{raw}");
+        let same = fisher_two_proportions(500, 500, 500, 500).unwrap();
+        assert_eq!(same.p_value, 1.0);
+    }
 }

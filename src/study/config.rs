@@ -76,13 +76,40 @@ pub struct SceneTemplate {
 }
 
 /// A one-or-many value in the design grid.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum OneOrMany<T> {
     /// A single value.
     One(T),
     /// A list of values.
     Many(Vec<T>),
+}
+
+/// Written by hand instead of serde's `untagged`: that one can only say "data
+/// did not match any variant"; this one passes on what was wrong with the
+/// value (or with which list entry), e.g. "invalid value: integer `-3`,
+/// expected u32" or "unknown variant `bal`, expected one of ...".
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for OneOrMany<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        match toml::Value::deserialize(deserializer)? {
+            toml::Value::Array(items) => items
+                .into_iter()
+                .enumerate()
+                .map(|(i, item)| {
+                    T::deserialize(item)
+                        .map_err(|e| D::Error::custom(format!("entry {}: {}", i + 1, e.message())))
+                })
+                .collect::<Result<Vec<T>, _>>()
+                .map(OneOrMany::Many),
+            value => T::deserialize(value).map(OneOrMany::One).map_err(|e| {
+                D::Error::custom(format!(
+                    "{} (give one value or a list of them)",
+                    e.message()
+                ))
+            }),
+        }
+    }
 }
 
 impl<T: Clone> OneOrMany<T> {
@@ -409,19 +436,8 @@ impl StudyFile {
                 "must be finite",
             ));
         }
-        for (key, value) in [
-            ("metrics.delta", self.metrics.delta),
-            ("metrics.hold_revs", self.metrics.hold_revs),
-            ("metrics.t_end_revs", self.metrics.t_end_revs),
-            ("metrics.divergence_factor", self.metrics.divergence_factor),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(
-                    key,
-                    value.to_string(),
-                    "must be positive and finite",
-                ));
-            }
+        if let Err((key, value, reason)) = self.metrics.validate() {
+            return Err(invalid(key, value, &reason));
         }
         if let Err((key, value, reason)) = self.solver.validate() {
             return Err(invalid(key, value, &reason));
@@ -598,7 +614,13 @@ fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String
             };
             (key, value, reason)
         }
-        SceneError::Design(d) => ("designs".into(), format!("{kind} n = {n}"), d.to_string()),
+        SceneError::Design(d) => {
+            let key = match d.key() {
+                "" => "designs".to_string(),
+                k => format!("designs.{k}"),
+            };
+            (key, format!("{kind} n = {n}"), d.to_string())
+        }
     }
 }
 

@@ -1,5 +1,6 @@
 //! autobal's integration tests, linked into one binary to keep builds fast.
 
+mod bad_input;
 mod bench;
 mod check;
 mod claims;
@@ -12,6 +13,7 @@ mod design_criterion;
 mod design_transient;
 mod extremes;
 mod fixtures;
+mod fuzz_input;
 mod golden;
 mod integrate;
 mod model_conservation;

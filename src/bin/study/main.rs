@@ -23,7 +23,13 @@ use std::process::ExitCode;
 
 /// Design passive auto-balancers by virtual experiment.
 #[derive(Parser)]
-#[command(name = "study", version, about, long_about = None)]
+#[command(
+    name = "study",
+    version,
+    about,
+    long_about = None,
+    after_help = "Exit codes: 0 done; 1 a run or a check failed (e.g. a regression, a solver that did not converge); 2 bad input or usage (the message names the key or flag), nothing written."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

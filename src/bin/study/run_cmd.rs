@@ -129,10 +129,17 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         }
         None => None,
     };
+    if args.chunk_runs == 0 {
+        return Err(UserError(
+            "--chunk-runs 0: a chunk holds at least one run".into(),
+            2,
+        ));
+    }
     let plan = load(&args.study)?;
     let options = RunOptions {
         resume: args.resume,
         overwrite: args.overwrite,
+        chunk_runs: args.chunk_runs,
         shard: args.shard,
         threads,
         ..RunOptions::default()

@@ -1,0 +1,304 @@
+//! The bad-input corpus: every case is a study file, a scene file or a
+//! command line that must be refused with exit code 2, a message naming the
+//! key (or flag) at fault, and no output folder.
+
+use std::path::Path;
+use std::process::Command;
+
+fn study(results: &Path) -> String {
+    format!(
+        r#"name = "corpus"
+seed = 5
+output = "{}"
+[scene]
+start = "locked_steady"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+inertia = 0.05
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.05
+density = 7850.0
+drag = 10.0
+[sampling]
+samples = 2
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+direction = "uniform"
+initial = "clustered"
+[solver]
+rtol = 1e-6
+[metrics]
+delta = 0.05
+hold_revs = 50
+t_end_revs = 100
+"#,
+        results.display()
+    )
+}
+
+const SCENE: &str = r#"[rotor]
+mass = 1.0
+eccentricity = 0.01
+kx = 1.0
+ky = 1.0
+bx = 0.1
+by = 0.1
+[[cargo]]
+mass = 0.01
+track_radius = 1.0
+drag = 0.01
+kappa = 1.4
+[[cargo]]
+mass = 0.01
+track_radius = 1.0
+drag = 0.01
+kappa = 1.4
+[speed]
+mode = "constant"
+omega = 4.0
+[start]
+angles_deg = [90, 100]
+[metrics]
+t_end_revs = 100
+"#;
+
+/// (what to replace, with what, a text the message must contain).
+const STUDY_CASES: &[(&str, &str, &str)] = &[
+    ("mass = 10.0", "mass = -1.0", "mass"),
+    ("mass = 10.0", "mass = 0.0", "mass"),
+    ("mass = 10.0", "mass = \"heavy\"", "heavy"),
+    ("kx = 1.0e5", "kx = -5.0", "kx"),
+    ("bx = 100.0", "bx = -1.0", "bx"),
+    ("inertia = 0.05", "inertia = -0.05", "inertia"),
+    ("omega = 300.0", "omega = -300.0", "omega"),
+    ("omega = 300.0", "omega = 0.0", "omega"),
+    ("mode = \"constant\"", "mode = \"spinning\"", "spinning"),
+    ("kind = \"ball\"", "kind = \"bal\"", "bal"),
+    ("kind = \"ball\"", "kind = 3", "kind"),
+    ("n = 3", "n = -3", "-3"),
+    ("n = 3", "n = 3.5", "3.5"),
+    ("n = 3", "n = 0", "n"),
+    ("n = 3", "n = 1000000", "designs.n"),
+    ("n = 3", "n = [3, -1]", "entry 2"),
+    ("rho = \"optimal\"", "rho = 0.9", "rho"),
+    ("rho = \"optimal\"", "rho = -0.1", "rho"),
+    ("rho = \"optimal\"", "rho = \"biggest\"", "biggest"),
+    ("race_radius = 0.05", "race_radius = -0.05", "race_radius"),
+    ("density = 7850.0", "density = 0.0", "density"),
+    ("drag = 10.0", "drag = true", "boolean"),
+    ("drag = 10.0", "drag = -1.0", "drag"),
+    ("samples = 2", "samples = 0", "sampling.samples"),
+    ("samples = 2", "samples = 4000000000", "sampling.samples"),
+    ("samples = 2", "samples = -2", "samples"),
+    ("min = 0.2", "min = 0.9", "min"),
+    ("min = 0.2", "min = -0.2", "min"),
+    (
+        "distribution = \"uniform\"",
+        "distribution = \"gaussian\"",
+        "gaussian",
+    ),
+    ("direction = \"uniform\"", "direction = \"north\"", "north"),
+    (
+        "initial = \"clustered\"",
+        "initial = \"scattered\"",
+        "scattered",
+    ),
+    (
+        "start = \"locked_steady\"",
+        "start = \"sideways\"",
+        "sideways",
+    ),
+    ("rtol = 1e-6", "rtol = 1e-20", "solver.rtol"),
+    ("rtol = 1e-6", "rtol = 1.0", "solver.rtol"),
+    ("rtol = 1e-6", "rtol = 1e-6\natol = 0.0", "solver.atol"),
+    ("rtol = 1e-6", "rtol = 1e-6\nmethod = \"rk45\"", "rk45"),
+    ("rtol = 1e-6", "rtol = 1e-6\nfidelity = \"exact\"", "exact"),
+    (
+        "rtol = 1e-6",
+        "rtol = 1e-6\nmax_steps = 0",
+        "solver.max_steps",
+    ),
+    (
+        "rtol = 1e-6",
+        "rtol = 1e-6\nmax_wall_seconds = 0.0",
+        "solver.max_wall_seconds",
+    ),
+    ("delta = 0.05", "delta = 2", "metrics.delta"),
+    ("delta = 0.05", "delta = 0.0", "metrics.delta"),
+    ("hold_revs = 50", "hold_revs = -5", "metrics.hold_revs"),
+    ("t_end_revs = 100", "t_end_revs = 20", "metrics.t_end_revs"),
+    (
+        "t_end_revs = 100",
+        "t_end_revs = 100\nsamples_per_rev = 4",
+        "metrics.samples_per_rev",
+    ),
+    (
+        "t_end_revs = 100",
+        "t_end_revs = 100\ndivergence_factor = 0.5",
+        "metrics.divergence_factor",
+    ),
+    ("t_end_revs = 100", "t_end_revs = 100\nbogus = 1", "bogus"),
+    ("seed = 5", "seed = -5", "seed"),
+    ("name = \"corpus\"", "name = \"../escape\"", "name"),
+    ("mass = 10.0", "mass = = 10.0", "line"),
+    ("[designs]", "[designz]", "designz"),
+];
+
+/// (what to replace in the scene, with what, a text the message must contain).
+const SCENE_CASES: &[(&str, &str, &str)] = &[
+    ("mass = 1.0", "mass = -1.0", "mass"),
+    (
+        "eccentricity = 0.01",
+        "eccentricity = -0.01",
+        "eccentricity",
+    ),
+    ("kx = 1.0", "kx = \"stiff\"", "stiff"),
+    (
+        "angles_deg = [90, 100]",
+        "angles_deg = [90, 90]",
+        "start.angles_deg",
+    ),
+    (
+        "angles_deg = [90, 100]",
+        "angles_deg = [90]",
+        "start.angles_deg",
+    ),
+    (
+        "track_radius = 1.0\ndrag = 0.01\nkappa = 1.4\n[[cargo]]",
+        "track_radius = -1.0\ndrag = 0.01\nkappa = 1.4\n[[cargo]]",
+        "track_radius",
+    ),
+    ("kappa = 1.4\n[speed]", "kappa = 0.5\n[speed]", "kappa"),
+    ("omega = 4.0", "omega = 4.0\nbogus = 2", "bogus"),
+    ("t_end_revs = 100", "t_end_revs = 10", "metrics.t_end_revs"),
+    (
+        "t_end_revs = 100",
+        "t_end_revs = 100\ndelta = 1.5",
+        "metrics.delta",
+    ),
+    ("[start]", "[solver]\nrtol = 0.5\n[start]", "solver.rtol"),
+    ("[start]", "[solver]\nmethod = \"euler\"\n[start]", "euler"),
+    (
+        "mode = \"constant\"\nomega = 4.0",
+        "mode = \"ramp\"\nomega_start = 0.0\nomega_end = 4.0\nduration = 2000.0",
+        "metrics.t_end_revs",
+    ),
+    ("[rotor]", "[rotor]\nmodel = \"wobbly\"", "wobbly"),
+    (
+        "[start]",
+        "[effects.contact]\nfrequency_ratio = 10.0\nstiff = true\n[start]",
+        "stiff",
+    ),
+];
+
+/// Command lines (after `study`) that must be refused with exit code 2.
+fn flag_cases(study_path: &str, scene_path: &str) -> Vec<(Vec<String>, &'static str)> {
+    let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    vec![
+        (s(&["run", study_path, "--threads", "0"]), "--threads"),
+        (s(&["run", study_path, "--threads", "many"]), "--threads"),
+        (s(&["run", study_path, "--shard", "3/2"]), "shard"),
+        (s(&["run", study_path, "--shard", "0/4"]), "shard"),
+        (
+            s(&["run", study_path, "--resume", "--overwrite"]),
+            "--overwrite",
+        ),
+        (s(&["run", "no/such/study.toml"]), "no/such/study.toml"),
+        (s(&["simulate", scene_path, "--series"]), "--series"),
+        (s(&["frobnicate"]), "frobnicate"),
+        (s(&["design", "--kind", "cube", "--n", "3"]), "cube"),
+        (s(&["run", study_path, "--chunk-runs", "0"]), "--chunk-runs"),
+    ]
+}
+
+fn run_study(dir: &Path, text: &str) -> (Option<i32>, String, bool) {
+    let path = dir.join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", path.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+        dir.join("results").exists(),
+    )
+}
+
+#[test]
+fn every_bad_study_file_is_refused_naming_the_key_with_nothing_written() {
+    let mut failures = Vec::new();
+    for (from, to, needle) in STUDY_CASES {
+        let tmp = tempfile::tempdir().unwrap();
+        let base = study(&tmp.path().join("results"));
+        assert!(base.contains(from), "fixture lacks {from:?}");
+        let text = base.replacen(from, to, 1);
+        let (code, err, wrote) = run_study(tmp.path(), &text);
+        if code != Some(2) || !err.contains(needle) || wrote {
+            failures.push(format!(
+                "{to:?}: exit {code:?}, wrote {wrote}, expected {needle:?} in: {err}"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn every_bad_scene_file_is_refused_naming_the_key() {
+    let mut failures = Vec::new();
+    for (from, to, needle) in SCENE_CASES {
+        assert!(SCENE.contains(from), "fixture lacks {from:?}");
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("scene.toml");
+        std::fs::write(&path, SCENE.replacen(from, to, 1)).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["simulate", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        if out.status.code() != Some(2) || !err.contains(needle) {
+            failures.push(format!(
+                "{to:?}: exit {:?}, expected {needle:?} in: {err}",
+                out.status.code()
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn every_bad_command_line_is_refused_naming_the_flag() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let study_path = tmp.path().join("ok.toml");
+    std::fs::write(&study_path, study(&results)).unwrap();
+    let scene_path = tmp.path().join("ok_scene.toml");
+    std::fs::write(&scene_path, SCENE).unwrap();
+    let mut failures = Vec::new();
+    let cases = flag_cases(study_path.to_str().unwrap(), scene_path.to_str().unwrap());
+    assert!(STUDY_CASES.len() + SCENE_CASES.len() + cases.len() >= 60);
+    for (args, needle) in cases {
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        if out.status.code() != Some(2) || !err.contains(needle) {
+            failures.push(format!(
+                "{args:?}: exit {:?}, expected {needle:?} in: {err}",
+                out.status.code()
+            ));
+        }
+    }
+    assert!(!results.exists(), "a refused command wrote results");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
