@@ -6,16 +6,17 @@ use sha2::{Digest, Sha256};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-/// Provenance stored in every Parquet file's key-value metadata.
+/// Provenance stored in every Parquet file's key-value metadata. The study
+/// text itself is stored once per folder (`study.toml` beside the files),
+/// not in every file and chunk: a long study file would otherwise be copied
+/// into each of them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Provenance {
     /// autobal's version.
     pub version: String,
     /// Git commit of the autobal source tree, when it can be found.
     pub git_commit: String,
-    /// The study file's text.
-    pub study_text: String,
-    /// SHA-256 of the study file's text.
+    /// SHA-256 of the study file's text (the text is the folder's `study.toml`).
     pub study_sha256: String,
     /// The master seed.
     pub seed: u64,
@@ -29,7 +30,6 @@ impl Provenance {
         Provenance {
             version: env!("CARGO_PKG_VERSION").to_string(),
             git_commit: git_commit(),
-            study_text: study_text.to_string(),
             study_sha256: sha256_hex(study_text),
             seed,
             shard: shard.to_string(),
@@ -43,7 +43,6 @@ impl Provenance {
             ("study_sha256".into(), self.study_sha256.clone()),
             ("seed".into(), self.seed.to_string()),
             ("shard".into(), self.shard.clone()),
-            ("study_toml".into(), self.study_text.clone()),
         ]
     }
 }

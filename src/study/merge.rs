@@ -2,7 +2,7 @@
 
 use super::aggregate::summarize;
 use super::config::StudyPlan;
-use super::io::{Provenance, read_metadata, read_parquet, write_parquet};
+use super::io::{Provenance, read_parquet, write_parquet};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::run::{RunError, StudyOutput};
 use std::collections::HashSet;
@@ -15,7 +15,7 @@ pub enum MergeError {
     #[error("{0}: no runs.parquet (is the shard finished?)")]
     Missing(String),
     /// Shards come from different study files.
-    #[error("{0}: comes from a different study file than {1}")]
+    #[error("{0}: comes from a different study file or autobal build than {1}")]
     DifferentStudy(String, String),
     /// Two shards hold the same run.
     #[error("run {0} appears in more than one shard")]
@@ -53,15 +53,15 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<StudyOutput, MergeE
         if !path.exists() {
             return Err(MergeError::Missing(dir.display().to_string()));
         }
-        let meta = read_metadata(&path)?;
-        let text = meta
-            .iter()
-            .find(|(k, _)| k == "study_toml")
-            .map(|(_, v)| v.clone())
-            .unwrap_or_default();
+        // The shard's plan: its study text and the build that ran it.
+        let text = std::fs::read_to_string(dir.join("study.toml"))
+            .map_err(|_| MergeError::Missing(dir.join("study.toml").display().to_string()))?;
+        let plan_id =
+            std::fs::read_to_string(dir.join(super::run::PLAN_ID_FILE)).unwrap_or_default();
+        let shard_plan = format!("{plan_id}\n{text}");
         match &study {
-            None => study = Some((text, dir.display().to_string())),
-            Some((first, first_dir)) if *first != text => {
+            None => study = Some((shard_plan, dir.display().to_string())),
+            Some((first, first_dir)) if *first != shard_plan => {
                 return Err(MergeError::DifferentStudy(
                     dir.display().to_string(),
                     first_dir.clone(),
@@ -71,8 +71,12 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<StudyOutput, MergeE
         }
         runs.extend(from_dataframe(&read_parquet(&path)?)?);
     }
-    let (text, first_dir) =
+    let (shard_plan, first_dir) =
         study.ok_or_else(|| MergeError::Missing("(no shard folders given)".into()))?;
+    let text = shard_plan
+        .split_once('\n')
+        .map_or(shard_plan.as_str(), |(_, t)| t)
+        .to_string();
     let plan: StudyPlan = super::config::StudyFile::parse(&text, &first_dir)
         .and_then(|f| f.plan(&text, &first_dir))
         .map_err(|e| MergeError::BadStudy(first_dir.clone(), e.to_string()))?;
@@ -109,6 +113,12 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<StudyOutput, MergeE
     let mut summary = summarize(&plan, &runs)?;
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
     super::io::write_text(&dir.join("study.toml"), &plan.text).map_err(RunError::Io)?;
+    if let Some((plan_id, _)) = shard_plan.split_once('\n')
+        && !plan_id.is_empty()
+    {
+        super::io::write_text(&dir.join(super::run::PLAN_ID_FILE), plan_id)
+            .map_err(RunError::Io)?;
+    }
     Ok(StudyOutput {
         dir,
         runs,

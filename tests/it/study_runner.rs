@@ -243,7 +243,12 @@ fn provenance_is_stored_in_the_parquet_metadata() {
             .map(|(_, v)| v.clone())
             .unwrap()
     };
-    assert_eq!(get("study_toml"), text);
+    // The study text is stored once, beside the files, not in each of them.
+    assert!(meta.iter().all(|(key, _)| key != "study_toml"));
+    assert_eq!(
+        std::fs::read_to_string(out.dir.join("study.toml")).unwrap(),
+        text
+    );
     assert_eq!(get("seed"), "7");
     assert_eq!(get("shard"), "all");
     assert_eq!(get("study_sha256"), autobal::study::io::sha256_hex(&text));
