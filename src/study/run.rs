@@ -18,7 +18,8 @@ use polars::prelude::{DataFrame, PolarsError};
 use rayon::prelude::*;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, mpsc};
 use std::time::{Duration, Instant};
 
 /// The k-th of N disjoint slices of a study (k counted from 1).
@@ -76,6 +77,10 @@ pub struct RunOptions {
     /// Replace the results already in the folder (otherwise a fresh run over
     /// existing results is refused: they are never deleted silently).
     pub overwrite: bool,
+    /// Set it (e.g. from a SIGINT handler) to stop: runs not yet started are
+    /// skipped, finished ones are saved as chunks for `--resume`, and
+    /// [`run_study`] returns [`RunError::Interrupted`].
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl Default for RunOptions {
@@ -87,6 +92,7 @@ impl Default for RunOptions {
             chunk_runs: 256,
             chunk_interval: Duration::from_secs(2),
             overwrite: false,
+            cancel: None,
         }
     }
 }
@@ -169,6 +175,16 @@ pub enum RunError {
     /// Another process is writing the folder.
     #[error(transparent)]
     Locked(#[from] LockError),
+    /// Stopped on request; what finished is saved.
+    #[error(
+        "interrupted: {saved} runs of this invocation are saved in {path}; continue with --resume"
+    )]
+    Interrupted {
+        /// The folder.
+        path: String,
+        /// Runs finished and saved in this invocation.
+        saved: u64,
+    },
     /// Reading or writing Parquet failed.
     #[error("parquet: {0}")]
     Polars(#[from] PolarsError),
@@ -379,8 +395,19 @@ pub fn run_study(
     let total = (0..plan.total_runs()).filter(in_slice).count() as u64;
     progress.begin(total, done.len() as u64);
 
-    let executed = pending.len() as u64;
     let fresh = execute(plan, &pending, options, &chunks, &provenance, progress)?;
+    if options
+        .cancel
+        .as_ref()
+        .is_some_and(|c| c.load(Ordering::Relaxed))
+    {
+        progress.end();
+        return Err(RunError::Interrupted {
+            path: dir.display().to_string(),
+            saved: fresh.len() as u64,
+        });
+    }
+    let executed = pending.len() as u64;
     done.extend(fresh);
     done.sort_by_key(|r| r.run_id);
 
@@ -427,6 +454,13 @@ fn execute(
         scope.spawn(move || {
             let work = move || {
                 pending.par_iter().for_each_with(tx, |tx, &id| {
+                    if options
+                        .cancel
+                        .as_ref()
+                        .is_some_and(|c| c.load(Ordering::Relaxed))
+                    {
+                        return;
+                    }
                     // The receiver only disappears if writing failed; the error is reported there.
                     let _ = tx.send(run_one(plan, id));
                 });

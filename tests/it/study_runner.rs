@@ -176,6 +176,73 @@ fn resume_after_a_kill_ends_with_the_same_files() {
 }
 
 #[test]
+fn ctrl_c_saves_the_finished_runs_leaves_no_temporary_file_and_resume_completes() {
+    let whole = tempfile::tempdir().unwrap();
+    let stopped = tempfile::tempdir().unwrap();
+    let text = small_study(stopped.path(), 150, "");
+    let study = stopped.path().join("small.toml");
+    std::fs::write(&study, &text).unwrap();
+    let out = stopped.path().join("small");
+    let child = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args([
+            "run",
+            study.to_str().unwrap(),
+            "--quiet",
+            "--chunk-runs",
+            "5",
+            "--threads",
+            "1",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let chunks = out.join("chunks");
+    let start = std::time::Instant::now();
+    while !std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some()) {
+        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let ended = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&ended.stderr);
+    assert_eq!(ended.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted") && err.contains("--resume"),
+        "{err}"
+    );
+    assert!(!out.join("runs.parquet").exists());
+    // Nothing temporary is left: no lock, no half-written file.
+    let mut leftovers = Vec::new();
+    for dir in [&out, &chunks] {
+        for entry in std::fs::read_dir(dir).unwrap().filter_map(Result::ok) {
+            let name = entry.file_name().to_string_lossy().to_string();
+            if name == ".lock" || name.contains(".tmp-") {
+                leftovers.push(name);
+            }
+        }
+    }
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let resumed = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", study.to_str().unwrap(), "--quiet", "--resume"])
+        .output()
+        .unwrap();
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let p = plan(&small_study(whole.path(), 150, ""));
+    let dir = run_study(&p, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .dir;
+    assert!(stable(&dir.join("runs.parquet")).equals_missing(&stable(&out.join("runs.parquet"))));
+}
+
+#[test]
 fn resume_refuses_a_changed_study() {
     let tmp = tempfile::tempdir().unwrap();
     let study = tmp.path().join("small.toml");

@@ -28,7 +28,7 @@ use std::process::ExitCode;
     version,
     about,
     long_about = None,
-    after_help = "Exit codes: 0 done; 1 a run or a check failed (e.g. a regression, a solver that did not converge); 2 bad input or usage (the message names the key or flag), nothing written."
+    after_help = "Exit codes: 0 done; 1 a run or a check failed (e.g. a regression, a solver that did not converge); 2 bad input or usage (the message names the key or flag), nothing written; 130 interrupted (finished runs saved; continue with --resume)."
 )]
 struct Cli {
     #[command(subcommand)]

@@ -6,11 +6,13 @@ use autobal::metrics::Outcome;
 use autobal::study::config::load;
 use autobal::study::merge::merge;
 use autobal::study::record::RunRecord;
-use autobal::study::run::{Progress, RunOptions, Shard, run_study};
+use autobal::study::run::{Progress, RunError, RunOptions, Shard, run_study};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use polars::prelude::DataFrame;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Examples shown under `study run --help`.
@@ -136,7 +138,16 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         ));
     }
     let plan = load(&args.study)?;
+    // Ctrl-C (or a batch system's SIGTERM) asks the run to stop and save
+    // what it has; a second one ends the process at once.
+    let cancel = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(signal, 130, Arc::clone(&cancel))
+            .and_then(|_| signal_hook::flag::register(signal, Arc::clone(&cancel)))
+            .map_err(|e| UserError::internal(format!("cannot watch for Ctrl-C: {e}")))?;
+    }
     let options = RunOptions {
+        cancel: Some(cancel),
         resume: args.resume,
         overwrite: args.overwrite,
         chunk_runs: args.chunk_runs,
@@ -146,7 +157,9 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
     };
     let bar = Bar::new(args.quiet);
     let output = run_study(&plan, &options, &bar).map_err(|e| {
-        if e.is_user_error() {
+        if matches!(e, RunError::Interrupted { .. }) {
+            UserError(e.to_string(), 130)
+        } else if e.is_user_error() {
             UserError(e.to_string(), 2)
         } else {
             UserError::internal(e.to_string())
