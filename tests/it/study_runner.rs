@@ -243,6 +243,62 @@ fn ctrl_c_saves_the_finished_runs_leaves_no_temporary_file_and_resume_completes(
 }
 
 #[test]
+fn a_killed_and_resumed_shard_merges_into_the_whole() {
+    let whole = tempfile::tempdir().unwrap();
+    let sharded = tempfile::tempdir().unwrap();
+    let text = small_study(sharded.path(), 150, "");
+    let study = sharded.path().join("small.toml");
+    std::fs::write(&study, &text).unwrap();
+    let shard_dir = |k: u32| sharded.path().join("small").join(format!("shard-{k}-of-2"));
+    // Shard 1 is killed once it has saved a chunk, then resumed.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args([
+            "run",
+            study.to_str().unwrap(),
+            "--quiet",
+            "--shard",
+            "1/2",
+            "--chunk-runs",
+            "5",
+            "--threads",
+            "1",
+        ])
+        .spawn()
+        .unwrap();
+    let chunks = shard_dir(1).join("chunks");
+    let start = std::time::Instant::now();
+    while !std::fs::read_dir(&chunks).is_ok_and(|d| {
+        d.filter_map(Result::ok)
+            .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
+    }) {
+        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    for args in [vec!["--shard", "1/2", "--resume"], vec!["--shard", "2/2"]] {
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["run", study.to_str().unwrap(), "--quiet"])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let merged = autobal::study::merge::merge(&[shard_dir(1), shard_dir(2)], None).unwrap();
+    let p = plan(&small_study(whole.path(), 150, ""));
+    let dir = run_study(&p, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .dir;
+    assert!(
+        stable(&dir.join("runs.parquet")).equals_missing(&stable(&merged.dir.join("runs.parquet")))
+    );
+}
+
+#[test]
 fn resume_refuses_a_changed_study() {
     let tmp = tempfile::tempdir().unwrap();
     let study = tmp.path().join("small.toml");
