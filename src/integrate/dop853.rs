@@ -18,7 +18,7 @@
 )]
 
 use super::controller::PiController;
-use super::norm::{atol_of, initial_step};
+use super::norm::{atol_of, explicit_start};
 use super::stepper::{Stepper, Trial};
 use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
@@ -505,19 +505,17 @@ impl Stepper for Dop853 {
         stats: &mut Stats,
     ) -> Result<f64, Failure> {
         let [k1, k2, k3, ..] = &mut self.st.k;
-        system.rhs(t0, y0, k1);
-        stats.rhs_calls += 1;
-        Ok(match self.options.h0 {
-            Some(h0) => h0.min(h_max),
-            None => {
-                stats.rhs_calls += 1;
-                initial_step(system, t0, y0, k1, 8, h_max, &self.options, (k2, k3))
-            }
-        })
-    }
-
-    fn end_stretch(&self) -> f64 {
-        1.01
+        Ok(explicit_start(
+            system,
+            t0,
+            y0,
+            8,
+            h_max,
+            &self.options,
+            k1,
+            (k2, k3),
+            stats,
+        ))
     }
 
     fn attempt<S: OdeSystem + ?Sized>(

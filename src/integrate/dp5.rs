@@ -2,7 +2,7 @@
 //! 4th-order continuous extension for dense output and PI step-size control.
 
 use super::controller::PiController;
-use super::norm::{error_norm, initial_step};
+use super::norm::{error_norm, explicit_start};
 use super::stepper::{Stepper, Trial};
 use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
@@ -110,19 +110,17 @@ impl Stepper for Dp5 {
         stats: &mut Stats,
     ) -> Result<f64, Failure> {
         let [k1, k2, k3, ..] = &mut self.k;
-        system.rhs(t0, y0, k1);
-        stats.rhs_calls += 1;
-        Ok(match self.options.h0 {
-            Some(h0) => h0.min(h_max),
-            None => {
-                stats.rhs_calls += 1;
-                initial_step(system, t0, y0, k1, 5, h_max, &self.options, (k2, k3))
-            }
-        })
-    }
-
-    fn end_stretch(&self) -> f64 {
-        1.01
+        Ok(explicit_start(
+            system,
+            t0,
+            y0,
+            5,
+            h_max,
+            &self.options,
+            k1,
+            (k2, k3),
+            stats,
+        ))
     }
 
     fn attempt<S: OdeSystem + ?Sized>(

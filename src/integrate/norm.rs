@@ -114,6 +114,32 @@ pub fn initial_step<S: OdeSystem + ?Sized>(
     (100.0 * h).min(h1).min(h_max)
 }
 
+/// How an explicit FSAL method starts: f(t0, y0) into `f0`, then the first
+/// step size, `options.h0` or Hairer's guess for a method of this `order`
+/// (two scratch vectors in `work`); counts its right-hand-side calls.
+#[allow(clippy::too_many_arguments)]
+pub fn explicit_start<S: OdeSystem + ?Sized>(
+    system: &S,
+    t0: f64,
+    y0: &[f64],
+    order: i32,
+    h_max: f64,
+    options: &SolverOptions,
+    f0: &mut [f64],
+    work: (&mut [f64], &mut [f64]),
+    stats: &mut super::Stats,
+) -> f64 {
+    system.rhs(t0, y0, f0);
+    stats.rhs_calls += 1;
+    match options.h0 {
+        Some(h0) => h0.min(h_max),
+        None => {
+            stats.rhs_calls += 1;
+            initial_step(system, t0, y0, f0, order, h_max, options, work)
+        }
+    }
+}
+
 /// The checks every stepper makes before a step: the step budget and a step
 /// size that floating point can still resolve at t.
 pub fn check_step(

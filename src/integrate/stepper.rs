@@ -53,8 +53,11 @@ pub trait Stepper: Sized {
     ) -> Result<f64, Failure>;
 
     /// Factor f in the driver's end test t + f·h ≥ t_end: a step that would
-    /// stop just short of t_end is stretched to reach it.
-    fn end_stretch(&self) -> f64;
+    /// stop just short of t_end is stretched to reach it (Hairer's explicit
+    /// codes use 1.01).
+    fn end_stretch(&self) -> f64 {
+        1.01
+    }
 
     /// Try a step of size `h` from (t, y).
     fn attempt<S: OdeSystem + ?Sized>(

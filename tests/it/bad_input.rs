@@ -45,31 +45,10 @@ t_end_revs = 100
     )
 }
 
-const SCENE: &str = r#"[rotor]
-mass = 1.0
-eccentricity = 0.01
-kx = 1.0
-ky = 1.0
-bx = 0.1
-by = 0.1
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-[speed]
-mode = "constant"
-omega = 4.0
-[start]
-angles_deg = [90, 100]
-[metrics]
-t_end_revs = 100
-"#;
+fn scene() -> String {
+    crate::fixtures::point_weights_scene(2)
+        + "[speed]\nmode = \"constant\"\nomega = 4.0\n[start]\nangles_deg = [90, 100]\n[metrics]\nt_end_revs = 100\n"
+}
 
 /// (what to replace, with what, a text the message must contain).
 const STUDY_CASES: &[(&str, &str, &str)] = &[
@@ -256,10 +235,11 @@ fn every_bad_study_file_is_refused_naming_the_key_with_nothing_written() {
 fn every_bad_scene_file_is_refused_naming_the_key() {
     let mut failures = Vec::new();
     for (from, to, needle) in SCENE_CASES {
-        assert!(SCENE.contains(from), "fixture lacks {from:?}");
+        let base = scene();
+        assert!(base.contains(from), "fixture lacks {from:?}");
         let tmp = tempfile::tempdir().unwrap();
         let path = tmp.path().join("scene.toml");
-        std::fs::write(&path, SCENE.replacen(from, to, 1)).unwrap();
+        std::fs::write(&path, base.replacen(from, to, 1)).unwrap();
         let out = Command::new(env!("CARGO_BIN_EXE_study"))
             .args(["simulate", path.to_str().unwrap()])
             .output()
@@ -282,7 +262,7 @@ fn every_bad_command_line_is_refused_naming_the_flag() {
     let study_path = tmp.path().join("ok.toml");
     std::fs::write(&study_path, study(&results)).unwrap();
     let scene_path = tmp.path().join("ok_scene.toml");
-    std::fs::write(&scene_path, SCENE).unwrap();
+    std::fs::write(&scene_path, scene()).unwrap();
     let mut failures = Vec::new();
     let cases = flag_cases(study_path.to_str().unwrap(), scene_path.to_str().unwrap());
     assert!(STUDY_CASES.len() + SCENE_CASES.len() + cases.len() >= 60);

@@ -180,48 +180,28 @@ fn sampled_starts_never_overlap() {
 }
 
 fn simulate_scene(text: &str) -> std::process::Output {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    std::process::Command::new(env!("CARGO_BIN_EXE_study"))
-        .arg("simulate")
-        .arg(&path)
-        .output()
-        .unwrap()
+    crate::fixtures::simulate_text(text)
 }
 
-const POINT_SCENE: &str = r#"
-[rotor]
-mass = 1.0
-eccentricity = 0.01
-kx = 1.0
-ky = 1.0
-bx = 0.1
-by = 0.1
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-[speed]
-mode = "constant"
-omega = 4.0
-"#;
+fn point_scene() -> String {
+    crate::fixtures::point_weights_scene(2) + "[speed]\nmode = \"constant\"\nomega = 4.0\n"
+}
 
 #[test]
 fn coincident_point_weights_are_refused_naming_the_key_and_the_weights() {
-    let out = simulate_scene(&format!("{POINT_SCENE}[start]\nangles_deg = [30, 30]\n"));
+    let out = simulate_scene(&format!(
+        "{}[start]\nangles_deg = [30, 30]\n",
+        point_scene()
+    ));
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("start.angles_deg"), "{err}");
     assert!(err.contains("weights 1 and 2"), "{err}");
     // A start apart is fine.
-    let ok = simulate_scene(&format!("{POINT_SCENE}[start]\nangles_deg = [30, 31]\n"));
+    let ok = simulate_scene(&format!(
+        "{}[start]\nangles_deg = [30, 31]\n",
+        point_scene()
+    ));
     assert!(
         ok.status.success(),
         "{}",

@@ -12,3 +12,28 @@ by = 100.0
 mode = "constant"
 omega = 300.0
 "#;
+
+/// The dimensionless plane rotor of `scenes/three_balls.toml` (M = 1, k = 1:
+/// natural frequency 1) with `n` equal point weights, as scene-file text up
+/// to (not including) its `[speed]` table.
+pub fn point_weights_scene(n: usize) -> String {
+    let mut text = String::from(
+        "[rotor]\nmass = 1.0\neccentricity = 0.01\nkx = 1.0\nky = 1.0\nbx = 0.1\nby = 0.1\n",
+    );
+    for _ in 0..n {
+        text += "[[cargo]]\nmass = 0.01\ntrack_radius = 1.0\ndrag = 0.01\nkappa = 1.4\n";
+    }
+    text
+}
+
+/// Run `study simulate` on a scene file holding `text`.
+pub fn simulate_text(text: &str) -> std::process::Output {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg("simulate")
+        .arg(&path)
+        .output()
+        .unwrap()
+}

@@ -11,34 +11,9 @@ use autobal::scene_file::SceneFile;
 const RAMP: f64 = 2000.0;
 
 fn runup(angles: &str, t_end_revs: f64) -> String {
-    format!(
-        r#"
-[rotor]
-mass = 1.0
-eccentricity = 0.01
-kx = 1.0
-ky = 1.0
-bx = 0.1
-by = 0.1
-
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-
-[[cargo]]
-mass = 0.01
-track_radius = 1.0
-drag = 0.01
-kappa = 1.4
-
+    crate::fixtures::point_weights_scene(3)
+        + &format!(
+            r#"
 [speed]
 mode = "ramp"
 omega_start = 0.0
@@ -51,7 +26,7 @@ angles_deg = {angles}
 [metrics]
 t_end_revs = {t_end_revs}
 "#
-    )
+        )
 }
 
 #[test]

@@ -117,6 +117,18 @@ fn sharded_and_merged_equals_whole() {
     assert!(err.to_string().contains("missing"), "{err}");
 }
 
+/// Wait until a run has saved at least one chunk of finished runs.
+fn wait_for_a_chunk(chunks: &Path) {
+    let start = std::time::Instant::now();
+    while !std::fs::read_dir(chunks).is_ok_and(|d| {
+        d.filter_map(Result::ok)
+            .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
+    }) {
+        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
 #[test]
 fn resume_after_a_kill_ends_with_the_same_files() {
     let whole = tempfile::tempdir().unwrap();
@@ -138,20 +150,7 @@ fn resume_after_a_kill_ends_with_the_same_files() {
         .spawn()
         .unwrap();
     // Kill once at least one chunk of finished runs is on disk.
-    let chunks = out.join("chunks");
-    let start = std::time::Instant::now();
-    let has_chunk = || {
-        std::fs::read_dir(&chunks)
-            .map(|d| {
-                d.filter_map(Result::ok)
-                    .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
-            })
-            .unwrap_or(false)
-    };
-    while !has_chunk() {
-        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    wait_for_a_chunk(&out.join("chunks"));
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(
@@ -197,11 +196,7 @@ fn ctrl_c_saves_the_finished_runs_leaves_no_temporary_file_and_resume_completes(
         .spawn()
         .unwrap();
     let chunks = out.join("chunks");
-    let start = std::time::Instant::now();
-    while !std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some()) {
-        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    wait_for_a_chunk(&chunks);
     let sent = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -265,15 +260,7 @@ fn a_killed_and_resumed_shard_merges_into_the_whole() {
         ])
         .spawn()
         .unwrap();
-    let chunks = shard_dir(1).join("chunks");
-    let start = std::time::Instant::now();
-    while !std::fs::read_dir(&chunks).is_ok_and(|d| {
-        d.filter_map(Result::ok)
-            .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
-    }) {
-        assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    wait_for_a_chunk(&shard_dir(1).join("chunks"));
     child.kill().unwrap();
     child.wait().unwrap();
     for args in [vec!["--shard", "1/2", "--resume"], vec!["--shard", "2/2"]] {
