@@ -54,7 +54,7 @@ fn scene() -> String {
 const STUDY_CASES: &[(&str, &str, &str)] = &[
     ("mass = 10.0", "mass = -1.0", "mass"),
     ("mass = 10.0", "mass = 0.0", "mass"),
-    ("mass = 10.0", "mass = \"heavy\"", "heavy"),
+    ("mass = 10.0", "mass = \"heavy\"", "rotor.mass"),
     ("kx = 1.0e5", "kx = -5.0", "kx"),
     ("bx = 100.0", "bx = -1.0", "bx"),
     ("inertia = 0.05", "inertia = -0.05", "inertia"),

@@ -128,10 +128,13 @@ macro_rules! rotor_registry {
                 }
             }
 
-            /// The model called `name` read from `value`; `None` for an unknown name.
-            fn from_toml(name: &str, value: toml::Value) -> Option<Result<Self, toml::de::Error>> {
+            /// The model called `name` read from `table`; `None` for an unknown name.
+            /// Read from the table's text, not its value, so that an error
+            /// carries a position and the key can be named.
+            fn from_toml(name: &str, table: &toml::Table) -> Option<Result<Self, toml::de::Error>> {
+                let text = table.to_string();
                 match name {
-                    $( $name => Some(value.try_into().map(RotorModel::$variant)), )*
+                    $( $name => Some(toml::from_str(&text).map(RotorModel::$variant)), )*
                     _ => None,
                 }
             }
@@ -235,13 +238,26 @@ impl<'de> Deserialize<'de> for RotorModel {
                 )));
             }
         };
-        let Some(result) = RotorModel::from_toml(&model, toml::Value::Table(table)) else {
+        let Some(result) = RotorModel::from_toml(&model, &table) else {
             return Err(D::Error::custom(format!(
                 "rotor.model = \"{model}\": expected {}",
                 names_list()
             )));
         };
-        result.map_err(|e| D::Error::custom(format!("rotor ({model}): {}", e.message())))
+        result.map_err(|e| {
+            // The key on the line the error points at, e.g. `mass = "heavy"`.
+            let text = table.to_string();
+            let key = e
+                .span()
+                .and_then(|span| text[..span.start].rsplit('\n').next())
+                .and_then(|line| line.split('=').next())
+                .map(str::trim)
+                .filter(|k| !k.is_empty());
+            match key {
+                Some(key) => D::Error::custom(format!("rotor.{key} ({model}): {}", e.message())),
+                None => D::Error::custom(format!("rotor ({model}): {}", e.message())),
+            }
+        })
     }
 }
 
