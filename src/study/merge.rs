@@ -3,6 +3,7 @@
 use super::aggregate::summarize;
 use super::config::StudyPlan;
 use super::io::{Provenance, read_parquet, write_parquet};
+use super::lock::FolderLock;
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::run::{RunError, StudyOutput};
 use std::collections::HashSet;
@@ -45,7 +46,12 @@ impl From<polars::prelude::PolarsError> for MergeError {
 }
 
 /// Merge shard folders; the result goes to `out` (default: the shards' parent folder).
-pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<StudyOutput, MergeError> {
+/// Results already in the output folder are replaced only with `overwrite`.
+pub fn merge(
+    dirs: &[PathBuf],
+    out: Option<&Path>,
+    overwrite: bool,
+) -> Result<StudyOutput, MergeError> {
     let mut runs: Vec<RunRecord> = Vec::new();
     let mut study: Option<(String, String)> = None;
     for dir in dirs {
@@ -107,6 +113,15 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<StudyOutput, MergeE
         path: dir.display().to_string(),
         source,
     })?;
+    // The merged folder is a results folder like any other: one writer, and
+    // results already there are replaced only when asked.
+    let _lock = FolderLock::acquire(&dir).map_err(RunError::from)?;
+    if !overwrite && (dir.join("runs.parquet").exists() || dir.join("summary.parquet").exists()) {
+        return Err(RunError::ResultsExist {
+            path: dir.display().to_string(),
+        }
+        .into());
+    }
     let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
     let mut df = to_dataframe(&runs)?;
     write_parquet(&dir.join("runs.parquet"), &mut df, &provenance)?;

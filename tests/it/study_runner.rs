@@ -101,7 +101,14 @@ fn sharded_and_merged_equals_whole() {
         dirs.push(out.dir);
     }
     // Shards are disjoint and together hold every run.
-    let merged = autobal::study::merge::merge(&dirs, None).unwrap();
+    let merged = autobal::study::merge::merge(&dirs, None, false).unwrap();
+    // A second merge into the same folder needs to say it replaces the first.
+    let again = autobal::study::merge::merge(&dirs, None, false).unwrap_err();
+    assert!(
+        again.to_string().contains("already holds results"),
+        "{again}"
+    );
+    autobal::study::merge::merge(&dirs, None, true).unwrap();
     assert_eq!(merged.runs.len(), 20);
     assert!(
         stable(&dir.join("runs.parquet")).equals_missing(&stable(&merged.dir.join("runs.parquet")))
@@ -112,8 +119,9 @@ fn sharded_and_merged_equals_whole() {
             .equals_missing(&read_parquet(&merged.dir.join("summary.parquet")).unwrap())
     );
     // Merging an incomplete set fails and names what is missing.
-    let err = autobal::study::merge::merge(&dirs[..2], Some(&sharded.path().join("partial")))
-        .unwrap_err();
+    let err =
+        autobal::study::merge::merge(&dirs[..2], Some(&sharded.path().join("partial")), false)
+            .unwrap_err();
     assert!(err.to_string().contains("missing"), "{err}");
 }
 
@@ -275,7 +283,7 @@ fn a_killed_and_resumed_shard_merges_into_the_whole() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    let merged = autobal::study::merge::merge(&[shard_dir(1), shard_dir(2)], None).unwrap();
+    let merged = autobal::study::merge::merge(&[shard_dir(1), shard_dir(2)], None, false).unwrap();
     let p = plan(&small_study(whole.path(), 150, ""));
     let dir = run_study(&p, &RunOptions::default(), &NoProgress)
         .unwrap()

@@ -61,6 +61,9 @@ pub struct MergeArgs {
     /// Output folder (default: the shards' parent folder).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace merged results already in the output folder.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// indicatif progress bar on stderr: runs done, rate, ETA, failures so far.
@@ -180,7 +183,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
 
 /// Run `study merge`.
 pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
-    let output = merge(&args.dirs, args.out.as_deref())?;
+    let output = merge(&args.dirs, args.out.as_deref(), args.overwrite)?;
     if let Some(summary) = &output.summary {
         print!("{}", ranked_table(summary)?);
     }
