@@ -51,7 +51,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             OneOrMany::Many(drags.iter().map(|d| d * (1.0 + drift / 100.0)).collect());
         // The study text stays the original: a planted change is a change of the code, not of the file.
         let p: StudyPlan = file.plan(&plan.text, &study.display().to_string())?;
-        let out = run_study(&p, &RunOptions::default(), &NoProgress)?;
+        // Every seed and drift reuses one scratch folder.
+        let replace = RunOptions {
+            overwrite: true,
+            ..RunOptions::default()
+        };
+        let out = run_study(&p, &replace, &NoProgress)?;
         Ok(design_samples(&to_dataframe(&out.runs)?)?)
     };
     println!(
