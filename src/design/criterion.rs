@@ -11,7 +11,7 @@
 //! unbalances s_j in the planes points against them: ω² JᵀKJ / Δ(ω) < 0
 //! (eq 29).
 //!
-//! Paper typos handled here (see also `../shared/MODEL-NOTES.md`):
+//! Paper typos handled here (also in docs/rotors.md):
 //! - eqs 21 and 23 (short rotor) print the terms −(C−A)k11 + Mk33 and
 //!   (C−A)k11 − Mk33 swapped: the positive root of eq 11 for A < C is
 //!   ω1² = [(C−A)k11 − Mk33 + √(…)] / (2M(C−A)) (with k14 = 0 it must give

@@ -80,7 +80,7 @@ pub fn transient_measure(p: f64, mass: f64, n: u32) -> Result<f64, DesignError> 
 /// 4/3 π γ R³ for balls, k = 3).
 ///
 /// This is eq 15 (odd n) and eq 16 (even n, with the sqrt(1 − 2ρ) divisor of
-/// MODEL-NOTES) in closed form: ã_r = ρ[nρ − (1−ρ) sin nα] and
+/// docs/design-theory.md) in closed form: ã_r = ρ[nρ − (1−ρ) sin nα] and
 /// ã_r = ρ[nρ − (1−ρ)² sin nα / sqrt(1−2ρ)], ã_b = ρ ã_r. Evaluating it through
 /// p_max keeps ã ≥ 0 where the printed forms cancel to −1e-17 (n = 2). n = 1 gives 0.
 pub fn a_tilde(shape: Shape, n: u32, rho: f64) -> Result<f64, DesignError> {

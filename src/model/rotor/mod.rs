@@ -1,7 +1,7 @@
 //! Rotor models: the rigid-body (or elastic) coordinates that carry the
 //! balancer planes. One file per model; each implements [`Rotor`].
 //!
-//! The equations of every model share one structure (MODEL-NOTES, seed 004):
+//! The equations of every model share one structure (seed 004; docs/model.md):
 //! the rotor's coordinates h (k ≤ [`MAX_DOF`]) and, when the speed is free,
 //! the spin angle φ form a small "head" block; every cargo adds one diagonal
 //! row coupled only to that block. [`crate::model::system`] eliminates the
