@@ -123,35 +123,35 @@ impl SceneFile {
             source,
         };
         scene.validate().map_err(invalid)?;
-        let n = scene.cargoes().map_err(invalid)?.len();
+        let cargo = scene.cargoes().map_err(invalid)?;
+        let n = cargo.len();
         let initial_angles: Vec<f64> = match &self.start.angles_deg {
             Some(a) => a.iter().map(|d| d.to_radians()).collect(),
             None => evenly_spaced(n),
         };
-        if initial_angles.len() == n {
-            let cargo = scene.cargoes().map_err(invalid)?;
-            if let Some(clash) = start_clash(&cargo, &initial_angles) {
-                let reason = if clash.touching > 0.0 {
-                    format!(
-                        "weights {} and {} start {:.3}° apart, closer than their touching angle 2α = {:.3}°: solid weights cannot overlap",
-                        clash.first + 1,
-                        clash.second + 1,
-                        clash.apart.to_degrees(),
-                        clash.touching.to_degrees()
-                    )
-                } else {
-                    format!(
-                        "weights {} and {} start at the same angle: that symmetric state is an equilibrium and they would never separate; start them apart",
-                        clash.first + 1,
-                        clash.second + 1
-                    )
-                };
-                return Err(invalid(SceneError::Invalid {
-                    field: "start.angles_deg".into(),
-                    value: format!("{:?}", self.start.angles_deg.as_deref().unwrap_or(&[])),
-                    reason,
-                }));
-            }
+        if initial_angles.len() == n
+            && let Some(clash) = start_clash(&cargo, &initial_angles)
+        {
+            let reason = if clash.touching > 0.0 {
+                format!(
+                    "weights {} and {} start {:.3}° apart, closer than their touching angle 2α = {:.3}°: solid weights cannot overlap",
+                    clash.first + 1,
+                    clash.second + 1,
+                    clash.apart.to_degrees(),
+                    clash.touching.to_degrees()
+                )
+            } else {
+                format!(
+                    "weights {} and {} start at the same angle: that symmetric state is an equilibrium and they would never separate; start them apart",
+                    clash.first + 1,
+                    clash.second + 1
+                )
+            };
+            return Err(invalid(SceneError::Invalid {
+                field: "start.angles_deg".into(),
+                value: format!("{:?}", self.start.angles_deg.as_deref().unwrap_or(&[])),
+                reason,
+            }));
         }
         if let Err((field, value, reason)) = self.metrics.validate() {
             return Err(invalid(SceneError::Invalid {

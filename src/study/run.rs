@@ -298,9 +298,9 @@ fn failed(reason: String) -> RunMetrics {
 pub const PLAN_ID_FILE: &str = "plan.sha256";
 
 /// What makes runs of one folder comparable: the study text (with its seed)
-/// and the autobal build that ran them (version and git commit).
-pub fn plan_id(plan: &StudyPlan) -> String {
-    let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
+/// and the autobal build that ran them (version and git commit, as in the
+/// run's `provenance`).
+pub fn plan_id(plan: &StudyPlan, provenance: &Provenance) -> String {
     sha256_hex(&format!(
         "autobal {}\ncommit {}\n{}",
         provenance.version, provenance.git_commit, plan.text
@@ -336,7 +336,9 @@ pub fn run_study(
     let chunks = dir.join("chunks");
     let runs_path = dir.join("runs.parquet");
     let summary_path = dir.join("summary.parquet");
-    let id = plan_id(plan);
+    // Provenance asks git for the commit: once per run, shared with the plan id.
+    let provenance = Provenance::new(&plan.text, plan.file.seed, &shard_label(options.shard));
+    let id = plan_id(plan, &provenance);
     let has_results = runs_path.exists()
         || summary_path.exists()
         || std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some());
@@ -383,7 +385,6 @@ pub fn run_study(
         write_text(&plan_file, &id)?;
     }
     std::fs::create_dir_all(&chunks)?;
-    let provenance = Provenance::new(&plan.text, plan.file.seed, &shard_label(options.shard));
 
     let mut seen = HashSet::new();
     done.retain(|r| seen.insert(r.run_id));

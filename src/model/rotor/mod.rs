@@ -128,13 +128,12 @@ macro_rules! rotor_registry {
                 }
             }
 
-            /// The model called `name` read from `table`; `None` for an unknown name.
-            /// Read from the table's text, not its value, so that an error
-            /// carries a position and the key can be named.
-            fn from_toml(name: &str, table: &toml::Table) -> Option<Result<Self, toml::de::Error>> {
-                let text = table.to_string();
+            /// The model called `name` read from its table's `text`; `None`
+            /// for an unknown name. Read from text, not from a value, so that
+            /// an error carries a position and the key can be named.
+            fn from_toml(name: &str, text: &str) -> Option<Result<Self, toml::de::Error>> {
                 match name {
-                    $( $name => Some(toml::from_str(&text).map(RotorModel::$variant)), )*
+                    $( $name => Some(toml::from_str(text).map(RotorModel::$variant)), )*
                     _ => None,
                 }
             }
@@ -238,7 +237,8 @@ impl<'de> Deserialize<'de> for RotorModel {
                 )));
             }
         };
-        let Some(result) = RotorModel::from_toml(&model, &table) else {
+        let text = table.to_string();
+        let Some(result) = RotorModel::from_toml(&model, &text) else {
             return Err(D::Error::custom(format!(
                 "rotor.model = \"{model}\": expected {}",
                 names_list()
@@ -246,7 +246,6 @@ impl<'de> Deserialize<'de> for RotorModel {
         };
         result.map_err(|e| {
             // The key on the line the error points at, e.g. `mass = "heavy"`.
-            let text = table.to_string();
             let key = e
                 .span()
                 .and_then(|span| text[..span.start].rsplit('\n').next())
