@@ -44,6 +44,19 @@ fn median_counting_unsettled(settled_sorted: &[f64], runs: u64) -> Option<f64> {
     Some(0.5 * (at(lo)? + at(hi)?))
 }
 
+/// The q-quantile (linear interpolation) over every run of a design, runs
+/// that did not settle counting as later than every settled one; `None`
+/// when it falls among them (beyond the run).
+fn quantile_counting_unsettled(settled_sorted: &[f64], runs: u64, q: f64) -> Option<f64> {
+    if runs == 0 {
+        return None;
+    }
+    let h = q * (runs - 1) as f64;
+    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+    let (a, b) = (*settled_sorted.get(lo)?, *settled_sorted.get(hi)?);
+    Some(a + (h - lo as f64) * (b - a))
+}
+
 /// One row per design, in design order.
 pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame> {
     let df = to_dataframe(runs)?;
@@ -89,6 +102,8 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
         rows.ts_median.push(ts_q(0.5));
         rows.ts_median_all
             .push(median_counting_unsettled(&ts_sorted, runs_n));
+        rows.ts_p90_all
+            .push(quantile_counting_unsettled(&ts_sorted, runs_n, 0.9));
         rows.ts_p10.push(ts_q(0.10));
         rows.ts_p90.push(ts_q(0.90));
         rows.ts_p95.push(ts_q(0.95));
@@ -146,6 +161,7 @@ struct SummaryColumns {
     ts_std: Vec<Option<f64>>,
     ts_median: Vec<Option<f64>>,
     ts_median_all: Vec<Option<f64>>,
+    ts_p90_all: Vec<Option<f64>>,
     ts_p10: Vec<Option<f64>>,
     ts_p90: Vec<Option<f64>>,
     ts_p95: Vec<Option<f64>>,
@@ -186,6 +202,7 @@ impl SummaryColumns {
                 Column::new("settling_revs_std".into(), self.ts_std),
                 Column::new("settling_revs_median".into(), self.ts_median),
                 Column::new("settling_revs_median_all_runs".into(), self.ts_median_all),
+                Column::new("settling_revs_p90_all_runs".into(), self.ts_p90_all),
                 Column::new("settling_revs_p10".into(), self.ts_p10),
                 Column::new("settling_revs_p90".into(), self.ts_p90),
                 Column::new("settling_revs_p95".into(), self.ts_p95),

@@ -103,6 +103,15 @@ fn summary_matches_a_hand_computation() {
     // Over all six runs, the two that did not settle counting as later than
     // every settled one: [10, 20, 30, 40, ∞, ∞] → (30 + 40)/2.
     assert_eq!(f("settling_revs_median_all_runs"), 35.0);
+    // The p90 over all six falls among the two runs that did not settle.
+    assert!(
+        df.column("settling_revs_p90_all_runs")
+            .unwrap()
+            .f64()
+            .unwrap()
+            .get(0)
+            .is_none()
+    );
     assert!((f("settling_revs_std") - (500.0f64 / 3.0).sqrt()).abs() < 1e-12);
     assert!((f("settling_revs_p10") - 13.0).abs() < 1e-12);
     assert!((f("settling_revs_p90") - 37.0).abs() < 1e-12);
@@ -156,6 +165,27 @@ fn median_over_all_runs_counts_runs_that_did_not_settle() {
         (Outcome::Censored, None),
     ]);
     assert_eq!(median(&steady), Some(5.5));
+    // p90 of [3, 4, 5, 6, 7, ∞]: h = 4.5 lies between 7 and ∞, beyond the run.
+    let p90 = |rs: &[RunRecord]| {
+        summarize(&plan(), rs)
+            .unwrap()
+            .column("settling_revs_p90_all_runs")
+            .unwrap()
+            .f64()
+            .unwrap()
+            .get(0)
+    };
+    assert_eq!(p90(&steady), None);
+    let all_settled = runs(&[
+        (Outcome::Settled, Some(1.0)),
+        (Outcome::Settled, Some(2.0)),
+        (Outcome::Settled, Some(3.0)),
+        (Outcome::Settled, Some(4.0)),
+        (Outcome::Settled, Some(5.0)),
+        (Outcome::Settled, Some(6.0)),
+    ]);
+    // h = 0.9·5 = 4.5: 5 + 0.5·(6 − 5).
+    assert_eq!(p90(&all_settled), Some(5.5));
 }
 
 #[test]

@@ -217,10 +217,9 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
         col_f("settled_fraction_lo")?,
         col_f("settled_fraction_hi")?,
     );
-    let (median, p90, mean, res) = (
+    let (median, p90, res) = (
         col_f("settling_revs_median_all_runs")?,
-        col_f("settling_revs_p90")?,
-        col_f("settling_revs_mean")?,
+        col_f("settling_revs_p90_all_runs")?,
         col_f("residual_rel_median")?,
     );
     let mut order: Vec<usize> = (0..summary.height()).collect();
@@ -245,7 +244,6 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
                 format!("{} [{}, {}]", f(frac[i], 3), f(lo[i], 2), f(hi[i], 2)),
                 f(median[i], 1),
                 f(p90[i], 1),
-                f(mean[i], 1),
                 f(res[i], 4),
             ]
         })
@@ -259,12 +257,11 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             "β",
             "settled [95% CI]",
             "t_s median (all runs)",
-            "t_s p90",
-            "t_s mean",
+            "t_s p90 (all runs)",
             "residual/A_ref",
         ],
         &rows,
-    ) + "(settling times in revolutions; median over all runs, unsettled ones counting as later than any settled, – when half or more did not settle; p90 and mean over the settled runs only; residual: median RMS vibration over the last hold window)\n"
+    ) + "(settling times in revolutions; median and p90 over all runs, unsettled ones counting as later than any settled, – when that quantile lies beyond the run; residual: median RMS vibration over the last hold window)\n"
         + &contact_line(summary)?)
 }
 
