@@ -57,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..RunOptions::default()
         };
         let out = run_study(&p, &replace, &NoProgress)?;
-        Ok(design_samples(&to_dataframe(&out.runs)?)?)
+        Ok(design_samples(&to_dataframe(&out.load_runs()?)?)?)
     };
     println!(
         "{}: {} designs × {} runs, Holm at α = {DEFAULT_ALPHA}, {seeds} baseline seeds from {}",

@@ -15,7 +15,6 @@ use super::compare::{CheckReport, CompareError, compare};
 use super::samples::design_samples;
 use crate::study::config::StudyPlan;
 use crate::study::io::{read_metadata, read_parquet, sha256_hex};
-use crate::study::record::to_dataframe;
 use crate::study::run::{Progress, RunError, RunOptions, run_study};
 use polars::prelude::PolarsError;
 use std::path::{Path, PathBuf};
@@ -99,7 +98,7 @@ pub fn record_baseline(
         ..run.clone()
     };
     let output = run_study(plan, &run, progress)?;
-    Ok(write_baseline(dir, plan, &output.runs)?)
+    Ok(write_baseline(dir, plan, &output.load_runs()?)?)
 }
 
 /// Compare new results of `plan` with the baseline in `baseline_dir`.
@@ -131,7 +130,7 @@ pub fn check_study(
             };
             let out = run_study(&fresh, &run, progress)?;
             (
-                design_samples(&to_dataframe(&out.runs)?)?,
+                design_samples(&read_parquet(&out.dir.join("runs.parquet"))?)?,
                 fresh.file.seed,
                 out.dir.join("runs.parquet"),
             )

@@ -59,7 +59,12 @@ fn quantile_counting_unsettled(settled_sorted: &[f64], runs: u64, q: f64) -> Opt
 
 /// One row per design, in design order.
 pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame> {
-    let df = to_dataframe(runs)?;
+    summarize_table(plan, &to_dataframe(runs)?)
+}
+
+/// One row per design from a runs table holding at least the columns in
+/// [`super::runs_file::SUMMARY_COLUMNS`].
+pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFrame> {
     let design_col = df.column("design_id")?.u32()?.clone();
     let mut rows = SummaryColumns::default();
     for design in &plan.designs {

@@ -125,10 +125,11 @@ impl<T: Clone> OneOrMany<T> {
 /// Most weights one balancer may have (docs/running-at-scale.md).
 pub const MAX_WEIGHTS: u32 = 256;
 
-/// Most runs one study may hold: the runner keeps every run in memory for
-/// the summary; 1 000 000 runs peaked at 2.4 GB resident (measured, see
-/// docs/running-at-scale.md), so this limit keeps a study near 7 GB.
-pub const MAX_TOTAL_RUNS: u64 = 3_000_000;
+/// Most runs one study may hold. The runner streams runs to disk but keeps
+/// about 80 bytes a run (run ids and the columns the summary reads): about
+/// 60 MB + 80 B per run resident, measured in docs/running-at-scale.md, so
+/// this limit keeps a study under 2 GB of memory and of `runs.parquet`.
+pub const MAX_TOTAL_RUNS: u64 = 20_000_000;
 
 /// The design grid: every combination of kind × n × ρ × drag.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -488,7 +489,7 @@ impl StudyFile {
                 "sampling.samples",
                 s.samples.to_string(),
                 &format!(
-                    "{} designs × {} samples = {total} runs, more than the {MAX_TOTAL_RUNS} one study may hold (the runner keeps every run in memory, about 2.4 kB each); split the grid into several studies or use fewer samples",
+                    "{} designs × {} samples = {total} runs, more than the {MAX_TOTAL_RUNS} one study may hold (the runner keeps about 80 bytes of each run in memory, and runs.parquet takes about as much on disk); split the grid into several studies or use fewer samples",
                     designs.len(),
                     s.samples
                 ),

@@ -36,7 +36,8 @@ impl Provenance {
         }
     }
 
-    fn pairs(&self) -> Vec<(String, String)> {
+    /// The key-value pairs stored in a Parquet file's metadata.
+    pub(crate) fn pairs(&self) -> Vec<(String, String)> {
         vec![
             ("autobal_version".into(), self.version.clone()),
             ("git_commit".into(), self.git_commit.clone()),
@@ -68,7 +69,7 @@ fn git_commit() -> String {
 }
 
 /// Temporary sibling path used while writing `path`.
-fn temp_path(path: &Path) -> PathBuf {
+pub(crate) fn temp_path(path: &Path) -> PathBuf {
     let mut name = path
         .file_name()
         .map(|n| n.to_os_string())

@@ -1,12 +1,11 @@
 //! `study merge`: combine shard outputs into exactly what one unsharded run writes.
 
-use super::aggregate::summarize;
+use super::aggregate::summarize_table;
 use super::config::StudyPlan;
-use super::io::{Provenance, read_parquet, write_parquet};
+use super::io::{Provenance, write_parquet};
 use super::lock::FolderLock;
-use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::run::{RunError, StudyOutput};
-use std::collections::HashSet;
+use super::runs_file::{Piece, read_summary_columns, write_runs};
 use std::path::{Path, PathBuf};
 
 /// Why shard outputs cannot be merged.
@@ -52,7 +51,7 @@ pub fn merge(
     out: Option<&Path>,
     overwrite: bool,
 ) -> Result<StudyOutput, MergeError> {
-    let mut runs: Vec<RunRecord> = Vec::new();
+    let mut pieces: Vec<Piece> = Vec::new();
     let mut study: Option<(String, String)> = None;
     for dir in dirs {
         let path = dir.join("runs.parquet");
@@ -75,7 +74,7 @@ pub fn merge(
             }
             Some(_) => {}
         }
-        runs.extend(from_dataframe(&read_parquet(&path)?)?);
+        pieces.push(Piece::open(&path)?);
     }
     let (shard_plan, first_dir) =
         study.ok_or_else(|| MergeError::Missing("(no shard folders given)".into()))?;
@@ -86,22 +85,28 @@ pub fn merge(
     let plan: StudyPlan = super::config::StudyFile::parse(&text, &first_dir)
         .and_then(|f| f.plan(&text, &first_dir))
         .map_err(|e| MergeError::BadStudy(first_dir.clone(), e.to_string()))?;
-    let mut seen = HashSet::new();
-    for r in &runs {
-        if !seen.insert(r.run_id) {
-            return Err(MergeError::Duplicate(r.run_id));
+    let total = plan.total_runs();
+    let mut seen = vec![false; total as usize];
+    for &id in pieces.iter().flat_map(|p| p.ids()) {
+        match seen.get_mut(id as usize) {
+            Some(s) if !*s => *s = true,
+            Some(_) => return Err(MergeError::Duplicate(id)),
+            None => {
+                return Err(MergeError::BadStudy(
+                    first_dir.clone(),
+                    format!("run {id} is outside the plan's {total} runs"),
+                ));
+            }
         }
     }
-    let total = plan.total_runs();
-    if let Some(first) = (0..total).find(|id| !seen.contains(id)) {
-        let missing = (0..total).filter(|id| !seen.contains(id)).count() as u64;
+    if let Some(first) = seen.iter().position(|s| !s) {
+        let missing = seen.iter().filter(|s| !**s).count() as u64;
         return Err(MergeError::Incomplete {
             missing,
             total,
-            first,
+            first: first as u64,
         });
     }
-    runs.sort_by_key(|r| r.run_id);
     let dir = match out {
         Some(o) => o.to_path_buf(),
         None => dirs[0]
@@ -123,9 +128,10 @@ pub fn merge(
         .into());
     }
     let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
-    let mut df = to_dataframe(&runs)?;
-    write_parquet(&dir.join("runs.parquet"), &mut df, &provenance)?;
-    let mut summary = summarize(&plan, &runs)?;
+    let runs_path = dir.join("runs.parquet");
+    let runs = write_runs(&pieces, total, &runs_path, &provenance)?;
+    drop(pieces);
+    let mut summary = summarize_table(&plan, &read_summary_columns(&runs_path)?)?;
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
     super::io::write_text(&dir.join("study.toml"), &plan.text).map_err(RunError::Io)?;
     if let Some((plan_id, _)) = shard_plan.split_once('\n')

@@ -5,6 +5,7 @@
 //! - [`sample`]: per-run random streams and draws.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
 //! - [`record`]: one row of `runs.parquet`.
+//! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
 //! - [`merge`]: combining shard outputs.
 //! - [`io`]: Parquet with provenance, atomic writes.
@@ -19,6 +20,7 @@ pub mod merge;
 pub mod optimize_spec;
 pub mod record;
 pub mod run;
+pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
 pub mod sweep;

@@ -6,17 +6,17 @@
 //! are bit-identical (but for the wall-time column) for any thread count,
 //! any interruption and resumption, and any sharding followed by a merge.
 
-use super::aggregate::summarize;
+use super::aggregate::summarize_table;
 use super::config::{Design, StudyPlan};
 use super::io::{Provenance, read_parquet, sha256_hex, write_parquet, write_text};
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
+use super::runs_file::{Piece, read_summary_columns, write_runs};
 use super::sample::draw_sample;
 use crate::metrics::{Outcome, RunMetrics};
 use crate::simulation::Simulation;
-use polars::prelude::{DataFrame, PolarsError};
+use polars::prelude::{DataFrame, PolarsError, PolarsResult};
 use rayon::prelude::*;
-use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, mpsc};
@@ -89,7 +89,7 @@ impl Default for RunOptions {
             resume: false,
             shard: None,
             threads: None,
-            chunk_runs: 256,
+            chunk_runs: 4096,
             chunk_interval: Duration::from_secs(2),
             overwrite: false,
             cancel: None,
@@ -117,12 +117,20 @@ impl Progress for NoProgress {}
 pub struct StudyOutput {
     /// Folder holding the files.
     pub dir: PathBuf,
-    /// Every run of the slice, sorted by run index.
-    pub runs: Vec<RunRecord>,
+    /// How many runs `runs.parquet` holds (read them with [`StudyOutput::load_runs`]).
+    pub runs: u64,
     /// Per-design statistics (unsharded runs only; shards are summarised by `merge`).
     pub summary: Option<DataFrame>,
     /// Runs executed in this invocation (the rest came from a resumed run).
     pub executed: u64,
+}
+
+impl StudyOutput {
+    /// Every run of the folder, sorted by run index (the whole table in memory:
+    /// for small studies and tests; large ones are read with polars).
+    pub fn load_runs(&self) -> PolarsResult<Vec<RunRecord>> {
+        from_dataframe(&read_parquet(&self.dir.join("runs.parquet"))?)
+    }
 }
 
 /// Why a study could not run or finish.
@@ -342,7 +350,6 @@ pub fn run_study(
     let has_results = runs_path.exists()
         || summary_path.exists()
         || std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some());
-    let mut done: Vec<RunRecord> = Vec::new();
     if options.resume && manifest.exists() {
         if std::fs::read_to_string(&manifest)? != plan.text {
             return Err(RunError::StudyChanged {
@@ -358,10 +365,6 @@ pub fn run_study(
                 expected: id,
             });
         }
-        if runs_path.exists() {
-            done.extend(from_dataframe(&read_parquet(&runs_path)?)?);
-        }
-        done.extend(read_chunks(&chunks)?);
     } else {
         if has_results && options.resume && !options.overwrite {
             return Err(RunError::NoPlan {
@@ -386,17 +389,34 @@ pub fn run_study(
     }
     std::fs::create_dir_all(&chunks)?;
 
-    let mut seen = HashSet::new();
-    done.retain(|r| seen.insert(r.run_id));
+    // What earlier invocations finished: only their run ids are read.
+    let total_ids = plan.total_runs();
+    let mut done = vec![false; total_ids as usize];
+    let mark_done = |pieces: &[Piece], done: &mut Vec<bool>| {
+        for piece in pieces {
+            for &id in piece.ids() {
+                if let Some(d) = done.get_mut(id as usize) {
+                    *d = true;
+                }
+            }
+        }
+    };
+    let earlier_table = if runs_path.exists() {
+        vec![Piece::open(&runs_path)?]
+    } else {
+        Vec::new()
+    };
+    mark_done(&earlier_table, &mut done);
+    mark_done(&chunk_pieces(&chunks)?, &mut done);
     let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
-    let pending: Vec<u64> = (0..plan.total_runs())
+    let pending: Vec<u64> = (0..total_ids)
         .filter(in_slice)
-        .filter(|id| !seen.contains(id))
+        .filter(|&id| !done[id as usize])
         .collect();
-    let total = (0..plan.total_runs()).filter(in_slice).count() as u64;
-    progress.begin(total, done.len() as u64);
+    let total = (0..total_ids).filter(in_slice).count() as u64;
+    progress.begin(total, total - pending.len() as u64);
 
-    let fresh = execute(plan, &pending, options, &chunks, &provenance, progress)?;
+    let saved = execute(plan, &pending, options, &chunks, &provenance, progress)?;
     if options
         .cancel
         .as_ref()
@@ -405,18 +425,20 @@ pub fn run_study(
         progress.end();
         return Err(RunError::Interrupted {
             path: dir.display().to_string(),
-            saved: fresh.len() as u64,
+            saved,
         });
     }
     let executed = pending.len() as u64;
-    done.extend(fresh);
-    done.sort_by_key(|r| r.run_id);
 
-    let mut df = to_dataframe(&done)?;
-    write_parquet(&runs_path, &mut df, &provenance)?;
+    // The earlier table first: on a duplicate (a crash between writing the
+    // table and removing the chunks) its copy is kept.
+    let mut pieces = earlier_table;
+    pieces.extend(chunk_pieces(&chunks)?);
+    let written = write_runs(&pieces, total_ids, &runs_path, &provenance)?;
+    drop(pieces);
     let summary = if options.shard.is_none() {
-        let mut summary = summarize(plan, &done)?;
-        write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
+        let mut summary = summarize_table(plan, &read_summary_columns(&runs_path)?)?;
+        write_parquet(&summary_path, &mut summary, &provenance)?;
         Some(summary)
     } else {
         None
@@ -425,13 +447,20 @@ pub fn run_study(
     progress.end();
     Ok(StudyOutput {
         dir,
-        runs: done,
+        runs: written,
         summary,
         executed,
     })
 }
 
-/// Run `pending` on the pool, writing chunks as results arrive.
+/// Run ids per block: blocks run one after the other (runs of a block in
+/// parallel), so every chunk holds runs of one block and the final table is
+/// assembled from a few chunks per window. Large enough that waiting for a
+/// block's slowest run costs little.
+const BLOCK_RUNS: usize = 8_192;
+
+/// Run `pending` on the pool, writing chunks (each sorted by run id) as
+/// results arrive; returns how many runs were saved.
 fn execute(
     plan: &StudyPlan,
     pending: &[u64],
@@ -439,7 +468,7 @@ fn execute(
     chunks: &Path,
     provenance: &Provenance,
     progress: &dyn Progress,
-) -> Result<Vec<RunRecord>, RunError> {
+) -> Result<u64, RunError> {
     let pool = match options.threads {
         Some(t) => Some(
             rayon::ThreadPoolBuilder::new()
@@ -449,35 +478,45 @@ fn execute(
         ),
         None => None,
     };
+    let cancelled = || {
+        options
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    };
     let mut next_chunk = next_chunk_index(chunks)?;
-    let (tx, rx) = mpsc::channel::<RunRecord>();
+    // Bounded, so that runs finishing faster than chunks are written wait
+    // instead of piling up in memory.
+    let (tx, rx) = mpsc::sync_channel::<RunRecord>(2 * options.chunk_runs.max(1));
     std::thread::scope(|scope| {
         scope.spawn(move || {
             let work = move || {
-                pending.par_iter().for_each_with(tx, |tx, &id| {
-                    if options
-                        .cancel
-                        .as_ref()
-                        .is_some_and(|c| c.load(Ordering::Relaxed))
-                    {
+                for block in pending.chunks(BLOCK_RUNS) {
+                    if cancelled() {
                         return;
                     }
-                    // The receiver only disappears if writing failed; the error is reported there.
-                    let _ = tx.send(run_one(plan, id));
-                });
+                    block.par_iter().for_each_with(tx.clone(), |tx, &id| {
+                        if cancelled() {
+                            return;
+                        }
+                        // The receiver only disappears if writing failed; the error is reported there.
+                        let _ = tx.send(run_one(plan, id));
+                    });
+                }
             };
             match &pool {
                 Some(p) => p.install(work),
                 None => work(),
             }
         });
-        let mut all = Vec::with_capacity(pending.len());
+        let mut saved = 0u64;
         let mut buffer: Vec<RunRecord> = Vec::new();
         let mut last_flush = Instant::now();
         let mut flush = |buffer: &mut Vec<RunRecord>| -> Result<(), RunError> {
             if buffer.is_empty() {
                 return Ok(());
             }
+            buffer.sort_by_key(|r| r.run_id);
             let mut df = to_dataframe(buffer)?;
             write_parquet(
                 &chunks.join(format!("chunk-{next_chunk:06}.parquet")),
@@ -485,6 +524,7 @@ fn execute(
                 provenance,
             )?;
             next_chunk += 1;
+            saved += buffer.len() as u64;
             buffer.clear();
             Ok(())
         };
@@ -492,7 +532,6 @@ fn execute(
             match rx.recv_timeout(Duration::from_millis(200)) {
                 Ok(record) => {
                     progress.advance(&record);
-                    all.push(record.clone());
                     buffer.push(record);
                 }
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
@@ -505,12 +544,13 @@ fn execute(
             }
         }
         flush(&mut buffer)?;
-        Ok(all)
+        Ok(saved)
     })
 }
 
-/// Records of every complete chunk in `dir` (leftover temporary files are removed).
-fn read_chunks(dir: &Path) -> Result<Vec<RunRecord>, RunError> {
+/// Every complete chunk in `dir`, in the order written (leftover temporary
+/// files of an interrupted write are removed).
+fn chunk_pieces(dir: &Path) -> Result<Vec<Piece>, RunError> {
     let mut out = Vec::new();
     if !dir.exists() {
         return Ok(out);
@@ -527,7 +567,7 @@ fn read_chunks(dir: &Path) -> Result<Vec<RunRecord>, RunError> {
         if name.contains(".tmp-") {
             std::fs::remove_file(&path)?;
         } else if name.ends_with(".parquet") {
-            out.extend(from_dataframe(&read_parquet(&path)?)?);
+            out.push(Piece::open(&path)?);
         }
     }
     Ok(out)

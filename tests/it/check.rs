@@ -287,7 +287,7 @@ fn planted_drag_change_of_five_percent_is_detected() {
             ..RunOptions::default()
         };
         let out = run_study(&after, &replace, &NoProgress).unwrap();
-        let now = design_samples(&to_dataframe(&out.runs).unwrap()).unwrap();
+        let now = design_samples(&to_dataframe(&out.load_runs().unwrap()).unwrap()).unwrap();
         let report = compare(&baseline.samples, &now, 0.01).unwrap();
         assert!(!report.passed(), "seed {seed}: not detected");
         let flagged: Vec<_> = report
@@ -392,7 +392,7 @@ fn cli_exit_codes_are_pass_regression_and_bad_input() {
     let mut weaker = plan(&small_study(&tmp.path().join("weaker"), 20.0 / 1.05));
     weaker.file.seed = p.file.seed;
     let old = run_study(&weaker, &RunOptions::default(), &NoProgress).unwrap();
-    write_baseline(&baseline, &p, &old.runs).unwrap();
+    write_baseline(&baseline, &p, &old.load_runs().unwrap()).unwrap();
     let out = study_cli(&["check", s, "--baseline", b]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stdout).contains("REGRESSION"));

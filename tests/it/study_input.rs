@@ -216,7 +216,7 @@ fn plans_too_large_to_run_are_refused_before_anything_is_written() {
     );
     rejects(
         |t| t.replace("samples = 2", "samples = 4000000000"),
-        &["sampling.samples", "4000000000", "more than the 3000000"],
+        &["sampling.samples", "4000000000", "more than the 20000000"],
     );
 }
 

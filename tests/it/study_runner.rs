@@ -97,7 +97,12 @@ fn sharded_and_merged_equals_whole() {
         };
         let out = run_study(&p, &opts, &NoProgress).unwrap();
         assert!(out.summary.is_none());
-        assert!(out.runs.iter().all(|r| r.run_id % 3 == u64::from(k - 1)));
+        assert!(
+            out.load_runs()
+                .unwrap()
+                .iter()
+                .all(|r| r.run_id % 3 == u64::from(k - 1))
+        );
         dirs.push(out.dir);
     }
     // Shards are disjoint and together hold every run.
@@ -109,7 +114,8 @@ fn sharded_and_merged_equals_whole() {
         "{again}"
     );
     autobal::study::merge::merge(&dirs, None, true).unwrap();
-    assert_eq!(merged.runs.len(), 20);
+    assert_eq!(merged.runs, 20);
+    assert_eq!(merged.load_runs().unwrap().len(), 20);
     assert!(
         stable(&dir.join("runs.parquet")).equals_missing(&stable(&merged.dir.join("runs.parquet")))
     );
@@ -371,4 +377,48 @@ fn provenance_is_stored_in_the_parquet_metadata() {
     assert_eq!(get("shard"), "all");
     assert_eq!(get("study_sha256"), autobal::study::io::sha256_hex(&text));
     assert_eq!(get("autobal_version"), env!("CARGO_PKG_VERSION"));
+}
+
+/// Runs spanning several row-group windows of `runs.parquet` (32 768 run ids
+/// each) give the same table whole, sharded and merged, or with small chunks.
+#[test]
+fn runs_spanning_several_windows_are_the_same_however_split() {
+    let extra = "[solver]\nfidelity = \"analytic\"\n";
+    let whole = tempfile::tempdir().unwrap();
+    let p = plan(&small_study(whole.path(), 20_000, extra));
+    let out = run_study(&p, &RunOptions::default(), &NoProgress).unwrap();
+    assert_eq!(out.runs, 40_000);
+    let reference = stable(&out.dir.join("runs.parquet"));
+    let ids: Vec<u64> = reference
+        .column("run_id")
+        .unwrap()
+        .u64()
+        .unwrap()
+        .into_no_null_iter()
+        .collect();
+    assert!(ids.iter().copied().eq(0..40_000));
+
+    let small_chunks = tempfile::tempdir().unwrap();
+    let p = plan(&small_study(small_chunks.path(), 20_000, extra));
+    let opts = RunOptions {
+        chunk_runs: 97,
+        threads: Some(2),
+        ..RunOptions::default()
+    };
+    let out = run_study(&p, &opts, &NoProgress).unwrap();
+    assert!(reference.equals_missing(&stable(&out.dir.join("runs.parquet"))));
+
+    let sharded = tempfile::tempdir().unwrap();
+    let p = plan(&small_study(sharded.path(), 20_000, extra));
+    let dirs: Vec<_> = (1..=3)
+        .map(|k| {
+            let opts = RunOptions {
+                shard: Some(Shard { index: k, count: 3 }),
+                ..RunOptions::default()
+            };
+            run_study(&p, &opts, &NoProgress).unwrap().dir
+        })
+        .collect();
+    let merged = autobal::study::merge::merge(&dirs, None, false).unwrap();
+    assert!(reference.equals_missing(&stable(&merged.dir.join("runs.parquet"))));
 }

@@ -47,8 +47,8 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
-    /// Write finished runs to disk after this many (smaller: less lost on a kill).
-    #[arg(long, default_value_t = 256)]
+    /// Write finished runs to disk after this many, or every 2 s, whichever comes first.
+    #[arg(long, default_value_t = 4096)]
     chunk_runs: usize,
 }
 
@@ -173,7 +173,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         None => println!(
             "shard {} done: {} runs in {} (merge the shards with `study merge`)",
             args.shard.map(|s| s.label()).unwrap_or_default(),
-            output.runs.len(),
+            output.runs,
             output.dir.display()
         ),
     }
@@ -187,11 +187,7 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
     if let Some(summary) = &output.summary {
         print!("{}", ranked_table(summary)?);
     }
-    eprintln!(
-        "merged {} runs into {}",
-        output.runs.len(),
-        output.dir.display()
-    );
+    eprintln!("merged {} runs into {}", output.runs, output.dir.display());
     Ok(())
 }
 

@@ -142,15 +142,13 @@ pub fn measure_threads(config: &ThreadConfig, output: &Path) -> Result<ThreadSca
             if let (Some(a), Some(b)) = (cpu_start, process_cpu_seconds()) {
                 cpu[i].push(b - a);
             }
-            records[i].get_or_insert_with(|| {
-                out.runs
-                    .into_iter()
-                    .map(|mut r| {
-                        r.wall_time_s = 0.0;
-                        r
-                    })
-                    .collect()
-            });
+            if records[i].is_none() {
+                let mut runs = out.load_runs()?;
+                for r in &mut runs {
+                    r.wall_time_s = 0.0;
+                }
+                records[i] = Some(runs);
+            }
         }
     }
     let load_after = load_average();

@@ -1,0 +1,188 @@
+//! The runs table on disk. `runs.parquet` is assembled from pieces (a run's
+//! chunks, a resumed folder's earlier table, the shards of a merge), each
+//! sorted by run id, one window of run ids at a time: memory holds an index
+//! of run ids (8 bytes a run) and one window of rows, whatever the number of
+//! runs. The window boundaries lie in run-id space, so the same runs give the
+//! same file however they were split into pieces (threads, resumes, shards).
+
+use super::io::{Provenance, temp_path};
+use polars::prelude::*;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// Run ids per row group of `runs.parquet`: a few tens of megabytes of rows
+/// in memory while writing, few enough row groups to read fast.
+pub const WINDOW_RUNS: u64 = 32_768;
+
+/// Columns the per-design summary reads (a slim projection of the runs).
+pub const SUMMARY_COLUMNS: [&str; 7] = [
+    "design_id",
+    "outcome",
+    "settled",
+    "settling_revs",
+    "residual_rel",
+    "contact",
+    "min_gap_rad",
+];
+
+/// One Parquet file of runs, with its run ids (ascending).
+#[derive(Debug)]
+pub struct Piece {
+    path: PathBuf,
+    ids: Vec<u64>,
+}
+
+impl Piece {
+    /// Index a file by reading its run ids only. A file whose rows are not in
+    /// run order (written by an older build) is rewritten sorted first.
+    pub fn open(path: &Path) -> PolarsResult<Piece> {
+        let ids = read_ids(path)?;
+        if ids.is_sorted() {
+            return Ok(Piece {
+                path: path.to_path_buf(),
+                ids,
+            });
+        }
+        let df = ParquetReader::new(File::open(path)?).finish()?;
+        let mut sorted = df.sort(["run_id"], SortMultipleOptions::default())?;
+        let tmp = temp_path(path);
+        ParquetWriter::new(File::create(&tmp)?).finish(&mut sorted)?;
+        std::fs::rename(&tmp, path)?;
+        Ok(Piece {
+            path: path.to_path_buf(),
+            ids: read_ids(path)?,
+        })
+    }
+
+    /// The run ids the file holds, ascending.
+    pub fn ids(&self) -> &[u64] {
+        &self.ids
+    }
+
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The file's rows with run ids in `[from, to)`, if any.
+    fn rows_between(&self, from: u64, to: u64) -> PolarsResult<Option<DataFrame>> {
+        let lo = self.ids.partition_point(|&id| id < from);
+        let hi = self.ids.partition_point(|&id| id < to);
+        if hi == lo {
+            return Ok(None);
+        }
+        ParquetReader::new(File::open(&self.path)?)
+            .with_slice(Some((lo, hi - lo)))
+            .finish()
+            .map(Some)
+    }
+}
+
+fn read_ids(path: &Path) -> PolarsResult<Vec<u64>> {
+    let df = ParquetReader::new(File::open(path)?)
+        .with_columns(Some(vec!["run_id".into()]))
+        .finish()?;
+    Ok(df.column("run_id")?.u64()?.into_no_null_iter().collect())
+}
+
+/// Write the runs of `pieces` to `out` (atomically) in run order, one row
+/// group per [`WINDOW_RUNS`] run ids up to `total_ids`. A run id held by
+/// several pieces is written once, from the first piece that holds it.
+/// Returns the number of rows written.
+pub fn write_runs(
+    pieces: &[Piece],
+    total_ids: u64,
+    out: &Path,
+    provenance: &Provenance,
+) -> PolarsResult<u64> {
+    let tmp = temp_path(out);
+    let result = write_windows(pieces, total_ids, &tmp, provenance);
+    match result {
+        Ok(rows) => {
+            std::fs::rename(&tmp, out)?;
+            Ok(rows)
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+fn write_windows(
+    pieces: &[Piece],
+    total_ids: u64,
+    tmp: &Path,
+    provenance: &Provenance,
+) -> PolarsResult<u64> {
+    let mut writer: Option<polars::io::parquet::write::BatchedWriter<File>> = None;
+    let mut rows = 0u64;
+    let mut from = 0;
+    while from < total_ids {
+        let to = (from + WINDOW_RUNS).min(total_ids);
+        let Some(window) = window_rows(pieces, from, to)? else {
+            from = to;
+            continue;
+        };
+        if writer.is_none() {
+            writer = Some(
+                ParquetWriter::new(File::create(tmp)?)
+                    .with_key_value_metadata(Some(KeyValueMetadata::from_static(
+                        provenance.pairs(),
+                    )))
+                    .batched(window.schema())?,
+            );
+        }
+        if let Some(w) = writer.as_mut() {
+            w.write_batch(&window)?;
+        }
+        rows += window.height() as u64;
+        from = to;
+    }
+    match writer {
+        Some(w) => {
+            w.finish()?;
+        }
+        None => {
+            return Err(PolarsError::NoData("no runs to write".into()));
+        }
+    }
+    Ok(rows)
+}
+
+/// Rows of every piece in `[from, to)`, in run order, each run once.
+fn window_rows(pieces: &[Piece], from: u64, to: u64) -> PolarsResult<Option<DataFrame>> {
+    let mut parts: Vec<DataFrame> = Vec::new();
+    for piece in pieces {
+        if let Some(df) = piece.rows_between(from, to)? {
+            parts.push(df);
+        }
+    }
+    let Some(mut all) = parts.first().cloned() else {
+        return Ok(None);
+    };
+    for part in &parts[1..] {
+        all.vstack_mut(part)?;
+    }
+    // A stable order by run id keeps the first piece's copy of a duplicate.
+    let ids: Vec<u64> = all.column("run_id")?.u64()?.into_no_null_iter().collect();
+    let mut order: Vec<usize> = (0..ids.len()).collect();
+    order.sort_by_key(|&i| ids[i]);
+    order.dedup_by_key(|i| ids[*i]);
+    let take = IdxCa::from_vec(
+        "".into(),
+        order.iter().map(|&i| i as IdxSize).collect::<Vec<_>>(),
+    );
+    let mut window = all.take(&take)?;
+    window.rechunk_mut();
+    Ok(Some(window))
+}
+
+/// The slim projection of `runs.parquet` the summary needs (about 40 bytes a run).
+pub fn read_summary_columns(path: &Path) -> PolarsResult<DataFrame> {
+    ParquetReader::new(File::open(path)?)
+        .with_columns(Some(
+            SUMMARY_COLUMNS.iter().map(|c| c.to_string()).collect(),
+        ))
+        .finish()
+}
