@@ -2,7 +2,9 @@
 //! ([`quantile`]), intervals of a proportion ([`interval`]), the bootstrap
 //! ([`bootstrap`]), and the two-sample tests and multiple-testing correction
 //! that regression checks are built from ([`ks`], [`proportion`], [`mood`],
-//! [`holm`]).
+//! [`holm`]), censoring-aware settling statistics ([`survival`]: Kaplan–Meier,
+//! its median and restricted mean) and paired comparisons of designs that
+//! share their samples ([`paired`]: win shares, sign and signed-rank tests).
 //!
 //! Nothing here knows about rotors or studies; the analyses (`study`,
 //! `check`, `optimize`, `plot`, `tradeoff`) bring the data.
@@ -12,5 +14,7 @@ pub mod holm;
 pub mod interval;
 pub mod ks;
 pub mod mood;
+pub mod paired;
 pub mod proportion;
 pub mod quantile;
+pub mod survival;
