@@ -18,12 +18,14 @@ use crate::model::scene::{DesignSpec, RhoChoice};
 use crate::model::start::StartMode;
 use crate::study::config::{Distribution, InitialSpec, Scale, StudyPlan, UnbalanceSpec};
 use crate::study::run::{Progress, RunError, RunOptions, run_study};
+use crate::study::runs_file::read_summary_columns;
+use crate::study::verdict::{DesignRuns, design_runs, settling_horizon};
 use normalisation::{Normalisation, design_capacity, rho_for};
 use polars::prelude::*;
 use serde::Serialize;
 
 /// One design's statistics in one experiment.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct DesignResult {
     /// "shift_90" or "fastest".
     pub experiment: String,
@@ -43,14 +45,20 @@ pub struct DesignResult {
     pub runs: u64,
     /// Fraction settled.
     pub settled_fraction: f64,
-    /// Mean settling time (revolutions, settled runs).
-    pub mean: Option<f64>,
-    /// Bootstrap 95 % interval of the mean.
-    pub mean_ci: Option<(f64, f64)>,
-    /// Median settling time (revolutions).
+    /// Kaplan–Meier median settling time over every run (revolutions;
+    /// `None`: beyond the run).
     pub median: Option<f64>,
-    /// 90th percentile (revolutions).
+    /// Its 95 % interval (`None` ends: not bounded within the run).
+    pub median_ci: (Option<f64>, Option<f64>),
+    /// Restricted mean settling time up to the horizon (revolutions).
+    pub rmst: Option<f64>,
+    /// 90th percentile over every run (revolutions; `None`: beyond the run).
     pub p90: Option<f64>,
+    /// The runs themselves, for paired comparisons between designs.
+    #[serde(skip)]
+    pub runs_by_sample: DesignRuns,
+    /// The runs' seed (for the bootstrap intervals of comparisons).
+    pub seed: u64,
 }
 
 /// Everything the experiment produced.
@@ -176,14 +184,18 @@ fn run_variant(
     let f = |c: &str| -> PolarsResult<Vec<Option<f64>>> {
         Ok(summary.column(c)?.f64()?.iter().collect())
     };
-    let (mean, lo, hi, median, p90, frac) = (
-        f("settling_revs_mean")?,
-        f("settling_revs_mean_ci_lo")?,
-        f("settling_revs_mean_ci_hi")?,
-        f("settling_revs_median")?,
-        f("settling_revs_p90")?,
+    let (median, lo, hi, rmst, p90, frac) = (
+        f("settling_revs_median_km")?,
+        f("settling_revs_median_km_lo")?,
+        f("settling_revs_median_km_hi")?,
+        f("settling_revs_rmst")?,
+        f("settling_revs_p90_all_runs")?,
         f("settled_fraction")?,
     );
+    let by_design = design_runs(
+        &read_summary_columns(&out.dir.join("runs.parquet"))?,
+        settling_horizon(plan),
+    )?;
     let runs: Vec<u64> = summary
         .column("runs")?
         .u64()?
@@ -204,10 +216,21 @@ fn run_variant(
             total_mass: f64::from(d.spec.n) * d.weight_mass,
             runs: runs[i],
             settled_fraction: frac[i].unwrap_or(0.0),
-            mean: mean[i],
-            mean_ci: lo[i].zip(hi[i]),
             median: median[i],
+            median_ci: (lo[i], hi[i]),
+            rmst: rmst[i],
             p90: p90[i],
+            runs_by_sample: by_design
+                .iter()
+                .find(|r| r.design_id == d.id)
+                .cloned()
+                .unwrap_or_else(|| DesignRuns {
+                    design_id: d.id,
+                    sample_ids: Vec::new(),
+                    settling: Vec::new(),
+                    residual: Vec::new(),
+                }),
+            seed: plan.file.seed,
         })
         .collect())
 }

@@ -7,23 +7,32 @@ use crate::design::optimum::optimal_rho;
 use crate::model::balancer::Kind;
 use crate::model::rotor::{PlaneRotor, RotorModel};
 use crate::study::config::StudyPlan;
+use crate::study::verdict::{
+    Comparison, DesignRuns, Verdict, best_versus_rest, compare, settling_horizon,
+};
 use std::fmt::Write;
 
 fn f(v: Option<f64>, d: usize) -> String {
     v.map_or("–".into(), |x| format!("{x:.d$}"))
 }
 
-fn ci(v: Option<(f64, f64)>) -> String {
-    v.map_or("–".into(), |(a, b)| format!("[{a:.1}, {b:.1}]"))
+/// An interval whose ends may be unbounded within the run (∞).
+fn ci(v: (Option<f64>, Option<f64>)) -> String {
+    let end = |x: Option<f64>| x.map_or("∞".into(), |x| format!("{x:.1}"));
+    format!("[{}, {}]", end(v.0), end(v.1))
 }
 
-/// True when two 95 % intervals do not overlap (a clear difference).
-fn separated(a: Option<(f64, f64)>, b: Option<(f64, f64)>) -> bool {
-    matches!((a, b), (Some(a), Some(b)) if a.1 < b.0 || b.1 < a.0)
+/// A p-value as printed.
+fn p_text(p: f64) -> String {
+    if p < 1e-4 {
+        "< 0.0001".into()
+    } else {
+        format!("{p:.4}")
+    }
 }
 
 fn design_table(out: &mut String, rows: &[&DesignResult]) {
-    out.push_str("| kind | n | ρ | capacity (kg·m) | weights (kg) | settled | mean t_s (rev) [95% CI] | median | p90 |\n|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| kind | n | ρ | capacity (kg·m) | weights (kg) | settled | median t_s (rev) [95% CI] | restricted mean | p90 |\n|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let _ = writeln!(
             out,
@@ -34,12 +43,39 @@ fn design_table(out: &mut String, rows: &[&DesignResult]) {
             r.capacity,
             r.total_mass,
             r.settled_fraction,
-            f(r.mean, 1),
-            ci(r.mean_ci),
             f(r.median, 1),
+            ci(r.median_ci),
+            f(r.rmst, 1),
             f(r.p90, 1)
         );
     }
+}
+
+/// "A settles sooner than B in x % [lo, hi] of N paired runs, median d rev
+/// sooner [lo, hi]", from a paired comparison with A first.
+fn paired_effect(c: &Comparison, a: &str, b: &str) -> String {
+    let Some(p) = &c.paired else {
+        return format!("{a} and {b} could not be paired");
+    };
+    let rev = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.1}")
+        } else {
+            "∞".into()
+        }
+    };
+    format!(
+        "{a} settles sooner than {b} in {:.0} % [{:.0}, {:.0}] of {} paired runs ({b} sooner in {:.0} %, ties {:.0} %), median {} rev sooner [{}, {}]",
+        100.0 * p.a_sooner_share,
+        100.0 * p.a_sooner_share_interval.0,
+        100.0 * p.a_sooner_share_interval.1,
+        p.n,
+        100.0 * p.b_sooner as f64 / p.n as f64,
+        100.0 * p.ties as f64 / p.n as f64,
+        rev(p.median_difference),
+        rev(p.median_difference_interval.0),
+        rev(p.median_difference_interval.1),
+    )
 }
 
 /// One line describing the rotor of the study.
@@ -57,6 +93,8 @@ fn rotor_description(rotor: &RotorModel) -> String {
 pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
     let mut s = String::new();
     let g = &plan.file.designs;
+    let alpha = plan.file.statistics.alpha;
+    let horizon = settling_horizon(plan);
     let _ = writeln!(
         s,
         "# Seed 000's design claims, put to a virtual experiment\n"
@@ -180,24 +218,22 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         design_table(&mut s, &rows);
         let two = rows.iter().find(|r| r.n == 2);
         let three = rows.iter().find(|r| r.n == 3);
-        if let (Some(a), Some(b)) = (two, three) {
-            let ratio = a.mean.zip(b.mean).map(|(x, y)| x / y);
-            let clear = separated(a.mean_ci, b.mean_ci);
+        if let (Some(two), Some(three)) = (two, three) {
+            let c = compare(&three.runs_by_sample, &two.runs_by_sample, true, three.seed);
+            let p = c.p_value();
+            let clear = p <= alpha;
+            let share = c.paired.as_ref().map_or(0.5, |x| x.a_sooner_share);
             let _ = writeln!(
                 s,
-                "\nMean settling of two weights / three weights: {} ({}). {}\n",
-                f(ratio, 2),
-                if clear {
-                    "95 % intervals do not overlap"
-                } else {
-                    "95 % intervals overlap"
-                },
-                match ratio {
-                    Some(r) if r > 1.5 && clear => "Confirmed under this normalisation.",
-                    Some(r) if r > 1.0 && clear =>
+                "\n{}; sign test p = {} (α = {alpha}). {}\n",
+                paired_effect(&c, "three weights", "two"),
+                p_text(p),
+                match (clear, c.a_is_sooner()) {
+                    (true, true) if share >= 0.75 => "Confirmed under this normalisation.",
+                    (true, true) =>
                         "Three are faster, but not by the wide margin the paper suggests.",
-                    Some(_) if clear => "Contradicted: two weights are faster here.",
-                    _ => "No clear difference at this sample size.",
+                    (true, false) => "Contradicted: two weights are faster here.",
+                    (false, _) => "Not distinguishable at this sample size.",
                 }
             );
         }
@@ -222,43 +258,80 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         design_table(&mut s, &rows);
         s.push('\n');
         for (kind, paper_n) in [(Kind::Ball, 3), (Kind::Roller, 5)] {
-            let of_kind: Vec<&&DesignResult> = rows
-                .iter()
-                .filter(|r| r.kind == kind && r.mean.is_some())
-                .collect();
-            let Some(best) = of_kind.iter().min_by(|a, b| {
-                a.mean
-                    .unwrap_or(f64::INFINITY)
-                    .total_cmp(&b.mean.unwrap_or(f64::INFINITY))
-            }) else {
+            let of_kind: Vec<&&DesignResult> = rows.iter().filter(|r| r.kind == kind).collect();
+            let runs: Vec<DesignRuns> = of_kind.iter().map(|r| r.runs_by_sample.clone()).collect();
+            let seed = of_kind.first().map_or(0, |r| r.seed);
+            let Some(v) = best_versus_rest(&runs, horizon, alpha, true, seed) else {
                 continue;
             };
-            let paper = of_kind.iter().find(|r| r.n == paper_n);
-            let verdict = match paper {
-                Some(p) if p.n == best.n => format!("Confirmed: {paper_n} {kind}s settle fastest."),
-                Some(p) if !separated(p.mean_ci, best.mean_ci) => format!(
-                    "Not distinguishable: {} {kind}s are fastest (mean {:.1} rev), {paper_n} {kind}s ({:.1} rev) lie within the 95 % interval.",
-                    best.n,
-                    best.mean.unwrap_or(f64::NAN),
-                    p.mean.unwrap_or(f64::NAN)
-                ),
-                Some(p) => format!(
-                    "Contradicted: {} {kind}s are fastest (mean {:.1} rev {}), clearly ahead of {paper_n} {kind}s ({:.1} rev {}).",
-                    best.n,
-                    best.mean.unwrap_or(f64::NAN),
-                    ci(best.mean_ci),
-                    p.mean.unwrap_or(f64::NAN),
-                    ci(p.mean_ci)
-                ),
-                None => format!(
-                    "{} {kind}s are fastest; {paper_n} was not simulated.",
-                    best.n
-                ),
+            let n_of = |id: u32| {
+                of_kind
+                    .iter()
+                    .find(|r| r.runs_by_sample.design_id == id)
+                    .map_or(0, |r| r.n)
+            };
+            let best_n = n_of(v.best);
+            let per_design = runs.iter().map(|r| r.settling.len()).max().unwrap_or(0);
+            let family = format!(
+                "α = {alpha}, Holm-adjusted over the {} comparisons of the fastest {kind} design with the others, n = {per_design} runs per design",
+                v.others.len()
+            );
+            let beaten = v
+                .others
+                .iter()
+                .filter(|(_, _, x)| *x == Verdict::BestSooner)
+                .count();
+            let verdict = if best_n == paper_n {
+                let unclear: Vec<String> = v
+                    .others
+                    .iter()
+                    .filter(|(_, _, x)| *x != Verdict::BestSooner)
+                    .map(|(c, p, _)| {
+                        format!(
+                            "{} {kind}s ({}; Holm p = {})",
+                            n_of(c.b),
+                            paired_effect(c, &format!("{paper_n}"), &n_of(c.b).to_string()),
+                            p_text(*p)
+                        )
+                    })
+                    .collect();
+                if unclear.is_empty() {
+                    format!(
+                        "Confirmed: {paper_n} {kind}s have the lowest median settling time and settle sooner than each of the other {beaten} counts ({family})."
+                    )
+                } else {
+                    format!(
+                        "Partly confirmed: {paper_n} {kind}s have the lowest median, but cannot be told apart from {} ({family}).",
+                        unclear.join("; ")
+                    )
+                }
+            } else {
+                match v.others.iter().find(|(c, _, _)| n_of(c.b) == paper_n) {
+                    Some((c, p, x)) => {
+                        let effect =
+                            paired_effect(c, &format!("{best_n} {kind}s"), &format!("{paper_n}"));
+                        match x {
+                            Verdict::BestSooner => format!(
+                                "Contradicted: {best_n} {kind}s settle fastest: {effect}; Holm p = {} ({family}).",
+                                p_text(*p)
+                            ),
+                            Verdict::NotDistinguishable => format!(
+                                "Not distinguishable: {best_n} {kind}s have the lowest median, but {effect}; Holm p = {} ({family}).",
+                                p_text(*p)
+                            ),
+                            Verdict::OtherSooner => format!(
+                                "Mixed: {best_n} {kind}s have the lowest median, yet {paper_n} {kind}s settle sooner in more paired runs: {effect}; Holm p = {} ({family}).",
+                                p_text(*p)
+                            ),
+                        }
+                    }
+                    None => format!("{best_n} {kind}s are fastest; {paper_n} was not simulated."),
+                }
             };
             let _ = writeln!(s, "- {verdict}");
         }
         s.push('\n');
     }
-    s.push_str("## Notes\n\n- The paper's measure ã (eqs 15/16) ranks designs at p = p_max, the slowest balanced configuration; the simulation averages over the sampled unbalances, so a design can rank differently.\n- Every number above comes from the runs under `results/` of the command at the top; rerunning it rewrites this file.\n");
+    s.push_str("## Notes\n\n- The paper's measure ã (eqs 15/16) ranks designs at p = p_max, the slowest balanced configuration; the simulation ranks by the Kaplan–Meier median settling time over the sampled unbalances (every run counts, unsettled ones as censored) and compares designs on paired runs, so a design can rank differently.\n- Every number above comes from the runs under `results/` of the command at the top; rerunning it rewrites this file.\n");
     s
 }

@@ -1,17 +1,19 @@
 //! Per-design statistics of a study (`summary.parquet`), computed with polars.
 //!
-//! Settling statistics use the settled runs and are in revolutions; residual
-//! vibration uses every run that was simulated to the end (settled or not),
-//! i.e. the distribution over the sampled unbalances; diverged and failed runs
-//! are counted, not averaged.
+//! Settling statistics count every run: a run that did not settle is a
+//! censored observation (Kaplan–Meier median and restricted mean, in
+//! revolutions), never dropped; the best design is compared with every
+//! other on paired runs ([`super::verdict`]). Residual vibration uses every
+//! run that was simulated to the end (settled or not), i.e. the distribution
+//! over the sampled unbalances; diverged and failed runs are counted.
 
 use super::config::StudyPlan;
 use super::record::{RunRecord, to_dataframe};
-use super::sample::{Purpose, stream};
+use super::verdict::{BestVersusRest, LEVEL, best_versus_rest, design_runs, settling_horizon};
 use crate::model::gap::GapGauge;
-use crate::stats::bootstrap;
 use crate::stats::interval::wilson_interval;
 use crate::stats::quantile::{Interpolation, quantile_sorted};
+use crate::stats::survival::Transform;
 use polars::prelude::*;
 
 /// Non-null values of a column, sorted for [`quantile_sorted`].
@@ -25,23 +27,6 @@ fn sorted_values(ca: &Float64Chunked) -> Vec<f64> {
     let mut v: Vec<f64> = ca.iter().flatten().collect();
     v.sort_by(f64::total_cmp);
     v
-}
-
-/// The median settling time over every run of a design, a run that did not
-/// settle counting as "later than any settled one": censored runs are only
-/// known to settle after t_end − W, which no settled run's t_s exceeds (its
-/// hold had to complete by t_end), and diverged or failed runs never settle.
-/// With such censoring this is exactly the Kaplan–Meier median. `None` when
-/// half the runs or more did not settle: the median is then beyond the run.
-fn median_counting_unsettled(settled_sorted: &[f64], runs: u64) -> Option<f64> {
-    let runs = runs as usize;
-    if runs == 0 {
-        return None;
-    }
-    // Lower and upper middle order statistics of all runs (unsettled = +∞).
-    let (lo, hi) = ((runs - 1) / 2, runs / 2);
-    let at = |i: usize| settled_sorted.get(i).copied();
-    Some(0.5 * (at(lo)? + at(hi)?))
 }
 
 /// The q-quantile (linear interpolation) over every run of a design, runs
@@ -67,6 +52,19 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
 pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFrame> {
     let design_col = df.column("design_id")?.u32()?.clone();
     let mut rows = SummaryColumns::default();
+    let by_design = design_runs(df, settling_horizon(plan))?;
+    // The restricted mean is taken up to the latest time any run could show.
+    let horizon = by_design
+        .iter()
+        .flat_map(|d| d.settling.iter().map(|o| o.time))
+        .fold(settling_horizon(plan), f64::max);
+    let verdicts = best_versus_rest(
+        &by_design,
+        horizon,
+        plan.file.statistics.alpha,
+        plan.file.sampling.common_random_numbers,
+        plan.file.seed,
+    );
     for design in &plan.designs {
         let mine = df.filter(&design_col.equal(design.id))?;
         let outcome = mine.column("outcome")?.str()?.clone();
@@ -81,10 +79,6 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let runs_n = mine.height() as u64;
         let settled_n = settled.height() as u64;
         let (lo, hi) = wilson_interval(settled_n, runs_n);
-        let ts_values: Vec<f64> = ts.into_no_null_iter().collect();
-        let mut rng = stream(plan.file.seed, Some(design.id), 0, Purpose::Bootstrap);
-        let ci = bootstrap::mean_ci(&ts_values, &mut rng);
-
         rows.design_id.push(design.id);
         rows.kind.push(design.spec.kind.name().to_string());
         rows.n.push(design.spec.n);
@@ -100,21 +94,30 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         });
         rows.settled_lo.push(lo);
         rows.settled_hi.push(hi);
-        rows.ts_mean.push(ts.mean());
-        rows.ts_std.push(ts.std(1));
         let ts_sorted = sorted_values(&ts);
-        let ts_q = |q| quantile_sorted(&ts_sorted, q, Interpolation::Linear);
-        rows.ts_median.push(ts_q(0.5));
-        rows.ts_median_all
-            .push(median_counting_unsettled(&ts_sorted, runs_n));
         rows.ts_p90_all
             .push(quantile_counting_unsettled(&ts_sorted, runs_n, 0.9));
-        rows.ts_p10.push(ts_q(0.10));
-        rows.ts_p90.push(ts_q(0.90));
-        rows.ts_p95.push(ts_q(0.95));
-        rows.ts_max.push(ts.max());
-        rows.ts_ci_lo.push(ci.map(|c| c.0));
-        rows.ts_ci_hi.push(ci.map(|c| c.1));
+        let km = by_design
+            .iter()
+            .find(|d| d.design_id == design.id)
+            .and_then(|d| d.kaplan_meier());
+        let median = km.as_ref().and_then(|k| k.median());
+        let (median_lo, median_hi) = km.as_ref().map_or((None, None), |k| {
+            k.median_interval(LEVEL, Transform::LogLog)
+        });
+        rows.ts_median_km.push(median);
+        rows.ts_median_km_lo.push(median_lo);
+        rows.ts_median_km_hi.push(median_hi);
+        let rmst = km.as_ref().map(|k| k.restricted_mean(horizon));
+        rows.ts_rmst.push(rmst.map(|r| r.estimate));
+        let rmst_interval = rmst.map(|r| r.interval(LEVEL));
+        rows.ts_rmst_lo
+            .push(rmst_interval.map(|i| i.lower.max(0.0)));
+        rows.ts_rmst_hi
+            .push(rmst_interval.map(|i| i.upper.min(horizon)));
+        rows.horizon.push(horizon);
+        rows.push_verdict(verdicts.as_ref(), design.id);
+        rows.vs_best_alpha.push(plan.file.statistics.alpha);
         rows.res_mean.push(residual.mean());
         let res_sorted = sorted_values(&residual);
         let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
@@ -162,17 +165,24 @@ struct SummaryColumns {
     settled_fraction: Vec<f64>,
     settled_lo: Vec<f64>,
     settled_hi: Vec<f64>,
-    ts_mean: Vec<Option<f64>>,
-    ts_std: Vec<Option<f64>>,
-    ts_median: Vec<Option<f64>>,
-    ts_median_all: Vec<Option<f64>>,
+    ts_median_km: Vec<Option<f64>>,
+    ts_median_km_lo: Vec<Option<f64>>,
+    ts_median_km_hi: Vec<Option<f64>>,
+    ts_rmst: Vec<Option<f64>>,
+    ts_rmst_lo: Vec<Option<f64>>,
+    ts_rmst_hi: Vec<Option<f64>>,
+    horizon: Vec<f64>,
     ts_p90_all: Vec<Option<f64>>,
-    ts_p10: Vec<Option<f64>>,
-    ts_p90: Vec<Option<f64>>,
-    ts_p95: Vec<Option<f64>>,
-    ts_max: Vec<Option<f64>>,
-    ts_ci_lo: Vec<Option<f64>>,
-    ts_ci_hi: Vec<Option<f64>>,
+    vs_best_verdict: Vec<String>,
+    vs_best_test: Vec<Option<String>>,
+    vs_best_share: Vec<Option<f64>>,
+    vs_best_share_lo: Vec<Option<f64>>,
+    vs_best_share_hi: Vec<Option<f64>>,
+    vs_best_diff: Vec<Option<f64>>,
+    vs_best_diff_lo: Vec<Option<f64>>,
+    vs_best_diff_hi: Vec<Option<f64>>,
+    vs_best_p_holm: Vec<Option<f64>>,
+    vs_best_alpha: Vec<f64>,
     res_mean: Vec<Option<f64>>,
     res_median: Vec<Option<f64>>,
     res_p95: Vec<Option<f64>>,
@@ -186,7 +196,45 @@ struct SummaryColumns {
     max_overlap: Vec<Option<f64>>,
 }
 
+/// A finite value, or `None` (an infinite paired median difference means
+/// that in half the pairs or more one design did not settle).
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
 impl SummaryColumns {
+    /// The comparison of design `id` with the best design (nothing for the
+    /// best itself, or when there is only one design).
+    fn push_verdict(&mut self, verdicts: Option<&BestVersusRest>, id: u32) {
+        let other = verdicts.and_then(|v| v.others.iter().find(|(c, _, _)| c.b == id));
+        self.vs_best_verdict.push(match (verdicts, other) {
+            (Some(v), _) if v.best == id => "best".to_string(),
+            (_, Some((_, _, verdict))) => verdict.name().to_string(),
+            _ => "only_design".to_string(),
+        });
+        let paired = other.and_then(|(c, _, _)| c.paired.as_ref());
+        self.vs_best_test.push(other.map(|(c, _, _)| {
+            if c.paired.is_some() {
+                "sign"
+            } else {
+                "log_rank"
+            }
+            .to_string()
+        }));
+        self.vs_best_share.push(paired.map(|p| p.a_sooner_share));
+        self.vs_best_share_lo
+            .push(paired.map(|p| p.a_sooner_share_interval.0));
+        self.vs_best_share_hi
+            .push(paired.map(|p| p.a_sooner_share_interval.1));
+        self.vs_best_diff
+            .push(paired.and_then(|p| finite(p.median_difference)));
+        self.vs_best_diff_lo
+            .push(paired.and_then(|p| finite(p.median_difference_interval.0)));
+        self.vs_best_diff_hi
+            .push(paired.and_then(|p| finite(p.median_difference_interval.1)));
+        self.vs_best_p_holm.push(other.map(|(_, p, _)| *p));
+    }
+
     fn into_dataframe(self) -> PolarsResult<DataFrame> {
         let height = self.design_id.len();
         DataFrame::new(
@@ -203,17 +251,24 @@ impl SummaryColumns {
                 Column::new("settled_fraction".into(), self.settled_fraction),
                 Column::new("settled_fraction_lo".into(), self.settled_lo),
                 Column::new("settled_fraction_hi".into(), self.settled_hi),
-                Column::new("settling_revs_mean".into(), self.ts_mean),
-                Column::new("settling_revs_std".into(), self.ts_std),
-                Column::new("settling_revs_median".into(), self.ts_median),
-                Column::new("settling_revs_median_all_runs".into(), self.ts_median_all),
+                Column::new("settling_revs_median_km".into(), self.ts_median_km),
+                Column::new("settling_revs_median_km_lo".into(), self.ts_median_km_lo),
+                Column::new("settling_revs_median_km_hi".into(), self.ts_median_km_hi),
+                Column::new("settling_revs_rmst".into(), self.ts_rmst),
+                Column::new("settling_revs_rmst_lo".into(), self.ts_rmst_lo),
+                Column::new("settling_revs_rmst_hi".into(), self.ts_rmst_hi),
+                Column::new("settling_horizon_revs".into(), self.horizon),
                 Column::new("settling_revs_p90_all_runs".into(), self.ts_p90_all),
-                Column::new("settling_revs_p10".into(), self.ts_p10),
-                Column::new("settling_revs_p90".into(), self.ts_p90),
-                Column::new("settling_revs_p95".into(), self.ts_p95),
-                Column::new("settling_revs_max".into(), self.ts_max),
-                Column::new("settling_revs_mean_ci_lo".into(), self.ts_ci_lo),
-                Column::new("settling_revs_mean_ci_hi".into(), self.ts_ci_hi),
+                Column::new("vs_best_verdict".into(), self.vs_best_verdict),
+                Column::new("vs_best_test".into(), self.vs_best_test),
+                Column::new("vs_best_sooner_share".into(), self.vs_best_share),
+                Column::new("vs_best_sooner_share_lo".into(), self.vs_best_share_lo),
+                Column::new("vs_best_sooner_share_hi".into(), self.vs_best_share_hi),
+                Column::new("vs_best_median_diff_revs".into(), self.vs_best_diff),
+                Column::new("vs_best_median_diff_revs_lo".into(), self.vs_best_diff_lo),
+                Column::new("vs_best_median_diff_revs_hi".into(), self.vs_best_diff_hi),
+                Column::new("vs_best_p_holm".into(), self.vs_best_p_holm),
+                Column::new("vs_best_alpha".into(), self.vs_best_alpha),
                 Column::new("residual_rel_mean".into(), self.res_mean),
                 Column::new("residual_rel_median".into(), self.res_median),
                 Column::new("residual_rel_p95".into(), self.res_p95),

@@ -48,6 +48,31 @@ pub struct StudyFile {
     /// Settings of `study optimize` (ignored by `study run`).
     #[serde(default)]
     pub optimize: Option<super::optimize_spec::OptimizeSpec>,
+    /// How designs are compared (significance level of the verdicts).
+    #[serde(default)]
+    pub statistics: StatisticsSpec,
+}
+
+/// How verdicts between designs are reached.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StatisticsSpec {
+    /// Family-wise error rate of the "settles sooner than" verdicts
+    /// (Holm-adjusted over every comparison of the best design with another).
+    #[serde(default = "default_alpha")]
+    pub alpha: f64,
+}
+
+impl Default for StatisticsSpec {
+    fn default() -> Self {
+        StatisticsSpec {
+            alpha: default_alpha(),
+        }
+    }
+}
+
+fn default_alpha() -> f64 {
+    0.05
 }
 
 fn default_seed() -> u64 {
@@ -408,6 +433,14 @@ impl StudyFile {
                 "name",
                 format!("{name:?}"),
                 "must be a plain folder name",
+            ));
+        }
+        let alpha = self.statistics.alpha;
+        if !(alpha > 0.0 && alpha <= 0.5) {
+            return Err(invalid(
+                "statistics.alpha",
+                alpha.to_string(),
+                "a significance level in (0, 0.5], e.g. 0.05",
             ));
         }
         let s = &self.sampling;

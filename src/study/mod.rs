@@ -7,6 +7,7 @@
 //! - [`record`]: one row of `runs.parquet`.
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
 //! - [`merge`]: combining shard outputs.
 //! - [`io`]: Parquet with provenance, atomic writes.
 //! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
@@ -24,3 +25,4 @@ pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
 pub mod sweep;
+pub mod verdict;

@@ -15,11 +15,13 @@ use std::path::{Path, PathBuf};
 pub const WINDOW_RUNS: u64 = 32_768;
 
 /// Columns the per-design summary reads (a slim projection of the runs).
-pub const SUMMARY_COLUMNS: [&str; 7] = [
+pub const SUMMARY_COLUMNS: [&str; 9] = [
     "design_id",
+    "sample_id",
     "outcome",
     "settled",
     "settling_revs",
+    "censoring_revs",
     "residual_rel",
     "contact",
     "min_gap_rad",

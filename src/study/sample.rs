@@ -33,6 +33,8 @@ pub enum Purpose {
     Initial = 2,
     /// Bootstrap resampling of a design's statistics.
     Bootstrap = 3,
+    /// Bootstrap resampling of a comparison of two designs.
+    Comparison = 4,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for

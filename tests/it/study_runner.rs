@@ -332,7 +332,7 @@ fn golden_study_makes_physical_sense() {
         .no_null_iter()
         .collect();
     let median: Vec<f64> = summary
-        .column("settling_revs_median")
+        .column("settling_revs_median_km")
         .unwrap()
         .f64()
         .unwrap()
@@ -346,8 +346,11 @@ fn golden_study_makes_physical_sense() {
     // Summary columns the README promises.
     for c in [
         "settled_fraction_lo",
-        "settling_revs_p95",
-        "settling_revs_mean_ci_lo",
+        "settling_revs_median_km_lo",
+        "settling_revs_rmst",
+        "settling_revs_rmst_hi",
+        "vs_best_verdict",
+        "vs_best_p_holm",
         "residual_rel_p95",
         "diverged",
     ] {

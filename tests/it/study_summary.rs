@@ -4,10 +4,12 @@ use crate::fixtures::SI_SCENE;
 use autobal::metrics::{Outcome, RunMetrics};
 use autobal::stats::bootstrap;
 use autobal::stats::interval::wilson_interval;
+use autobal::stats::survival::Observation;
 use autobal::study::aggregate::summarize;
 use autobal::study::config::StudyFile;
 use autobal::study::record::RunRecord;
 use autobal::study::sample::{Purpose, stream};
+use autobal::study::verdict::{DesignRuns, Verdict, best_versus_rest, settling_horizon};
 
 fn plan() -> autobal::study::config::StudyPlan {
     let text = &[
@@ -97,12 +99,18 @@ fn summary_matches_a_hand_computation() {
     assert_eq!(u("diverged"), 1);
     assert_eq!(u("solver_failed"), 0);
     assert!((f("settled_fraction") - 4.0 / 6.0).abs() < 1e-15);
-    // Settled runs: 10, 20, 30, 40 revolutions.
-    assert_eq!(f("settling_revs_mean"), 25.0);
-    assert_eq!(f("settling_revs_median"), 25.0);
-    // Over all six runs, the two that did not settle counting as later than
-    // every settled one: [10, 20, 30, 40, ∞, ∞] → (30 + 40)/2.
-    assert_eq!(f("settling_revs_median_all_runs"), 35.0);
+    // Every run counts: settled at 10, 20, 30, 40 revolutions; the two that
+    // did not settle are censored at the horizon (t_end − W). Kaplan–Meier:
+    // S = 5/6, 4/6, 3/6 after 10, 20, 30; S sits on 1/2 until 40, so the
+    // median is (30 + 40)/2, as over [10, 20, 30, 40, ∞, ∞].
+    assert_eq!(f("settling_revs_median_km"), 35.0);
+    let tau = settling_horizon(&plan());
+    assert_eq!(f("settling_horizon_revs"), tau);
+    // Restricted mean: the area under S from 0 to τ.
+    let area =
+        10.0 + 10.0 * 5.0 / 6.0 + 10.0 * 4.0 / 6.0 + 10.0 * 3.0 / 6.0 + (tau - 40.0) * 2.0 / 6.0;
+    assert!((f("settling_revs_rmst") - area).abs() < 1e-9 * area);
+    assert!(f("settling_revs_rmst_lo") < area && area < f("settling_revs_rmst_hi"));
     // The p90 over all six falls among the two runs that did not settle.
     assert!(
         df.column("settling_revs_p90_all_runs")
@@ -112,19 +120,22 @@ fn summary_matches_a_hand_computation() {
             .get(0)
             .is_none()
     );
-    assert!((f("settling_revs_std") - (500.0f64 / 3.0).sqrt()).abs() < 1e-12);
-    assert!((f("settling_revs_p10") - 13.0).abs() < 1e-12);
-    assert!((f("settling_revs_p90") - 37.0).abs() < 1e-12);
-    assert!((f("settling_revs_p95") - 38.5).abs() < 1e-12);
-    assert_eq!(f("settling_revs_max"), 40.0);
+    // No mean or quantile over the settled runs alone is reported.
+    for gone in [
+        "settling_revs_mean",
+        "settling_revs_median",
+        "settling_revs_p95",
+    ] {
+        assert!(df.column(gone).is_err(), "{gone}");
+    }
+    // One design: nothing to compare it with.
+    assert_eq!(
+        df.column("vs_best_verdict").unwrap().str().unwrap().get(0),
+        Some("only_design")
+    );
     // Residual over the runs simulated to the end (settled or not): 0.01..0.04 and 0.5.
     assert!((f("residual_rel_mean") - 0.6 / 5.0).abs() < 1e-15);
     assert!((f("residual_rel_median") - 0.03).abs() < 1e-15);
-    let (lo, hi) = (f("settling_revs_mean_ci_lo"), f("settling_revs_mean_ci_hi"));
-    assert!(
-        lo < 25.0 && 25.0 < hi && lo >= 10.0 && hi <= 40.0,
-        "[{lo}, {hi}]"
-    );
 }
 
 #[test]
@@ -139,7 +150,7 @@ fn median_over_all_runs_counts_runs_that_did_not_settle() {
     let median = |rs: &[RunRecord]| {
         let p = plan();
         let df = summarize(&p, rs).unwrap();
-        df.column("settling_revs_median_all_runs")
+        df.column("settling_revs_median_km")
             .unwrap()
             .f64()
             .unwrap()
@@ -219,4 +230,78 @@ fn bootstrap_is_seeded_and_brackets_the_mean() {
         "{a:?}"
     );
     assert!(bootstrap::mean_ci(&[1.0], &mut stream(1, Some(0), 0, Purpose::Bootstrap)).is_none());
+}
+
+/// Runs of one design at the given settling times (`None`: censored at 100).
+fn design(id: u32, times: &[Option<f64>]) -> DesignRuns {
+    DesignRuns {
+        design_id: id,
+        sample_ids: (0..times.len() as u32).collect(),
+        settling: times
+            .iter()
+            .map(|t| Observation {
+                time: t.unwrap_or(100.0),
+                settled: t.is_some(),
+            })
+            .collect(),
+        residual: vec![Some(0.01); times.len()],
+    }
+}
+
+#[test]
+fn the_best_design_is_compared_with_every_other_on_paired_runs() {
+    let fast: Vec<Option<f64>> = (0..40).map(|i| Some(10.0 + f64::from(i))).collect();
+    // Slower by 5 revolutions on every shared sample.
+    let slow: Vec<Option<f64>> = fast.iter().map(|t| t.map(|t| t + 5.0)).collect();
+    // The same as the fast one but for one sample either way: a tie.
+    let mut twin = fast.clone();
+    twin.swap(0, 39);
+    // Settles sooner on most samples, but never in a quarter of them.
+    let flaky: Vec<Option<f64>> = fast
+        .iter()
+        .enumerate()
+        .map(|(i, t)| if i % 4 == 0 { None } else { t.map(|t| t - 1.0) })
+        .collect();
+    let designs = [
+        design(0, &slow),
+        design(1, &fast),
+        design(2, &twin),
+        design(3, &flaky),
+    ];
+    let v = best_versus_rest(&designs, 100.0, 0.05, true, 1).unwrap();
+    assert!(v.paired);
+    // Kaplan–Meier medians: fast and twin 29.5 (the same times; equal
+    // restricted means, so the first is the best), flaky 35.5 (its 20th and
+    // 21st settling times, 35 and 36), slow 34.5.
+    assert_eq!(v.best, 1);
+    let verdict = |id: u32| v.others.iter().find(|(c, _, _)| c.b == id).unwrap();
+    let (vs_slow, p_slow, slow_verdict) = verdict(0);
+    let paired = vs_slow.paired.as_ref().unwrap();
+    assert_eq!((paired.a_sooner, paired.b_sooner, paired.ties), (40, 0, 0));
+    assert_eq!(paired.median_difference, 5.0);
+    assert_eq!(*slow_verdict, Verdict::BestSooner);
+    // Sign test 2·0.5⁴⁰, the smallest of three p-values: Holm multiplies it by 3.
+    assert!((p_slow / (3.0 * 2.0 * 0.5f64.powi(40)) - 1.0).abs() < 1e-9);
+    // The twin differs on two samples, one each way: indistinguishable.
+    let (vs_twin, p_twin, twin_verdict) = verdict(2);
+    assert_eq!(vs_twin.paired.as_ref().unwrap().ties, 38);
+    assert_eq!((*p_twin, *twin_verdict), (1.0, Verdict::NotDistinguishable));
+    // Flaky wins 30 of 40 pairs although its median is higher: the verdict
+    // says the rankings disagree instead of calling the best faster.
+    let (vs_flaky, _, flaky_verdict) = verdict(3);
+    assert_eq!(vs_flaky.paired.as_ref().unwrap().b_sooner, 30);
+    assert_eq!(*flaky_verdict, Verdict::OtherSooner);
+    // Holm: adjusted p-values are never below the raw ones.
+    for (c, p, _) in &v.others {
+        assert!(*p >= c.p_value());
+    }
+    // Without common random numbers the same runs are compared unpaired (log-rank).
+    let unpaired = best_versus_rest(&designs, 100.0, 0.05, false, 1).unwrap();
+    assert!(!unpaired.paired);
+    assert!(
+        unpaired
+            .others
+            .iter()
+            .all(|(c, _, _)| c.paired.is_none() && c.unpaired.is_some())
+    );
 }

@@ -191,21 +191,28 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
     Ok(())
 }
 
-/// Designs ranked by the median settling time over all their runs, a run
-/// that did not settle counting as later than every settled one (designs
-/// whose median lies beyond the run last): a design that often fails to
-/// settle cannot rank first on its few fast runs.
+/// Designs ranked by their Kaplan–Meier median settling time (every run
+/// counts; a run that did not settle is censored), ties and medians beyond
+/// the run ordered by the restricted mean; then the best design against
+/// every other on paired runs, Holm-corrected.
 pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     let col_f = |name: &str| -> Result<Vec<Option<f64>>, UserError> {
         Ok(summary.column(name)?.f64()?.iter().collect())
     };
-    let kind: Vec<String> = summary
-        .column("kind")?
-        .str()?
-        .iter()
-        .map(|s| s.unwrap_or_default().to_string())
+    let col_s = |name: &str| -> Result<Vec<Option<String>>, UserError> {
+        Ok(summary
+            .column(name)?
+            .str()?
+            .iter()
+            .map(|s| s.map(str::to_string))
+            .collect())
+    };
+    let kind: Vec<String> = col_s("kind")?
+        .into_iter()
+        .map(Option::unwrap_or_default)
         .collect();
     let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
+    let runs: Vec<Option<u64>> = summary.column("runs")?.u64()?.iter().collect();
     let (rho, drag, frac, lo, hi) = (
         col_f("rho")?,
         col_f("drag")?,
@@ -213,24 +220,66 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
         col_f("settled_fraction_lo")?,
         col_f("settled_fraction_hi")?,
     );
-    let (median, p90, res) = (
-        col_f("settling_revs_median_all_runs")?,
+    let (median, median_lo, median_hi, rmst, rmst_lo, rmst_hi) = (
+        col_f("settling_revs_median_km")?,
+        col_f("settling_revs_median_km_lo")?,
+        col_f("settling_revs_median_km_hi")?,
+        col_f("settling_revs_rmst")?,
+        col_f("settling_revs_rmst_lo")?,
+        col_f("settling_revs_rmst_hi")?,
+    );
+    let (p90, res) = (
         col_f("settling_revs_p90_all_runs")?,
         col_f("residual_rel_median")?,
     );
+    let (verdict, share, share_lo, share_hi, p_holm) = (
+        col_s("vs_best_verdict")?,
+        col_f("vs_best_sooner_share")?,
+        col_f("vs_best_sooner_share_lo")?,
+        col_f("vs_best_sooner_share_hi")?,
+        col_f("vs_best_p_holm")?,
+    );
+    let key = |i: usize| {
+        (
+            median[i].unwrap_or(f64::INFINITY),
+            rmst[i].unwrap_or(f64::INFINITY),
+        )
+    };
     let mut order: Vec<usize> = (0..summary.height()).collect();
-    order.sort_by(|&a, &b| match (median[a], median[b]) {
-        (Some(x), Some(y)) => x.total_cmp(&y),
-        (Some(_), None) => std::cmp::Ordering::Less,
-        (None, Some(_)) => std::cmp::Ordering::Greater,
-        (None, None) => a.cmp(&b),
+    order.sort_by(|&a, &b| {
+        let (ka, kb) = (key(a), key(b));
+        ka.0.total_cmp(&kb.0)
+            .then(ka.1.total_cmp(&kb.1))
+            .then(a.cmp(&b))
     });
+    // The summary picks the best design by the same key; show that one first.
+    if let Some(pos) = order
+        .iter()
+        .position(|&i| verdict[i].as_deref() == Some("best"))
+    {
+        let best = order.remove(pos);
+        order.insert(0, best);
+    }
     let f =
         |v: Option<f64>, digits: usize| v.map_or("–".to_string(), |x| format!("{x:.digits$}"));
+    let bound = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+    let pct = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{:.0}", 100.0 * x));
     let rows: Vec<Vec<String>> = order
         .iter()
         .enumerate()
         .map(|(rank, &i)| {
+            let versus = match verdict[i].as_deref() {
+                Some("best") => "best".to_string(),
+                Some("only_design") | None => "–".to_string(),
+                Some(_) if share[i].is_some() => format!(
+                    "{} % [{}, {}], p {}",
+                    pct(share[i]),
+                    pct(share_lo[i]),
+                    pct(share_hi[i]),
+                    p_text(p_holm[i])
+                ),
+                Some(_) => format!("log-rank p {}", p_text(p_holm[i])),
+            };
             vec![
                 (rank + 1).to_string(),
                 kind[i].clone(),
@@ -238,12 +287,28 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
                 f(rho[i], 4),
                 f(drag[i], 3),
                 format!("{} [{}, {}]", f(frac[i], 3), f(lo[i], 2), f(hi[i], 2)),
-                f(median[i], 1),
+                match median[i] {
+                    Some(m) => format!("{m:.1} [{}, {}]", bound(median_lo[i]), bound(median_hi[i])),
+                    None => "beyond the run".to_string(),
+                },
+                format!(
+                    "{} [{}, {}]",
+                    f(rmst[i], 1),
+                    f(rmst_lo[i], 1),
+                    f(rmst_hi[i], 1)
+                ),
                 f(p90[i], 1),
                 f(res[i], 4),
+                versus,
             ]
         })
         .collect();
+    let per_design = runs.iter().flatten().max().copied().unwrap_or(0);
+    let alpha = col_f("vs_best_alpha")?
+        .first()
+        .copied()
+        .flatten()
+        .unwrap_or(f64::NAN);
     Ok(text_table(
         &[
             "rank",
@@ -252,13 +317,89 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             "ρ",
             "β",
             "settled [95% CI]",
-            "t_s median (all runs)",
-            "t_s p90 (all runs)",
+            "t_s median [95% CI]",
+            "t_s restricted mean [95% CI]",
+            "t_s p90",
             "residual/A_ref",
+            "best sooner in (paired runs) [95% CI], Holm p",
         ],
         &rows,
-    ) + "(settling times in revolutions; median and p90 over all runs, unsettled ones counting as later than any settled, – when that quantile lies beyond the run; residual: median RMS vibration over the last hold window)\n"
+    ) + "(settling times in revolutions over every run, a run that did not settle counting as censored: Kaplan–Meier median with its Brookmeyer–Crowley interval (∞: not bounded within the run), restricted mean up to the horizon, p90; residual: median RMS vibration over the last hold window relative to A_ref)\n"
+        + &verdict_line(summary, &order, alpha, per_design)?
         + &contact_line(summary)?)
+}
+
+/// A p-value as printed: never below what its precision can tell.
+fn p_text(p: Option<f64>) -> String {
+    match p {
+        None => "–".to_string(),
+        Some(p) if p < 1e-4 => "< 0.0001".to_string(),
+        Some(p) => format!("{p:.4}"),
+    }
+}
+
+/// The sentence under the ranking: which design is fastest, against how
+/// many others that holds at α, and which it cannot be told apart from.
+fn verdict_line(
+    summary: &DataFrame,
+    order: &[usize],
+    alpha: f64,
+    per_design: u64,
+) -> Result<String, UserError> {
+    let verdict: Vec<Option<String>> = summary
+        .column("vs_best_verdict")?
+        .str()?
+        .iter()
+        .map(|s| s.map(str::to_string))
+        .collect();
+    let test: Vec<Option<String>> = summary
+        .column("vs_best_test")?
+        .str()?
+        .iter()
+        .map(|s| s.map(str::to_string))
+        .collect();
+    let Some(&best) = order.first() else {
+        return Ok(String::new());
+    };
+    if verdict[best].as_deref() != Some("best") {
+        return Ok(String::new());
+    }
+    let count = |name: &str| {
+        verdict
+            .iter()
+            .filter(|v| v.as_deref() == Some(name))
+            .count()
+    };
+    let rank_of = |names: &[&str]| -> Vec<String> {
+        order
+            .iter()
+            .enumerate()
+            .filter(|(_, i)| names.contains(&verdict[**i].as_deref().unwrap_or("")))
+            .map(|(r, _)| format!("#{}", r + 1))
+            .collect()
+    };
+    let how = if test.iter().flatten().any(|t| t == "sign") {
+        "sign test on runs paired by their shared samples"
+    } else {
+        "log-rank test: the designs did not share samples"
+    };
+    let mut line = format!(
+        "verdict: #1 settles sooner than {} of the other {} designs ({how}, Holm-adjusted at α = {alpha}, {per_design} runs per design)",
+        count("best_sooner"),
+        order.len() - 1
+    );
+    let unclear = rank_of(&["not_distinguishable"]);
+    if !unclear.is_empty() {
+        line += &format!("; not distinguishable from {}", unclear.join(", "));
+    }
+    let reversed = rank_of(&["other_sooner"]);
+    if !reversed.is_empty() {
+        line += &format!(
+            "; {} settle sooner in more paired runs although their median is higher",
+            reversed.join(", ")
+        );
+    }
+    Ok(line + "\n")
 }
 
 /// Whether the weights were solid, said under every ranking: a study that
