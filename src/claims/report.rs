@@ -22,12 +22,12 @@ fn ci(v: (Option<f64>, Option<f64>)) -> String {
     format!("[{}, {}]", end(v.0), end(v.1))
 }
 
-/// A p-value as printed.
+/// A p-value as printed: "p = 0.0123" or "p < 0.0001".
 fn p_text(p: f64) -> String {
     if p < 1e-4 {
-        "< 0.0001".into()
+        "p < 0.0001".into()
     } else {
-        format!("{p:.4}")
+        format!("p = {p:.4}")
     }
 }
 
@@ -65,7 +65,7 @@ fn paired_effect(c: &Comparison, a: &str, b: &str) -> String {
         }
     };
     format!(
-        "{a} settles sooner than {b} in {:.0} % [{:.0}, {:.0}] of {} paired runs ({b} sooner in {:.0} %, ties {:.0} %), median {} rev sooner [{}, {}]",
+        "{a} settle sooner than {b} in {:.0} % [{:.0}, {:.0}] of {} paired runs ({b} sooner in {:.0} %, ties {:.0} %), median {} rev sooner [{}, {}]",
         100.0 * p.a_sooner_share,
         100.0 * p.a_sooner_share_interval.0,
         100.0 * p.a_sooner_share_interval.1,
@@ -204,7 +204,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         s,
         "## Claim 2: three or more weights re-balance much faster than two after a 90° shift\n"
     );
-    s.push_str("Start: the weights at the position that balanced an unbalance of the same magnitude turned by 90°, the rotor in the locked steady state of the new unbalance (so that settling measures the weights, not the support's start-up transient).\n\n");
+    s.push_str("Start: the weights at the position that balanced an unbalance of the same magnitude turned by 90°, the rotor in the locked steady state of the new unbalance (so that settling measures the weights, not the support's start-up transient). Verdicts compare three with two weights on runs that met the same unbalance (sign test at α); \"confirmed\" needs three weights to settle sooner in at least 75 % of the pairs.\n\n");
     for norm in Normalisation::ALL {
         let rows: Vec<&DesignResult> = out
             .shift
@@ -225,7 +225,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
             let share = c.paired.as_ref().map_or(0.5, |x| x.a_sooner_share);
             let _ = writeln!(
                 s,
-                "\n{}; sign test p = {} (α = {alpha}). {}\n",
+                "\n{}; sign test {} (α = {alpha}). {}\n",
                 paired_effect(&c, "three weights", "two"),
                 p_text(p),
                 match (clear, c.a_is_sooner()) {
@@ -288,7 +288,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
                     .filter(|(_, _, x)| *x != Verdict::BestSooner)
                     .map(|(c, p, _)| {
                         format!(
-                            "{} {kind}s ({}; Holm p = {})",
+                            "{} {kind}s ({}; Holm-adjusted {})",
                             n_of(c.b),
                             paired_effect(c, &format!("{paper_n}"), &n_of(c.b).to_string()),
                             p_text(*p)
@@ -312,15 +312,15 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
                             paired_effect(c, &format!("{best_n} {kind}s"), &format!("{paper_n}"));
                         match x {
                             Verdict::BestSooner => format!(
-                                "Contradicted: {best_n} {kind}s settle fastest: {effect}; Holm p = {} ({family}).",
+                                "Contradicted: {best_n} {kind}s settle fastest: {effect}; Holm-adjusted {} ({family}).",
                                 p_text(*p)
                             ),
                             Verdict::NotDistinguishable => format!(
-                                "Not distinguishable: {best_n} {kind}s have the lowest median, but {effect}; Holm p = {} ({family}).",
+                                "Not distinguishable: {best_n} {kind}s have the lowest median, but {effect}; Holm-adjusted {} ({family}).",
                                 p_text(*p)
                             ),
                             Verdict::OtherSooner => format!(
-                                "Mixed: {best_n} {kind}s have the lowest median, yet {paper_n} {kind}s settle sooner in more paired runs: {effect}; Holm p = {} ({family}).",
+                                "Mixed: {best_n} {kind}s have the lowest median, yet {paper_n} {kind}s settle sooner in more paired runs: {effect}; Holm-adjusted {} ({family}).",
                                 p_text(*p)
                             ),
                         }

@@ -8,12 +8,14 @@
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
+//! - [`compare_designs`]: two designs of one or two results folders (`study compare`).
 //! - [`merge`]: combining shard outputs.
 //! - [`io`]: Parquet with provenance, atomic writes.
 //! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
 //! - [`stability_map`]: linear stability over (speed, unbalance).
 
 pub mod aggregate;
+pub mod compare_designs;
 pub mod config;
 pub mod io;
 pub mod lock;

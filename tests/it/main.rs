@@ -6,6 +6,7 @@ mod check;
 mod claims;
 mod cli_design;
 mod cli_simulate;
+mod compare;
 mod contact;
 mod convergence;
 mod design_capacity;

@@ -6,6 +6,7 @@ mod bench;
 mod bench_cmd;
 mod check_cmd;
 mod claims_cmd;
+mod compare_cmd;
 mod criterion_cmd;
 mod design_cmd;
 mod linear_cmd;
@@ -52,6 +53,9 @@ enum Command {
     /// Optimise weight count, radius (and drag) for an analytic or simulated objective.
     #[command(after_help = optimize_cmd::EXAMPLES)]
     Optimize(optimize_cmd::OptimizeArgs),
+    /// Compare two designs (of one results folder or two): paired when they met the same unbalances.
+    #[command(after_help = compare_cmd::EXAMPLES)]
+    Compare(compare_cmd::CompareArgs),
     /// Put seed 000's design claims to a virtual experiment and write a report.
     #[command(after_help = claims_cmd::EXAMPLES)]
     Claims(claims_cmd::ClaimsArgs),
@@ -113,6 +117,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Optimize(args) => optimize_cmd::run(&args),
         Command::Claims(args) => claims_cmd::run(&args),
+        Command::Compare(args) => compare_cmd::run(&args),
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),

@@ -64,3 +64,12 @@ pub fn text_table(header: &[&str], rows: &[Vec<String>]) -> String {
     }
     out
 }
+
+/// A p-value as printed: four decimals, or "< 0.0001" below what they show.
+pub fn p_value_text(p: f64) -> String {
+    if p < 1e-4 {
+        "< 0.0001".to_string()
+    } else {
+        format!("{p:.4}")
+    }
+}

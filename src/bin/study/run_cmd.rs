@@ -1,7 +1,7 @@
 //! `study run` and `study merge`: the Monte Carlo study runner.
 
 use crate::UserError;
-use crate::output::text_table;
+use crate::output::{p_value_text, text_table};
 use autobal::metrics::Outcome;
 use autobal::study::config::load;
 use autobal::study::merge::merge;
@@ -329,13 +329,9 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
         + &contact_line(summary)?)
 }
 
-/// A p-value as printed: never below what its precision can tell.
+/// An optional p-value as printed.
 fn p_text(p: Option<f64>) -> String {
-    match p {
-        None => "–".to_string(),
-        Some(p) if p < 1e-4 => "< 0.0001".to_string(),
-        Some(p) => format!("{p:.4}"),
-    }
+    p.map_or("–".to_string(), p_value_text)
 }
 
 /// The sentence under the ranking: which design is fastest, against how

@@ -1,0 +1,188 @@
+//! `study compare`: two designs side by side, paired when they met the same
+//! unbalances, with a verdict at a stated α.
+
+use crate::UserError;
+use crate::output::{p_value_text, text_table};
+use autobal::study::compare_designs::{Side, compare_sides, median_with_interval};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study compare --help`.
+pub const EXAMPLES: &str = "Examples:
+  study compare results/three_balls --designs 0,7       two designs of one study
+  study compare results/a results/b                     the only design of each folder
+  study compare results/a results/b --designs 2,0       design 2 of a against design 0 of b";
+
+/// Arguments of `study compare`.
+#[derive(Args)]
+pub struct CompareArgs {
+    /// One results folder (two of its designs) or two (one design of each).
+    #[arg(required = true, num_args = 1..=2)]
+    folders: Vec<PathBuf>,
+    /// Design ids A,B (with one folder: required; with two: when a folder holds several designs).
+    #[arg(long, value_delimiter = ',')]
+    designs: Option<Vec<u32>>,
+    /// Significance level of the verdict.
+    #[arg(long, default_value_t = 0.05)]
+    alpha: f64,
+}
+
+/// "= 0.0123" or "< 0.0001".
+fn p_eq(p: f64) -> String {
+    let text = p_value_text(p);
+    if text.starts_with('<') {
+        text
+    } else {
+        format!("= {text}")
+    }
+}
+
+/// Run `study compare`.
+pub fn run(args: &CompareArgs) -> Result<(), UserError> {
+    if !(args.alpha > 0.0 && args.alpha <= 0.5) {
+        return Err(UserError(
+            format!(
+                "--alpha {}: a significance level in (0, 0.5], e.g. 0.05",
+                args.alpha
+            ),
+            2,
+        ));
+    }
+    let (dir_a, dir_b) = match args.folders.as_slice() {
+        [one] => (one, one),
+        [a, b] => (a, b),
+        _ => unreachable!("clap takes one or two folders"),
+    };
+    let (design_a, design_b) = match (&args.designs, args.folders.len()) {
+        (Some(d), _) if d.len() != 2 => {
+            return Err(UserError(
+                format!(
+                    "--designs: two design ids A,B are needed, {} given",
+                    d.len()
+                ),
+                2,
+            ));
+        }
+        (Some(d), _) => (Some(d[0]), Some(d[1])),
+        (None, 1) => {
+            return Err(UserError(
+                "one folder: say which two of its designs to compare with --designs A,B".into(),
+                2,
+            ));
+        }
+        (None, _) => (None, None),
+    };
+    let a = Side::load(dir_a, design_a)?;
+    let b = Side::load(dir_b, design_b)?;
+    let result = compare_sides(&a, &b, 0);
+    let c = &result.comparison;
+    let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |x| format!("{x:.d$}"));
+    let end = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+    let column = |side: &Side| -> Vec<String> {
+        let (settled, runs, (lo, hi)) = side.settled();
+        let km = side.kaplan_meier();
+        let (median, (m_lo, m_hi)) = km
+            .as_ref()
+            .map_or((None, (None, None)), median_with_interval);
+        let rmst = km.map(|k| k.restricted_mean(side.horizon));
+        let residual_values: Vec<f64> = side.runs.residual.iter().flatten().copied().collect();
+        let residual = autobal::stats::quantile::median(&residual_values);
+        vec![
+            side.label.clone(),
+            format!("{runs}"),
+            format!(
+                "{:.3} [{lo:.2}, {hi:.2}]",
+                settled as f64 / runs.max(1) as f64
+            ),
+            match median {
+                Some(m) => format!("{m:.1} [{}, {}]", end(m_lo), end(m_hi)),
+                None => "beyond the run".into(),
+            },
+            rmst.map_or("–".into(), |r| {
+                let i = r.interval(0.95);
+                format!(
+                    "{:.1} [{:.1}, {:.1}]",
+                    r.estimate,
+                    i.lower.max(0.0),
+                    i.upper
+                )
+            }),
+            f(residual, 4),
+            side.dir.display().to_string(),
+        ]
+    };
+    let (ca, cb) = (column(&a), column(&b));
+    let names = [
+        "design",
+        "runs",
+        "settled [95% CI]",
+        "t_s median, Kaplan–Meier [95% CI] (rev)",
+        "t_s restricted mean [95% CI] (rev)",
+        "residual/A_ref, median",
+        "folder",
+    ];
+    let rows: Vec<Vec<String>> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| vec![n.to_string(), ca[i].clone(), cb[i].clone()])
+        .collect();
+    print!("{}", text_table(&["", "A", "B"], &rows));
+    let p = c.p_value();
+    let rev = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.1}")
+        } else {
+            "∞".into()
+        }
+    };
+    match (&c.paired, &result.unpaired_because) {
+        (Some(pair), _) => {
+            println!(
+                "paired on {} samples that met the same unbalances: A settles sooner in {:.0} % [{:.0}, {:.0}], B in {:.0} %, ties {:.0} %",
+                pair.n,
+                100.0 * pair.a_sooner_share,
+                100.0 * pair.a_sooner_share_interval.0,
+                100.0 * pair.a_sooner_share_interval.1,
+                100.0 * pair.b_sooner as f64 / pair.n as f64,
+                100.0 * pair.ties as f64 / pair.n as f64
+            );
+            println!(
+                "paired difference t_B − t_A: median {} rev [{}, {}] (∞: B did not settle in half the pairs or more); sign test p {}",
+                rev(pair.median_difference),
+                rev(pair.median_difference_interval.0),
+                rev(pair.median_difference_interval.1),
+                p_eq(pair.sign_test_p)
+            );
+            if let (Some(w), Some((ratio, (lo, hi)))) = (&c.residual_test, c.residual_ratio) {
+                println!(
+                    "residual vibration: median ratio A/B {ratio:.3} [{lo:.3}, {hi:.3}], Wilcoxon signed-rank p {} ({} pairs)",
+                    p_eq(w.p_value),
+                    w.n
+                );
+            }
+        }
+        (None, Some(why)) => {
+            println!("not paired: {why}");
+            match &c.unpaired {
+                Some(lr) => println!(
+                    "log-rank test: χ² = {:.3}, p {} (A settled {:.0} times, {:.1} expected if both settle alike)",
+                    lr.chi_squared,
+                    p_eq(lr.p_value),
+                    lr.observed_a,
+                    lr.expected_a
+                ),
+                None => println!("log-rank test: no run settled in either design"),
+            }
+        }
+        (None, None) => println!("nothing to compare: no runs"),
+    }
+    let verdict = if p > args.alpha {
+        format!("not distinguishable at α = {}", args.alpha)
+    } else if c.a_is_sooner() {
+        format!("A settles sooner than B (α = {})", args.alpha)
+    } else {
+        format!("B settles sooner than A (α = {})", args.alpha)
+    };
+    println!("verdict: {verdict}");
+    Ok(())
+}

@@ -1,0 +1,170 @@
+//! `study compare`: two designs, from one results folder or two, compared on
+//! paired runs when they met the same sampled unbalances, unpaired (log-rank)
+//! otherwise, with the reason pairing was refused.
+
+use super::config::{StudyFile, StudyPlan};
+use super::io::read_parquet;
+use super::verdict::{Comparison, DesignRuns, compare, design_runs, settling_horizon};
+use crate::stats::interval::wilson_interval;
+use crate::stats::survival::{KaplanMeier, Transform};
+use polars::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Why two designs cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// The folder holds no finished study.
+    #[error("{0}: no finished study here (runs.parquet and study.toml are needed)")]
+    NotAStudy(String),
+    /// The design is not in the folder.
+    #[error("{folder}: no design {design} (it holds designs {available})")]
+    NoSuchDesign {
+        /// The folder.
+        folder: String,
+        /// The design asked for.
+        design: u32,
+        /// What is there.
+        available: String,
+    },
+    /// The folder holds several designs and none was named.
+    #[error("{0}: holds {1} designs; say which with --designs A,B")]
+    WhichDesign(String, usize),
+    /// The study text stored in the folder is invalid.
+    #[error("{0}: {1}")]
+    BadStudy(String, String),
+    /// Reading failed.
+    #[error("{0}")]
+    Polars(#[from] PolarsError),
+}
+
+/// One side of a comparison: a design's runs and where they came from.
+#[derive(Debug, Clone)]
+pub struct Side {
+    /// The results folder.
+    pub dir: PathBuf,
+    /// A short description: kind, n, ρ, β.
+    pub label: String,
+    /// Its runs, in sample order.
+    pub runs: DesignRuns,
+    /// Latest settling time its runs can show (revolutions).
+    pub horizon: f64,
+    /// Sampled unbalance (fraction of capacity) and direction of each run.
+    draws: Vec<(Option<f64>, Option<f64>)>,
+}
+
+impl Side {
+    /// Load design `design` of the study in `dir` (`None`: its only design).
+    pub fn load(dir: &Path, design: Option<u32>) -> Result<Side, CompareError> {
+        let shown = dir.display().to_string();
+        let text = std::fs::read_to_string(dir.join("study.toml"))
+            .map_err(|_| CompareError::NotAStudy(shown.clone()))?;
+        let runs_path = dir.join("runs.parquet");
+        if !runs_path.exists() {
+            return Err(CompareError::NotAStudy(shown));
+        }
+        let plan: StudyPlan = StudyFile::parse(&text, &shown)
+            .and_then(|f| f.plan(&text, &shown))
+            .map_err(|e| CompareError::BadStudy(shown.clone(), e.to_string()))?;
+        let id = match design {
+            Some(id) => id,
+            None if plan.designs.len() == 1 => plan.designs[0].id,
+            None => return Err(CompareError::WhichDesign(shown, plan.designs.len())),
+        };
+        let Some(d) = plan.designs.iter().find(|d| d.id == id) else {
+            return Err(CompareError::NoSuchDesign {
+                folder: shown,
+                design: id,
+                available: format!("0..={}", plan.designs.len().saturating_sub(1)),
+            });
+        };
+        let df = read_parquet(&runs_path)?;
+        let mine = df.filter(&df.column("design_id")?.u32()?.equal(id))?;
+        let mine = mine.sort(["sample_id"], SortMultipleOptions::default())?;
+        let horizon = settling_horizon(&plan);
+        let runs = design_runs(&mine, horizon)?
+            .into_iter()
+            .next()
+            .ok_or_else(|| CompareError::NotAStudy(format!("{shown} (design {id} has no runs)")))?;
+        let fraction = mine.column("unbalance_fraction")?.f64()?;
+        let direction = mine.column("direction_deg")?.f64()?;
+        Ok(Side {
+            dir: dir.to_path_buf(),
+            label: format!(
+                "{} n={} ρ={:.4} β={}",
+                d.spec.kind.name(),
+                d.spec.n,
+                d.rho,
+                d.spec.drag
+            ),
+            runs,
+            horizon,
+            draws: fraction.iter().zip(direction.iter()).collect(),
+        })
+    }
+
+    /// Kaplan–Meier estimate of the side's settling.
+    pub fn kaplan_meier(&self) -> Option<KaplanMeier> {
+        self.runs.kaplan_meier()
+    }
+
+    /// Settled runs, runs, and the Wilson 95 % interval of the fraction.
+    pub fn settled(&self) -> (u64, u64, (f64, f64)) {
+        let settled = self.runs.settling.iter().filter(|o| o.settled).count() as u64;
+        let runs = self.runs.settling.len() as u64;
+        (settled, runs, wilson_interval(settled, runs))
+    }
+}
+
+/// Why the runs of two sides cannot be paired, if they cannot: pairs must
+/// be the same samples and have met the same unbalance (fraction of
+/// capacity) from the same direction.
+pub fn pairing_refusal(a: &Side, b: &Side) -> Option<String> {
+    if a.runs.sample_ids != b.runs.sample_ids {
+        return Some(format!(
+            "the designs have different samples ({} runs against {})",
+            a.runs.sample_ids.len(),
+            b.runs.sample_ids.len()
+        ));
+    }
+    let differ = a
+        .draws
+        .iter()
+        .zip(&b.draws)
+        .zip(&a.runs.sample_ids)
+        .find(|((x, y), _)| x != y);
+    differ.map(|(((fa, da), (fb, db)), sample)| {
+        format!(
+            "sample {sample} met a different unbalance (fraction {:.4} at {:.1}° against {:.4} at {:.1}°): the runs were drawn from different streams (another seed, or common_random_numbers = false)",
+            fa.unwrap_or(f64::NAN),
+            da.unwrap_or(f64::NAN),
+            fb.unwrap_or(f64::NAN),
+            db.unwrap_or(f64::NAN)
+        )
+    })
+}
+
+/// A compared pair: the comparison, and why it is unpaired if it is.
+#[derive(Debug, Clone)]
+pub struct DesignComparison {
+    /// A against B.
+    pub comparison: Comparison,
+    /// Why the runs were not paired (`None`: paired).
+    pub unpaired_because: Option<String>,
+}
+
+/// Compare side A with side B (paired when [`pairing_refusal`] allows).
+pub fn compare_sides(a: &Side, b: &Side, seed: u64) -> DesignComparison {
+    let refusal = pairing_refusal(a, b);
+    DesignComparison {
+        comparison: compare(&a.runs, &b.runs, refusal.is_none(), seed),
+        unpaired_because: refusal,
+    }
+}
+
+/// The Kaplan–Meier median of a side with its 95 % log-log interval.
+pub fn median_with_interval(km: &KaplanMeier) -> (Option<f64>, (Option<f64>, Option<f64>)) {
+    (
+        km.median(),
+        km.median_interval(super::verdict::LEVEL, Transform::LogLog),
+    )
+}

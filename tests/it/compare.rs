@@ -1,0 +1,103 @@
+//! `study compare`: paired when the designs met the same unbalances,
+//! refused pairing (with the reason) and a log-rank test when they did not.
+
+use autobal::study::config::StudyFile;
+use autobal::study::run::{NoProgress, RunOptions, run_study};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A two-design study (β = 10 and 50) run into `out` with `seed`.
+fn run(out: &Path, seed: u64) -> PathBuf {
+    let text = format!(
+        r#"
+name = "pair"
+seed = {seed}
+output = "{}"
+
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+
+[scene.speed]
+mode = "constant"
+omega = 300.0
+
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.05
+drag = [10.0, 50.0]
+
+[sampling]
+samples = 24
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+
+[metrics]
+t_end_revs = 800
+"#,
+        out.display()
+    );
+    let plan = StudyFile::parse(&text, "pair.toml")
+        .and_then(|f| f.plan(&text, "pair.toml"))
+        .unwrap();
+    run_study(&plan, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .dir
+}
+
+fn compare(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg("compare")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn designs_of_one_study_are_paired_and_foreign_samples_are_not() {
+    let tmp = tempfile::tempdir().unwrap();
+    let a = run(&tmp.path().join("a"), 7);
+    let b = run(&tmp.path().join("b"), 8);
+    let (a_s, b_s) = (a.to_str().unwrap(), b.to_str().unwrap());
+
+    // Two designs of one study met the same unbalances: paired.
+    let out = compare(&[a_s, "--designs", "0,1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("paired on 24 samples"), "{text}");
+    // β = 10 settles sooner than β = 50 on every shared sample (the golden
+    // study shows the same ordering at 800 revolutions).
+    assert!(text.contains("A settles sooner in 100 %"), "{text}");
+    assert!(text.contains("verdict: A settles sooner than B"), "{text}");
+
+    // The same design in two studies of different seeds: the samples differ,
+    // so pairing is refused with the reason and the log-rank test is used.
+    let out = compare(&[a_s, b_s, "--designs", "0,0"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("not paired: sample 0 met a different unbalance"),
+        "{text}"
+    );
+    assert!(text.contains("log-rank test"), "{text}");
+    // The same design under two seeds should not be told apart.
+    assert!(text.contains("verdict: not distinguishable"), "{text}");
+
+    // Bad input: exit 2 with a sentence naming what is wrong.
+    let out = compare(&[a_s]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--designs"));
+    let out = compare(&[a_s, "--designs", "0,9"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no design 9"));
+    let out = compare(&[tmp.path().to_str().unwrap(), "--designs", "0,1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no finished study"));
+    let out = compare(&[a_s, "--designs", "0,1", "--alpha", "2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--alpha"));
+}
