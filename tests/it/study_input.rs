@@ -221,6 +221,18 @@ fn plans_too_large_to_run_are_refused_before_anything_is_written() {
 }
 
 #[test]
+fn a_significance_level_outside_its_range_is_refused() {
+    rejects(
+        |t| format!("{t}\n[statistics]\nalpha = 2\n"),
+        &["statistics.alpha", "2", "(0, 0.5]"],
+    );
+    rejects(
+        |t| format!("{t}\n[statistics]\nalpha = 0\n"),
+        &["statistics.alpha", "0", "(0, 0.5]"],
+    );
+}
+
+#[test]
 fn zero_threads_is_refused_and_too_many_are_capped() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
