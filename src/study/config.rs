@@ -203,6 +203,31 @@ pub struct Sampling {
     /// by every design (common random numbers), so design differences are not noise.
     #[serde(default = "yes")]
     pub common_random_numbers: bool,
+    /// Sample until this precision is reached (`samples` is then the cap),
+    /// in batches of `batch` samples per design (docs/statistics.md).
+    #[serde(default)]
+    pub stop_when: Option<StopWhen>,
+    /// Samples per design in each batch of adaptive sampling.
+    #[serde(default = "default_batch")]
+    pub batch: u32,
+}
+
+fn default_batch() -> u32 {
+    100
+}
+
+/// The precision adaptive sampling stops at: every key given must hold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StopWhen {
+    /// Half-width of every design's 95 % interval of the Kaplan–Meier median
+    /// settling time, relative to the median (e.g. 0.05 for ±5 %).
+    #[serde(default)]
+    pub median_halfwidth_rel: Option<f64>,
+    /// Half-width of every 95 % interval of the share of paired runs in
+    /// which the best design settles sooner than another (e.g. 0.03).
+    #[serde(default, alias = "win_probability_halfwidth")]
+    pub win_share_halfwidth: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -450,6 +475,37 @@ impl StudyFile {
                 "0".into(),
                 "need at least one sample per design",
             ));
+        }
+        if s.batch == 0 {
+            return Err(invalid(
+                "sampling.batch",
+                "0".into(),
+                "a batch holds at least one sample per design",
+            ));
+        }
+        if let Some(stop) = &s.stop_when {
+            let keys = [
+                ("median_halfwidth_rel", stop.median_halfwidth_rel),
+                ("win_share_halfwidth", stop.win_share_halfwidth),
+            ];
+            if keys.iter().all(|(_, v)| v.is_none()) {
+                return Err(invalid(
+                    "sampling.stop_when",
+                    "{}".into(),
+                    "name a precision: median_halfwidth_rel or win_share_halfwidth",
+                ));
+            }
+            for (key, value) in keys {
+                if let Some(v) = value
+                    && !(v > 0.0 && v < 1.0)
+                {
+                    return Err(invalid(
+                        &format!("sampling.stop_when.{key}"),
+                        v.to_string(),
+                        "a half-width in (0, 1), e.g. 0.05",
+                    ));
+                }
+            }
         }
         check_distribution(&s.unbalance.distribution)
             .map_err(|(k, v, r)| invalid(&format!("sampling.unbalance.{k}"), v, r))?;

@@ -145,5 +145,6 @@ pub fn merge(
         runs,
         summary: Some(summary),
         executed: 0,
+        adaptive: None,
     })
 }

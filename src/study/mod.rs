@@ -3,6 +3,7 @@
 //!
 //! - [`config`]: the study file schema, validation and the resolved plan.
 //! - [`sample`]: per-run random streams and draws.
+//! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
 //! - [`record`]: one row of `runs.parquet`.
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
@@ -14,6 +15,7 @@
 //! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
 //! - [`stability_map`]: linear stability over (speed, unbalance).
 
+pub mod adaptive;
 pub mod aggregate;
 pub mod compare_designs;
 pub mod config;

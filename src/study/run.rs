@@ -6,16 +6,17 @@
 //! are bit-identical (but for the wall-time column) for any thread count,
 //! any interruption and resumption, and any sharding followed by a merge.
 
+use super::adaptive::{Precision, batch_ids, batches, precision};
 use super::aggregate::summarize_table;
 use super::config::{Design, StudyPlan};
 use super::io::{Provenance, read_parquet, sha256_hex, write_parquet, write_text};
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
-use super::runs_file::{Piece, read_summary_columns, write_runs};
+use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
 use super::sample::draw_sample;
 use crate::metrics::{Outcome, RunMetrics};
 use crate::simulation::Simulation;
-use polars::prelude::{DataFrame, PolarsError, PolarsResult};
+use polars::prelude::{ChunkCompareIneq, DataFrame, PolarsError, PolarsResult};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -123,6 +124,19 @@ pub struct StudyOutput {
     pub summary: Option<DataFrame>,
     /// Runs executed in this invocation (the rest came from a resumed run).
     pub executed: u64,
+    /// Where adaptive sampling stopped (studies with `stop_when`).
+    pub adaptive: Option<AdaptiveOutcome>,
+}
+
+/// Where adaptive sampling stopped, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveOutcome {
+    /// Batches run.
+    pub batches: usize,
+    /// Samples per design when it stopped.
+    pub samples_per_design: u32,
+    /// The precision then (not reached: the cap `samples` was).
+    pub precision: Precision,
 }
 
 impl StudyOutput {
@@ -183,6 +197,11 @@ pub enum RunError {
     /// Another process is writing the folder.
     #[error(transparent)]
     Locked(#[from] LockError),
+    /// Adaptive sampling decides on all designs' runs, which a shard lacks.
+    #[error(
+        "sampling.stop_when cannot be used with --shard: the stopping decision needs every run of a batch; run the study unsharded (or set a fixed sample count)"
+    )]
+    AdaptiveSharded,
     /// Stopped on request; what finished is saved.
     #[error(
         "interrupted: {saved} runs of this invocation are saved in {path}; continue with --resume"
@@ -215,6 +234,7 @@ impl RunError {
                 | RunError::NoPlan { .. }
                 | RunError::PlanChanged { .. }
                 | RunError::Locked(_)
+                | RunError::AdaptiveSharded
         )
     }
 }
@@ -401,34 +421,58 @@ pub fn run_study(
             }
         }
     };
-    let earlier_table = if runs_path.exists() {
-        vec![Piece::open(&runs_path)?]
-    } else {
-        Vec::new()
-    };
+    let earlier_table = earlier_table_pieces(&runs_path)?;
     mark_done(&earlier_table, &mut done);
     mark_done(&chunk_pieces(&chunks)?, &mut done);
     let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
-    let pending: Vec<u64> = (0..total_ids)
-        .filter(in_slice)
-        .filter(|&id| !done[id as usize])
-        .collect();
-    let total = (0..total_ids).filter(in_slice).count() as u64;
-    progress.begin(total, total - pending.len() as u64);
-
-    let saved = execute(plan, &pending, options, &chunks, &provenance, progress)?;
-    if options
-        .cancel
-        .as_ref()
-        .is_some_and(|c| c.load(Ordering::Relaxed))
-    {
-        progress.end();
-        return Err(RunError::Interrupted {
-            path: dir.display().to_string(),
-            saved,
-        });
+    let stop_when = plan.file.sampling.stop_when.as_ref();
+    if stop_when.is_some() && options.shard.is_some() {
+        return Err(RunError::AdaptiveSharded);
     }
-    let executed = pending.len() as u64;
+    let total = (0..total_ids).filter(in_slice).count() as u64;
+    let already = done.iter().filter(|d| **d).count() as u64;
+    progress.begin(total, already);
+
+    let mut executed = 0;
+    let mut adaptive = None;
+    let batches = batches(plan);
+    for (k, range) in batches.iter().enumerate() {
+        let pending: Vec<u64> = batch_ids(plan, range)
+            .into_iter()
+            .filter(in_slice)
+            .filter(|&id| !done[id as usize])
+            .collect();
+        let saved = execute(plan, &pending, options, &chunks, &provenance, progress)?;
+        if options
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+        {
+            progress.end();
+            return Err(RunError::Interrupted {
+                path: dir.display().to_string(),
+                saved,
+            });
+        }
+        executed += pending.len() as u64;
+        if let Some(stop) = stop_when {
+            // Judge the batches so far on their own runs only.
+            let mut pieces = earlier_table_pieces(&runs_path)?;
+            pieces.extend(chunk_pieces(&chunks)?);
+            let so_far = read_pieces_summary_columns(&pieces)?;
+            let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
+            let reached = precision(plan, stop, &so_far.filter(&mask)?)?;
+            let stop_here = reached.reached || k + 1 == batches.len();
+            adaptive = Some(AdaptiveOutcome {
+                batches: k + 1,
+                samples_per_design: range.end,
+                precision: reached,
+            });
+            if stop_here {
+                break;
+            }
+        }
+    }
 
     // The earlier table first: on a duplicate (a crash between writing the
     // table and removing the chunks) its copy is kept.
@@ -450,6 +494,7 @@ pub fn run_study(
         runs: written,
         summary,
         executed,
+        adaptive,
     })
 }
 
@@ -545,6 +590,15 @@ fn execute(
         }
         flush(&mut buffer)?;
         Ok(saved)
+    })
+}
+
+/// The folder's finished table as a piece, if there is one.
+fn earlier_table_pieces(runs_path: &Path) -> Result<Vec<Piece>, RunError> {
+    Ok(if runs_path.exists() {
+        vec![Piece::open(runs_path)?]
+    } else {
+        Vec::new()
     })
 }
 

@@ -188,3 +188,19 @@ pub fn read_summary_columns(path: &Path) -> PolarsResult<DataFrame> {
         ))
         .finish()
 }
+
+/// The slim projection of several pieces, stacked (for decisions taken
+/// while a run is under way, before `runs.parquet` exists).
+pub fn read_pieces_summary_columns(pieces: &[Piece]) -> PolarsResult<DataFrame> {
+    let mut out: Option<DataFrame> = None;
+    for piece in pieces {
+        let df = read_summary_columns(piece.path())?;
+        match out.as_mut() {
+            Some(all) => {
+                all.vstack_mut(&df)?;
+            }
+            None => out = Some(df),
+        }
+    }
+    out.ok_or_else(|| PolarsError::NoData("no runs yet".into()))
+}

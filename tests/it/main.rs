@@ -1,5 +1,6 @@
 //! autobal's integration tests, linked into one binary to keep builds fast.
 
+mod adaptive;
 mod bad_input;
 mod bench;
 mod check;

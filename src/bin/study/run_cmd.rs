@@ -6,7 +6,7 @@ use autobal::metrics::Outcome;
 use autobal::study::config::load;
 use autobal::study::merge::merge;
 use autobal::study::record::RunRecord;
-use autobal::study::run::{Progress, RunError, RunOptions, Shard, run_study};
+use autobal::study::run::{AdaptiveOutcome, Progress, RunError, RunOptions, Shard, run_study};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use polars::prelude::DataFrame;
@@ -169,7 +169,12 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         }
     })?;
     match &output.summary {
-        Some(summary) => print!("{}", ranked_table(summary)?),
+        Some(summary) => {
+            print!("{}", ranked_table(summary)?);
+            if let Some(adaptive) = &output.adaptive {
+                println!("{}", adaptive_line(adaptive));
+            }
+        }
         None => println!(
             "shard {} done: {} runs in {} (merge the shards with `study merge`)",
             args.shard.map(|s| s.label()).unwrap_or_default(),
@@ -327,6 +332,35 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     ) + "(settling times in revolutions over every run, a run that did not settle counting as censored: Kaplan–Meier median with its Brookmeyer–Crowley interval (∞: not bounded within the run), restricted mean up to the horizon, p90; residual: median RMS vibration over the last hold window relative to A_ref)\n"
         + &verdict_line(summary, &order, alpha, per_design)?
         + &contact_line(summary)?)
+}
+
+/// Where adaptive sampling stopped: how many samples it took, and the
+/// precision then against the target.
+fn adaptive_line(adaptive: &AdaptiveOutcome) -> String {
+    let state: Vec<String> = adaptive
+        .precision
+        .worst
+        .iter()
+        .map(|(key, value, target)| {
+            let value = if value.is_finite() {
+                format!("{value:.3}")
+            } else {
+                "unbounded".to_string()
+            };
+            format!("{key} {value} (target {target})")
+        })
+        .collect();
+    let how = if adaptive.precision.reached {
+        "precision reached"
+    } else {
+        "precision NOT reached: stopped at the cap `samples`"
+    };
+    format!(
+        "adaptive sampling: {how} after {} batches, {} samples per design; {}",
+        adaptive.batches,
+        adaptive.samples_per_design,
+        state.join(", ")
+    )
 }
 
 /// An optional p-value as printed.
