@@ -12,10 +12,12 @@
 //! - [`baseline`]: the baseline folder (runs, summary, manifest with provenance).
 //! - [`samples`]: the per-design samples read from a runs table.
 //! - [`study`]: record a baseline from a run; check a fresh run against one.
+//! - [`plant`]: planted changes, to measure the check's false-alarm rate and power.
 //!
 //! `docs/regression-checks.md` explains the choices and the detectable drift.
 
 pub mod baseline;
 pub mod compare;
+pub mod plant;
 pub mod samples;
 pub mod study;

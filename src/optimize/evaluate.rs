@@ -10,6 +10,7 @@ use crate::stats::quantile::{Interpolation, quantile};
 use crate::study::config::{Design, StudyPlan};
 use crate::study::run::run_design_sample;
 use crate::study::sample::{Purpose, stream};
+use crate::study::verdict::settling_horizon;
 use rayon::prelude::*;
 
 /// A point of the design space.
@@ -130,7 +131,6 @@ impl Evaluator<'_> {
     /// random numbers), and are reduced in index order, so the estimate does
     /// not depend on the thread count.
     fn simulate(&self, design: &Design, objective: Objective) -> (f64, f64) {
-        let t_end = self.plan.file.metrics.t_end_revs;
         let metrics: Vec<_> = (0..u64::from(self.samples))
             .into_par_iter()
             .map(|k| run_design_sample(self.plan, design, k, k).metrics)
@@ -145,26 +145,31 @@ impl Evaluator<'_> {
             };
             (mean, (var / n).sqrt())
         };
-        // Runs that never settle count as the whole run: a censored, conservative value.
+        // A run that never settles counts as the horizon, the latest settling
+        // time a run can show: right-censored there, so the mean is the
+        // restricted mean and the quantiles are the Kaplan–Meier ones.
+        let horizon = settling_horizon(self.plan);
         let censored: Vec<f64> = metrics
             .iter()
-            .map(|m| m.settling_revs.unwrap_or(t_end))
+            .map(|m| m.settling_revs.unwrap_or(horizon).min(horizon))
             .collect();
+        let quantile_se = |q: f64| {
+            let at = move |v: &[f64]| {
+                quantile(v, q, Interpolation::Linear).expect("at least one sample")
+            };
+            (
+                at(&censored),
+                bootstrap::std_error(
+                    &censored,
+                    at,
+                    &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
+                ),
+            )
+        };
         match objective {
             Objective::SettlingMean => mean_se(&censored),
-            Objective::SettlingP90 => {
-                let p90 = |v: &[f64]| {
-                    quantile(v, 0.9, Interpolation::Linear).expect("at least one sample")
-                };
-                (
-                    p90(&censored),
-                    bootstrap::std_error(
-                        &censored,
-                        p90,
-                        &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
-                    ),
-                )
-            }
+            Objective::SettlingMedian => quantile_se(0.5),
+            Objective::SettlingP90 => quantile_se(0.9),
             Objective::SettledFraction => {
                 let p = metrics.iter().filter(|m| m.settled).count() as f64 / n;
                 (p, (p * (1.0 - p) / n).sqrt())

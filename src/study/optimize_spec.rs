@@ -11,9 +11,13 @@ pub enum Objective {
     Capacity,
     /// Analytic transient measure ã (eqs 15/16, maximised).
     ATilde,
-    /// Mean settling time in revolutions over a Monte Carlo sample (minimised;
-    /// runs that do not settle count as the full run length).
+    /// Restricted mean settling time in revolutions over a Monte Carlo sample
+    /// (minimised): a run that does not settle counts as the horizon
+    /// t_end − hold, as in the summary's `settling_revs_rmst`.
     SettlingMean,
+    /// Median settling time over every run (minimised; runs that do not
+    /// settle count as the horizon, which makes it the Kaplan–Meier median).
+    SettlingMedian,
     /// 90th percentile of the settling time in revolutions (minimised, same censoring).
     SettlingP90,
     /// Fraction of runs that settle (maximised).
@@ -42,6 +46,7 @@ impl Objective {
             Objective::Capacity => "capacity",
             Objective::ATilde => "a_tilde",
             Objective::SettlingMean => "settling_mean",
+            Objective::SettlingMedian => "settling_median",
             Objective::SettlingP90 => "settling_p90",
             Objective::SettledFraction => "settled_fraction",
             Objective::Residual => "residual",

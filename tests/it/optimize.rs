@@ -218,3 +218,49 @@ fn nelder_mead_searches_rho_and_drag_within_bounds() {
     );
     assert!(best.candidate.drag > 3.0, "drag {}", best.candidate.drag);
 }
+
+/// The optimiser's settling objectives and the study summary count every
+/// run alike: on the same samples, `settling_mean` is the summary's
+/// restricted mean and `settling_median` its Kaplan–Meier median (two code
+/// paths: order statistics of censored times, and the survival curve).
+#[test]
+fn settling_objectives_equal_the_summarys_censoring_aware_statistics() {
+    use autobal::study::run::{NoProgress, RunOptions, run_study};
+    let tmp = tempfile::tempdir().unwrap();
+    let value = |objective: &str| {
+        let p = plan(
+            tmp.path(),
+            "kind = \"ball\"\nn = 3\nrho = 0.3\ndrag = 0.15",
+            "samples = 15\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.9 }",
+            &format!("objective = \"{objective}\""),
+        );
+        let spec = p.file.optimize.clone().unwrap();
+        let ev = Evaluator {
+            plan: &p,
+            spec: &spec,
+            samples: 15,
+        };
+        let c = Candidate {
+            kind: Kind::Ball,
+            n: 3,
+            rho: p.designs[0].rho,
+            drag: 0.15,
+        };
+        (ev.evaluate(c, "test").value.unwrap(), p)
+    };
+    let (mean, p) = value("settling_mean");
+    let (median, _) = value("settling_median");
+    let summary = run_study(&p, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .summary
+        .unwrap();
+    let get = |name: &str| summary.column(name).unwrap().f64().unwrap().get(0);
+    let settled = get("settled_fraction").unwrap();
+    assert!(
+        settled < 1.0 && settled > 0.5,
+        "the case needs censored runs and a bounded median: settled {settled}"
+    );
+    let rmst = get("settling_revs_rmst").unwrap();
+    assert!((mean - rmst).abs() <= 1e-9 * rmst, "{mean} vs {rmst}");
+    assert_eq!(Some(median), get("settling_revs_median_km"));
+}
