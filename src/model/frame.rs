@@ -21,6 +21,7 @@ use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
 use crate::integrate::OdeSystem;
+use std::cell::RefCell;
 
 /// Why a scene cannot use the rotating frame.
 pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
@@ -50,6 +51,12 @@ pub struct RotatingSystem {
     unbalance_force: (f64, f64),
     cargo: Vec<Cargo>,
     inertia: Vec<f64>,
+    /// m·l of each cargo (constant per run).
+    mass_track: Vec<f64>,
+    /// (sin ψ, cos ψ) of each cargo, evaluated once per call: the trig is a
+    /// third of a run's time and both loops of the right-hand side need it.
+    /// A field, not a local, so that a call allocates nothing.
+    trig: RefCell<Vec<(f64, f64)>>,
     effects: Vec<Box<dyn Effect>>,
     rotor_unbalance: (f64, f64),
 }
@@ -82,6 +89,8 @@ impl RotatingSystem {
             b: r.bx,
             unbalance_force: (me * omega * omega * c, me * omega * omega * s),
             inertia: cargo.iter().map(Cargo::inertia).collect(),
+            mass_track: cargo.iter().map(|c| c.mass * c.track_radius).collect(),
+            trig: RefCell::new(vec![(0.0, 0.0); cargo.len()]),
             cargo,
             effects,
             rotor_unbalance: (me, r.unbalance_angle),
@@ -164,9 +173,11 @@ impl OdeSystem for RotatingSystem {
             gi += rotor_f[1];
         }
         let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
-        for (j, c) in self.cargo.iter().enumerate() {
+        let mut trig = self.trig.borrow_mut();
+        for j in 0..n {
             let (s, co) = psi[j].sin_cos();
-            let ml = c.mass * c.track_radius;
+            trig[j] = (s, co);
+            let ml = self.mass_track[j];
             let rate = w + psi_rate[j];
             gr += ml * rate * rate * co;
             gi += ml * rate * rate * s;
@@ -184,9 +195,9 @@ impl OdeSystem for RotatingSystem {
         let det = a11 * a22 - a12 * a12;
         let ar = (gr * a22 - gi * a12) / det;
         let ai = (gi * a11 - gr * a12) / det;
-        for (j, c) in self.cargo.iter().enumerate() {
-            let (s, co) = psi[j].sin_cos();
-            let ml = c.mass * c.track_radius;
+        for j in 0..n {
+            let (s, co) = trig[j];
+            let ml = self.mass_track[j];
             cargo_f[j] = (cargo_f[j] - ml * (co * ai - s * ar)) / self.inertia[j];
         }
         dydt[nq] = ar;
