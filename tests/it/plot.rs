@@ -524,6 +524,17 @@ fn compare_plot_writes_kaplan_meier_figure() {
         compare(&dir.path().join("km.jpg")).stdout.is_empty(),
         "refused before comparing"
     );
+    // The write that failed left no temporary file beside the folder.
+    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["s", "taken.svg"]);
+    let png = dir.path().join("taken.png");
+    std::fs::create_dir(&png).unwrap();
+    assert_eq!(compare(&png).status.code(), Some(2));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
 }
 
 fn tradeoff_points() -> Vec<TradeoffPoint> {
