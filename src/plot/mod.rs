@@ -1,5 +1,6 @@
 //! Figures people can look at: one run, one study, the design curves of
-//! seed 000 and the work–precision diagram of the trade-off study.
+//! seed 000, the work–precision diagram of the trade-off study and the
+//! Kaplan–Meier curves of `study compare`.
 //!
 //! Every function takes data and an output path; the format follows the
 //! extension (`.svg` or `.png`). Text is set in an embedded subset of DejaVu
@@ -9,6 +10,7 @@
 
 pub mod decimate;
 pub mod design;
+pub mod km;
 pub mod map;
 pub mod run;
 pub mod study;

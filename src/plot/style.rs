@@ -109,7 +109,7 @@ pub fn render(figure: &impl Figure, path: &Path) -> Result<(), PlotError> {
                 let _ = std::fs::remove_file(&tmp);
                 return Err(e);
             }
-            std::fs::rename(&tmp, path)?;
+            crate::study::io::move_into_place(&tmp, path)?;
         }
     }
     Ok(())

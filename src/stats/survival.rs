@@ -108,16 +108,17 @@ fn z_value(level: f64) -> f64 {
     Normal::standard().inverse_cdf(0.5 + level / 2.0)
 }
 
-/// R survival's `minmin` (in `survmean`): the first time the curve is ≤ 0.5, but when it sits
-/// on 0.5 (within sqrt(eps)) the midpoint to the next drop, since any t there solves S(t) = 0.5.
-fn first_at_or_below_half(points: impl Iterator<Item = (f64, Option<f64>)>) -> Option<f64> {
+/// R survival's `minmin` (in `survmean`, and `quantile.survfit`): the first time the curve is
+/// ≤ `level`, but when it sits on `level` (within sqrt(eps)) the midpoint to the next drop, since
+/// any t there solves S(t) = `level`.
+fn first_at_or_below(points: impl Iterator<Item = (f64, Option<f64>)>, level: f64) -> Option<f64> {
     let tol = f64::EPSILON.sqrt();
-    let below = |(t, y): (f64, Option<f64>)| y.filter(|y| *y < 0.5 + tol).map(|y| (t, y));
+    let below = |(t, y): (f64, Option<f64>)| y.filter(|y| *y < level + tol).map(|y| (t, y));
     let kept: Vec<(f64, f64)> = points.filter_map(below).collect();
     let &(t0, y0) = kept.first()?;
     let next_drop = kept.iter().find(|(_, y)| *y < y0);
     match next_drop {
-        Some(&(t1, _)) if (y0 - 0.5).abs() < tol => Some((t0 + t1) / 2.0),
+        Some(&(t1, _)) if (y0 - level).abs() < tol => Some((t0 + t1) / 2.0),
         _ => Some(t0),
     }
 }
@@ -222,7 +223,16 @@ impl KaplanMeier {
     /// on an interval, its midpoint with the next event time (lifelines takes the first time).
     /// `None` if S never reaches 0.5 (too many runs censored unsettled).
     pub fn median(&self) -> Option<f64> {
-        first_at_or_below_half(self.steps.iter().map(|s| (s.time, Some(s.survival))))
+        self.quantile(0.5)
+    }
+
+    /// The time by which a fraction `p` of runs has settled, by the median's convention (R's
+    /// `quantile.survfit`): first t with S(t) ≤ 1 − p, or the midpoint with the next event time
+    /// where S sits on 1 − p. `None` if S never gets that low; panics for `p` outside (0, 1).
+    pub fn quantile(&self, p: f64) -> Option<f64> {
+        assert!(p > 0.0 && p < 1.0, "quantile {p} not in (0, 1)");
+        let curve = self.steps.iter().map(|s| (s.time, Some(s.survival)));
+        first_at_or_below(curve, 1.0 - p)
     }
 
     /// Brookmeyer–Crowley `level` interval for the median, as R's `print.survfit`: the lower
@@ -232,7 +242,7 @@ impl KaplanMeier {
         let band = self.confidence_band(level, transform);
         let limit = |pick: fn(&Interval) -> f64| {
             let curve = self.steps.iter().zip(&band);
-            first_at_or_below_half(curve.map(|(s, b)| (s.time, b.as_ref().map(pick))))
+            first_at_or_below(curve.map(|(s, b)| (s.time, b.as_ref().map(pick))), 0.5)
         };
         (limit(|b| b.lower), limit(|b| b.upper))
     }
@@ -610,6 +620,23 @@ rmean 10 0 40 0";
             assert!(same(rm.estimate, mean), "{rm:?}");
             assert!(same(rm.std_error, (population_var / n).sqrt()), "{rm:?}");
         }
+    }
+
+    #[test]
+    fn quantiles_follow_the_median_convention() {
+        // Without censoring the curve is the empirical distribution, and R's convention is the
+        // inverse ECDF averaged where it is flat on the level (Hyndman & Fan type 2).
+        let km = fit("uncensored");
+        let got = [0.25, 0.5, 0.75, 0.9].map(|p| km.quantile(p));
+        assert_eq!(got, [Some(3.0), Some(4.0), Some(7.0), Some(11.0)]);
+        for (name, _) in CASES {
+            assert_eq!(fit(name).quantile(0.5), fit(name).median(), "{name}");
+        }
+        // Censored: S = 0.9, 0.7, 0.56, 0.373, 0.187 at 1, 2, 4, 5, 6, and never ≤ 0.1.
+        let km = fit("ties");
+        let got = [0.1, 0.25, 0.75, 0.9].map(|p| km.quantile(p));
+        assert_eq!(got, [Some(1.5), Some(2.0), Some(6.0), None]);
+        assert_eq!(fit("all_censored").quantile(0.25), None);
     }
 
     #[test]

@@ -113,7 +113,15 @@ pub fn read_metadata(path: &Path) -> PolarsResult<Vec<(String, String)>> {
 pub fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
     let tmp = temp_path(path);
     std::fs::write(&tmp, text)?;
-    std::fs::rename(&tmp, path)
+    move_into_place(&tmp, path)
+}
+
+/// Rename a finished temporary file to `path`, removing it if that fails
+/// (e.g. `path` is a folder), so that a refused write leaves nothing behind.
+pub(crate) fn move_into_place(tmp: &Path, path: &Path) -> std::io::Result<()> {
+    std::fs::rename(tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(tmp);
+    })
 }
 
 /// A sampled time history as a DataFrame: t, x, y, r, eps, psi_0 … psi_{n−1}.

@@ -198,8 +198,8 @@ fn unsettled_run_with_circulating_cargo() {
     );
 }
 
-fn study_plan() -> autobal::study::config::StudyPlan {
-    let text = r#"
+/// The fixture study's file, as `study run` keeps it beside its results.
+const STUDY_TOML: &str = r#"
 [scene.rotor]
 mass = 10.0
 kx = 1.0e5
@@ -219,9 +219,11 @@ drag = [5.0, 20.0]
 samples = 40
 unbalance = { distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }
 "#;
-    StudyFile::parse(text, "fixture.toml")
+
+fn study_plan() -> autobal::study::config::StudyPlan {
+    StudyFile::parse(STUDY_TOML, "fixture.toml")
         .unwrap()
-        .plan(text, "fixture.toml")
+        .plan(STUDY_TOML, "fixture.toml")
         .unwrap()
 }
 
@@ -287,8 +289,9 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
     runs
 }
 
-/// A study folder as `study run` leaves it: runs.parquet and summary.parquet.
+/// A study folder as `study run` leaves it: study.toml, runs.parquet and summary.parquet.
 fn write_study(dir: &Path) {
+    std::fs::write(dir.join("study.toml"), STUDY_TOML).unwrap();
     let plan = study_plan();
     let runs = study_runs(&plan, 40);
     let provenance = Provenance::new("fixture", 1, "all");
@@ -390,6 +393,148 @@ fn study_figures_reject_bad_input() {
         plot_settling_times(&data, &out),
         Err(PlotError::NoData(_))
     ));
+}
+
+#[test]
+fn kaplan_meier_curve_is_the_product_limit_estimate() {
+    use autobal::plot::km::{settled_band, settled_steps};
+    use autobal::stats::survival::{KaplanMeier, Observation};
+    let o = |time, settled| Observation { time, settled };
+    // Settled at 2, 4 and 4; still unsettled when last seen at 3 and at 10.
+    let runs = [
+        o(2.0, true),
+        o(3.0, false),
+        o(4.0, true),
+        o(4.0, true),
+        o(10.0, false),
+    ];
+    let km = KaplanMeier::fit(&runs).unwrap();
+    // By hand: at 2 one of five settles, S = 4/5; at 4 two of the three
+    // still at risk settle, S = 4/5 · 1/3; the curve is 1 − S.
+    let f4 = 1.0 - 0.8 / 3.0;
+    let want = [
+        (0.0, 0.0),
+        (2.0, 0.0),
+        (2.0, 0.2),
+        (4.0, 0.2),
+        (4.0, f4),
+        (10.0, f4),
+    ];
+    let same = |got: Vec<(f64, f64)>, want: &[(f64, f64)]| {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        let ok = got.len() == want.len()
+            && got
+                .iter()
+                .zip(want)
+                .all(|(g, w)| close(g.0, w.0) && close(g.1, w.1));
+        assert!(ok, "got {got:?}, want {want:?}");
+    };
+    same(settled_steps(&km, 10.0), &want);
+    // Cut at 3, before the second settling: the curve stops there.
+    same(
+        settled_steps(&km, 3.0),
+        &want[..3]
+            .iter()
+            .copied()
+            .chain([(3.0, 0.2)])
+            .collect::<Vec<_>>(),
+    );
+    // The 95 % band, by hand: Greenwood V = Σ d/(n(n−d)) = 1/20 at 2 and
+    // 1/20 + 2/3 at 4; S's log-log limits exp(−exp(ln(−ln S) ± z·√V/|ln S|))
+    // with z = 1.959964, then 1 − each (Python's math module, 17 digits).
+    let band = settled_band(&km, 10.0);
+    let want = [
+        (2.0, 4.0, 0.030_820_211_133_257_28, 0.796_190_736_732_361),
+        (4.0, 10.0, 0.313_863_720_842_987_97, 0.990_322_999_421_118_7),
+    ];
+    assert_eq!(band.len(), 2, "{band:?}");
+    for ((from, to, iv), w) in band.iter().zip(want) {
+        assert_eq!((*from, *to), (w.0, w.1));
+        assert!(
+            (iv.lower - w.2).abs() < 1e-12 && (iv.upper - w.3).abs() < 1e-12,
+            "{band:?}"
+        );
+    }
+}
+
+#[test]
+fn compare_plot_writes_kaplan_meier_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let study_dir = dir.path().join("s");
+    std::fs::create_dir(&study_dir).unwrap();
+    write_study(&study_dir);
+    let compare = |plot: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .arg("compare")
+            .arg(&study_dir)
+            .args(["--designs", "0,3", "--plot"])
+            .arg(plot)
+            .output()
+            .unwrap()
+    };
+    let figures = out_dir("compare");
+    // Design 3 has runs that never settled (every ninth sample).
+    let svg = figures.path.join("km.svg");
+    let out = compare(&svg);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("verdict:") && stdout.contains("wrote"),
+        "{stdout}"
+    );
+    let text = check_svg(
+        &svg,
+        5_000,
+        &[
+            "fraction of runs settled by t",
+            "settling time t  (revolutions, log scale)",
+            "settled by t, 1 − S(t)",
+            "A: ball n=3",
+            "(40 runs, 0 not settled)",
+            "(40 runs, 5 not settled)",
+            "horizon t_end − W",
+            "95 % pointwise band",
+        ],
+    );
+    assert!(text.trim_end().ends_with("</svg>"));
+    let png = figures.path.join("km.png");
+    assert_eq!(compare(&png).status.code(), Some(0));
+    check_png(&png, 10_000, (1000, 600));
+
+    // A bad extension, a missing folder, or a path that cannot be written:
+    // exit 2 naming --plot; a bad path is refused before any work.
+    let blocked = dir.path().join("taken.svg");
+    std::fs::create_dir(&blocked).unwrap();
+    for bad in [
+        dir.path().join("km.jpg"),
+        dir.path().join("no/such/km.svg"),
+        blocked,
+    ] {
+        let out = compare(&bad);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{}: {err}", bad.display());
+        assert!(err.contains("--plot"), "{}: {err}", bad.display());
+    }
+    assert!(
+        compare(&dir.path().join("km.jpg")).stdout.is_empty(),
+        "refused before comparing"
+    );
+    // The write that failed left no temporary file beside the folder.
+    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["s", "taken.svg"]);
+    let png = dir.path().join("taken.png");
+    std::fs::create_dir(&png).unwrap();
+    assert_eq!(compare(&png).status.code(), Some(2));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
 }
 
 fn tradeoff_points() -> Vec<TradeoffPoint> {

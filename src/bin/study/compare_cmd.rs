@@ -3,15 +3,19 @@
 
 use crate::UserError;
 use crate::output::{p_value_text, text_table};
+use crate::plot_cmd::{check_figure_path, plot_error};
+use autobal::plot::km::{KmCurve, plot_kaplan_meier};
 use autobal::study::compare_designs::{Side, compare_sides, median_with_interval};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Examples shown under `study compare --help`.
 pub const EXAMPLES: &str = "Examples:
   study compare results/three_balls --designs 0,7       two designs of one study
   study compare results/a results/b                     the only design of each folder
-  study compare results/a results/b --designs 2,0       design 2 of a against design 0 of b";
+  study compare results/a results/b --designs 2,0       design 2 of a against design 0 of b
+  study compare results/three_balls --designs 0,7 --plot km.svg
+                                                        and their Kaplan–Meier curves (.svg or .png)";
 
 /// Arguments of `study compare`.
 #[derive(Args)]
@@ -25,6 +29,9 @@ pub struct CompareArgs {
     /// Significance level of the verdict.
     #[arg(long, default_value_t = 0.05)]
     alpha: f64,
+    /// Also draw both designs' Kaplan–Meier curves into this file (.svg or .png, by extension).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
 }
 
 /// "= 0.0123" or "< 0.0001".
@@ -47,6 +54,9 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             ),
             2,
         ));
+    }
+    if let Some(path) = &args.plot {
+        check_figure_path("--plot", path)?;
     }
     let (dir_a, dir_b) = match args.folders.as_slice() {
         [one] => (one, one),
@@ -184,5 +194,24 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         format!("B settles sooner than A (α = {})", args.alpha)
     };
     println!("verdict: {verdict}");
+    if let Some(path) = &args.plot {
+        plot_sides(&a, &b, path)?;
+        println!("wrote {}", path.display());
+    }
     Ok(())
+}
+
+/// Draw the Kaplan–Meier curves of both sides into `path`.
+fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
+    let curve = |name: &str, side: &Side| KmCurve {
+        label: format!("{name}: {}", side.label),
+        observations: side.runs.settling.clone(),
+        horizon: side.horizon,
+    };
+    let curves = [curve("A", a), curve("B", b)];
+    let title = "study compare: fraction of runs settled by t";
+    plot_kaplan_meier(&curves, title, path).map_err(|e| {
+        let UserError(message, code) = plot_error(e);
+        UserError(format!("--plot {}: {message}", path.display()), code)
+    })
 }

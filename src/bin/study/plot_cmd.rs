@@ -210,7 +210,13 @@ fn plot_one_study(a: &StudyArgs) -> Result<Vec<PathBuf>, UserError> {
 
 /// Reject a bad --out before any work: wrong extension or missing folder.
 fn check_out(out: &Path) -> Result<(), UserError> {
-    Format::from_path(out).map_err(|e| UserError(format!("--out {e}"), 2))?;
+    check_figure_path("--out", out)
+}
+
+/// Reject a bad figure path given with `flag` before any work: wrong
+/// extension or missing folder.
+pub(crate) fn check_figure_path(flag: &str, out: &Path) -> Result<(), UserError> {
+    Format::from_path(out).map_err(|e| UserError(format!("{flag} {e}"), 2))?;
     let parent = out
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -218,7 +224,7 @@ fn check_out(out: &Path) -> Result<(), UserError> {
     if !parent.is_dir() {
         return Err(UserError(
             format!(
-                "--out {}: folder {} does not exist",
+                "{flag} {}: folder {} does not exist",
                 out.display(),
                 parent.display()
             ),
@@ -229,7 +235,7 @@ fn check_out(out: &Path) -> Result<(), UserError> {
 }
 
 /// Drawing and font failures are ours (exit 1); everything else is the input's (exit 2).
-fn plot_error(e: PlotError) -> UserError {
+pub(crate) fn plot_error(e: PlotError) -> UserError {
     match e {
         PlotError::Draw(_) | PlotError::Font => UserError::internal(e.to_string()),
         other => UserError(other.to_string(), 2),

@@ -1,5 +1,5 @@
 //! One study's figures, one file per figure: settling-time distributions
-//! per design ([`settling_time`]), the settled fraction with its Wilson
+//! per design over every run ([`settling_time`]), the settled fraction with its Wilson
 //! intervals ([`settled_fraction`]), and settling time against the unbalance
 //! as a fraction of capacity ([`settling_vs_unbalance`]). This file reads the
 //! study's data and lists the figures; `labels.rs` names and groups designs.
@@ -14,6 +14,7 @@ pub use settling_time::plot_settling_times;
 pub use settling_vs_unbalance::plot_settling_vs_unbalance;
 
 use super::{Format, PlotError};
+use crate::stats::survival::Observation;
 use crate::study::io::read_parquet;
 use crate::study::record::{RunRecord, from_dataframe};
 use polars::prelude::*;
@@ -141,12 +142,42 @@ impl StudyData {
             .filter(|v| v.is_finite())
             .collect()
     }
+
+    /// Every run of one design as a settling observation (revolutions):
+    /// settled at its time, or censored unsettled.
+    fn settling_observations(&self, design_id: u32) -> Vec<Observation> {
+        // runs.parquet gives a censoring time only to runs simulated to their
+        // end, and does not hold the horizon; the others are censored at the
+        // latest time any run shows. Quantiles, all the figures draw from the
+        // fit, do not depend on where beyond the last settling a run is censored.
+        let latest = self
+            .runs
+            .iter()
+            .flat_map(|r| [r.metrics.settling_revs, r.metrics.censoring_revs])
+            .flatten()
+            .filter(|t| t.is_finite())
+            .fold(0.0, f64::max);
+        self.runs
+            .iter()
+            .filter(|r| r.design_id == design_id)
+            .map(|r| match r.metrics.settling_revs {
+                Some(t) if r.metrics.settled && t.is_finite() => Observation {
+                    time: t,
+                    settled: true,
+                },
+                _ => Observation {
+                    time: r.metrics.censoring_revs.unwrap_or(latest),
+                    settled: false,
+                },
+            })
+            .collect()
+    }
 }
 
 /// The three figures of a study.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StudyFigure {
-    /// Settling-time box plots per design.
+    /// Settling-time box plots per design (Kaplan–Meier quartiles over every run).
     SettlingTime,
     /// Settled fraction per design with Wilson intervals.
     SettledFraction,

@@ -1,0 +1,240 @@
+//! The Kaplan–Meier figure of `study compare --plot`: for each design the
+//! estimated fraction of runs settled by t, 1 − S(t), with its 95 % pointwise
+//! band. Runs that never settled are censored where they were last seen, so
+//! every run counts and a curve stops below 1 when some runs did not settle.
+
+use super::PlotError;
+use super::style::{self, Figure, REFERENCE, Swatch, TICK, colour, linear_label, log_ticks, text};
+use crate::stats::survival::{Interval, KaplanMeier, Observation, Transform};
+use crate::study::verdict::LEVEL;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::Path;
+
+/// The scale the band is built on: the one of the median interval that
+/// `study compare` and `summary.parquet` report, so the figure and the
+/// table agree on where the band crosses ½.
+pub const BAND: Transform = Transform::LogLog;
+
+/// One design's runs, as the figure draws them.
+#[derive(Debug, Clone)]
+pub struct KmCurve {
+    /// Legend label, e.g. "A: ball n=3 ρ=0.2500 β=10".
+    pub label: String,
+    /// Every run: settled at its time, or censored there.
+    pub observations: Vec<Observation>,
+    /// Latest settling time a run can show (revolutions): t_end − W.
+    pub horizon: f64,
+}
+
+/// Vertices of the step curve 1 − S(t) from t = 0 to `until`: flat between
+/// settling times and vertical at each (events after `until` are left out).
+pub fn settled_steps(km: &KaplanMeier, until: f64) -> Vec<(f64, f64)> {
+    let mut points = vec![(0.0, 0.0)];
+    let mut level = 0.0;
+    for step in km.steps().iter().take_while(|s| s.time <= until) {
+        let next = 1.0 - step.survival;
+        points.push((step.time, level));
+        points.push((step.time, next));
+        level = next;
+    }
+    points.push((until, level));
+    points
+}
+
+/// The pointwise 95 % band of 1 − S(t) on [`BAND`]'s scale, as (from, to,
+/// interval) for each stretch between settling times up to `until`; left
+/// out before the first settling (the band is the point 0) and where S = 0
+/// (it is undefined there).
+pub fn settled_band(km: &KaplanMeier, until: f64) -> Vec<(f64, f64, Interval)> {
+    let steps = km.steps();
+    let band = km.confidence_band(LEVEL, BAND);
+    steps
+        .iter()
+        .zip(band)
+        .enumerate()
+        .take_while(|(_, (s, _))| s.time <= until)
+        .filter_map(|(i, (s, b))| {
+            let to = steps.get(i + 1).map_or(until, |n| n.time.min(until));
+            Some((s.time, to.max(s.time), b?.complement()))
+        })
+        .collect()
+}
+
+/// Distinct times at which runs were censored (one tick each).
+fn censoring_times(observations: &[Observation]) -> Vec<f64> {
+    let mut times: Vec<f64> = observations
+        .iter()
+        .filter(|o| !o.settled)
+        .map(|o| o.time)
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
+}
+
+/// A curve with its fit, checked.
+struct Fitted<'a> {
+    curve: &'a KmCurve,
+    km: KaplanMeier,
+    /// Where the curve is drawn to: the horizon, or a later observation.
+    end: f64,
+}
+
+/// The Kaplan–Meier comparison figure.
+struct KmFigure<'a> {
+    fitted: Vec<Fitted<'a>>,
+    title: &'a str,
+}
+
+/// Write the Kaplan–Meier curves of `curves` to `path` (.svg or .png).
+pub fn plot_kaplan_meier(curves: &[KmCurve], title: &str, path: &Path) -> Result<(), PlotError> {
+    if curves.is_empty() {
+        return Err(PlotError::NoData("no design to draw".into()));
+    }
+    let fitted = curves
+        .iter()
+        .map(|curve| {
+            if !(curve.horizon.is_finite() && curve.horizon > 0.0) {
+                return Err(PlotError::invalid(
+                    format!("{} horizon", curve.label),
+                    "must be finite and > 0",
+                ));
+            }
+            let km = KaplanMeier::fit(&curve.observations).ok_or_else(|| {
+                PlotError::invalid(
+                    curve.label.clone(),
+                    "needs at least one run, every time finite and ≥ 0",
+                )
+            })?;
+            let last = curve
+                .observations
+                .iter()
+                .map(|o| o.time)
+                .fold(0.0, f64::max);
+            let end = curve.horizon.max(last);
+            Ok(Fitted { curve, km, end })
+        })
+        .collect::<Result<Vec<_>, PlotError>>()?;
+    style::render(&KmFigure { fitted, title }, path)
+}
+
+impl Figure for KmFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1100, 680)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
+        // Settling times span decades (a few to hundreds of revolutions):
+        // a log axis, from below the first settling to past the horizon.
+        let first = self
+            .fitted
+            .iter()
+            .filter_map(|f| f.km.steps().first().map(|s| s.time))
+            .filter(|t| *t > 0.0);
+        let ends = self.fitted.iter().map(|f| f.end);
+        let (lo, hi) = style::log_extent(first.chain(ends), 1.15)
+            .ok_or_else(|| PlotError::NoData("no positive time".into()))?;
+        let body = root.titled(self.title, text(style::TITLE))?;
+        let legend: Vec<(String, Swatch)> = self
+            .fitted
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let n = f.km.n_observations();
+                let unsettled = f.curve.observations.iter().filter(|o| !o.settled).count();
+                let label = format!("{}  ({n} runs, {unsettled} not settled)", f.curve.label);
+                (label, Swatch::Line(colour(i)))
+            })
+            .collect();
+        let caption = format!(
+            "every run counted; shaded: {:.0} % pointwise band (log-log); ticks: runs censored unsettled; dashed: ½, where the median reads off",
+            100.0 * LEVEL
+        );
+        let (strip, area) = body.split_vertically(34);
+        style::legend_row(&strip, &legend)?;
+        let mut chart = ChartBuilder::on(&area)
+            .caption(caption, text(TICK))
+            .margin(16)
+            .margin_top(4)
+            .margin_right(30)
+            .x_label_area_size(52)
+            .y_label_area_size(80)
+            .build_cartesian_2d(
+                (lo..hi).log_scale().with_key_points(log_ticks(lo, hi)),
+                0.0..1.02,
+            )?;
+        chart
+            .configure_mesh()
+            .x_desc("settling time t  (revolutions, log scale)")
+            .y_desc("settled by t, 1 − S(t)  (–)")
+            .axis_desc_style(text(style::AXIS))
+            .label_style(text(TICK))
+            .x_label_formatter(&style::log_formatter(lo, hi))
+            .y_label_formatter(&|v| {
+                if *v > 1.0 {
+                    String::new()
+                } else {
+                    linear_label(v)
+                }
+            })
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.08))
+            .draw()?;
+        // Time 0 cannot sit on a log axis; the curve starts at its left edge.
+        let x = |t: f64| t.clamp(lo, hi);
+        for (i, f) in self.fitted.iter().enumerate() {
+            let c = colour(i);
+            chart.draw_series(settled_band(&f.km, f.end).into_iter().map(|(a, b, iv)| {
+                Rectangle::new([(x(a), iv.lower), (x(b), iv.upper)], c.mix(0.18).filled())
+            }))?;
+        }
+        chart.draw_series(DashedLineSeries::new(
+            [(lo, 0.5), (hi, 0.5)],
+            8,
+            5,
+            REFERENCE.stroke_width(1),
+        ))?;
+        let mut horizons: Vec<f64> = self.fitted.iter().map(|f| f.curve.horizon).collect();
+        horizons.sort_by(f64::total_cmp);
+        horizons.dedup();
+        for h in horizons {
+            chart.draw_series([PathElement::new(
+                vec![(x(h), 0.0), (x(h), 1.02)],
+                REFERENCE.stroke_width(2),
+            )])?;
+            // Near the foot of the line: curves are high by the horizon.
+            chart.draw_series([Text::new(
+                format!("horizon t_end − W = {} rev ", style::short(h)),
+                (x(h), 0.03),
+                text(TICK).pos(Pos::new(HPos::Right, VPos::Bottom)),
+            )])?;
+        }
+        for (i, f) in self.fitted.iter().enumerate() {
+            let c = colour(i);
+            let steps = settled_steps(&f.km, f.end);
+            chart.draw_series(LineSeries::new(
+                steps.into_iter().map(|(t, y)| (x(t), y)),
+                c.stroke_width(2),
+            ))?;
+            chart.draw_series(censoring_times(&f.curve.observations).into_iter().map(|t| {
+                EmptyElement::at((x(t), f.km.settled_by(t)))
+                    + PathElement::new(vec![(0, -6), (0, 6)], c.stroke_width(2))
+            }))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn censoring_times_are_distinct_and_sorted() {
+        let o = |time, settled| Observation { time, settled };
+        let obs = [o(3.0, false), o(1.0, true), o(3.0, false), o(2.0, false)];
+        assert_eq!(censoring_times(&obs), vec![2.0, 3.0]);
+    }
+}
