@@ -96,7 +96,10 @@ impl Simulation {
     ) -> (RunMetrics, Option<Series>) {
         let omega = self.scene.speed.nominal_speed();
         let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
-        let method = self.solver.method.resolve(frame.is_some());
+        let method = self.solver.method.resolve(
+            self.solver.rtol,
+            frame.is_some() && !self.metrics.stop_when_settled,
+        );
         let explicit = !method.is_implicit();
         let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);
         if let Some(w) = frame {

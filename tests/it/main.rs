@@ -1,6 +1,7 @@
 //! autobal's integration tests, linked into one binary to keep builds fast.
 
 mod adaptive;
+mod auto_method;
 mod bad_input;
 mod bench;
 mod check;

@@ -13,7 +13,7 @@ use serde::Serialize;
 pub struct FidelityCost {
     /// "full" or "rotating".
     pub fidelity: String,
-    /// Integrator used (auto pairing: dp5 inertial, radau5 rotating).
+    /// Integrator used (auto without early stop: dp5 inertial, radau5 rotating).
     pub method: String,
     /// Right-hand-side calls.
     pub rhs_calls: u64,
