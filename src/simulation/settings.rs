@@ -132,8 +132,8 @@ pub enum MethodChoice {
 }
 
 /// Below this rtol `auto` takes DOP853, from it up DP5: on the main job's
-/// designs DP5 costs 0.82× DOP853's time per run at rtol 1e-6, DOP853 0.88×
-/// DP5's at 1e-8 and 0.84× at 1e-9 (docs/benchmarks.md).
+/// designs the two tie at rtol 1e-6 (1.11 and 1.09 ms per run), DOP853 takes
+/// 0.85× DP5's time at 1e-8 and 0.76× at 1e-9 (docs/benchmarks.md).
 pub const AUTO_DOP853_BELOW_RTOL: f64 = 1e-7;
 
 impl MethodChoice {
@@ -146,8 +146,8 @@ impl MethodChoice {
     /// below the tolerance in steps of 1/(ω + ω_n), while Radau5 steps across
     /// it: 11× fewer RHS calls over 10 000 revolutions. With early stop the
     /// run ends 50 revolutions after settling, the transient dominates, and
-    /// the explicit start is the cheaper: 0.53× Radau5's time per run on the
-    /// main job (docs/benchmarks.md).
+    /// the explicit start is the cheaper: 0.60× Radau5's time per run on the
+    /// main job at rtol 1e-6 (docs/benchmarks.md).
     pub fn resolve(self, rtol: f64, long_at_fixed_point: bool) -> Method {
         match self {
             MethodChoice::Auto if long_at_fixed_point => Method::Radau5,
