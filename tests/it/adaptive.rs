@@ -1,6 +1,7 @@
 //! Adaptive sampling: batches until a precision, deterministic, and the same
 //! rows as the fixed-sample study it stopped at.
 
+use crate::fixtures::SI_SCENE;
 use autobal::study::adaptive::precision;
 use autobal::study::config::{StudyFile, StudyPlan};
 use autobal::study::io::read_parquet;
@@ -14,36 +15,19 @@ use std::process::Command;
 /// `[sampling]` table's body.
 fn study(output: &Path, sampling: &str) -> String {
     format!(
-        r#"
-name = "adaptive"
-seed = 5
-output = "{}"
-
-[scene.rotor]
-mass = 10.0
-kx = 1.0e5
-ky = 1.0e5
-bx = 100.0
-by = 100.0
-
-[scene.speed]
-mode = "constant"
-omega = 300.0
-
+        "name = \"adaptive\"\nseed = 5\noutput = \"{}\"\n{SI_SCENE}
 [designs]
-kind = "ball"
+kind = \"ball\"
 n = 3
-rho = "optimal"
+rho = \"optimal\"
 race_radius = 0.05
 drag = [10.0, 50.0]
-
 [sampling]
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = \"uniform\", min = 0.2, max = 0.8 }}
 {sampling}
-
 [metrics]
 t_end_revs = 400
-"#,
+",
         output.display()
     )
 }
