@@ -7,8 +7,10 @@
 //! (never pulling), with δ the angular overlap. The stiffness puts the contact
 //! frequency at `frequency_ratio` × the nominal speed, so the weights' packing
 //! is resolved by the integrator without making the problem needlessly stiff.
-//! Pairs are checked exhaustively: O(n²), fine for the n ≤ 64 of a balancer,
-//! and only when a scene asks for contact.
+//! Up to [`ALL_PAIRS_UP_TO`] weights every pair is checked; beyond, only
+//! neighbours along the race (weights sorted by angle, per plane), which
+//! keeps a call O(n log n) instead of O(n²): two weights can only overlap if
+//! no third sits between them, short of a third weight already sunk into both.
 
 use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
@@ -105,12 +107,36 @@ pub fn wrapped(d: f64) -> f64 {
     if w > PI { w - TAU } else { w }
 }
 
-impl Effect for Contact {
-    fn name(&self) -> &'static str {
-        "contact"
+/// Up to this many weights every pair is checked: for a handful of weights
+/// the pairs are fewer than a sort costs, and the shipped studies (n ≤ 8)
+/// keep their exact arithmetic.
+pub const ALL_PAIRS_UP_TO: usize = 8;
+
+/// Largest weight count the neighbour search sorts on the stack (the study
+/// limit on weights per balancer); beyond it every pair is checked.
+const NEIGHBOUR_BUFFER: usize = 256;
+
+impl Contact {
+    /// The contact torque between cargoes j and k, if they overlap.
+    #[inline]
+    fn pair(&self, j: usize, k: usize, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
+        let gap = self.half_angle[j] + self.half_angle[k];
+        let d = wrapped(ctx.psi[k] - ctx.psi[j]);
+        let overlap = gap - d.abs();
+        if overlap <= 0.0 {
+            return;
+        }
+        let dir = if d >= 0.0 { 1.0 } else { -1.0 };
+        let overlap_rate = -dir * (ctx.psi_rate[k] - ctx.psi_rate[j]);
+        let k_pair = self.stiffness[j].min(self.stiffness[k]);
+        let c_pair = self.damping[j].min(self.damping[k]);
+        let torque = (k_pair * overlap + c_pair * overlap_rate).max(0.0);
+        forces.cargo[k] += dir * torque;
+        forces.cargo[j] -= dir * torque;
     }
 
-    fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
+    /// Every pair of sized cargoes in the same plane.
+    fn all_pairs(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
         let n = ctx.psi.len();
         for j in 0..n {
             if self.half_angle[j] == 0.0 {
@@ -120,19 +146,131 @@ impl Effect for Contact {
                 if self.half_angle[k] == 0.0 || self.plane[k] != self.plane[j] {
                     continue;
                 }
-                let gap = self.half_angle[j] + self.half_angle[k];
-                let d = wrapped(ctx.psi[k] - ctx.psi[j]);
-                let overlap = gap - d.abs();
-                if overlap <= 0.0 {
-                    continue;
+                self.pair(j, k, ctx, forces);
+            }
+        }
+    }
+
+    /// Neighbours along the race only, plane by plane (no allocation: the
+    /// order lives on the stack).
+    fn neighbours(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
+        let n = ctx.psi.len();
+        let mut order = [0u16; NEIGHBOUR_BUFFER];
+        let mut angle = [0.0f64; NEIGHBOUR_BUFFER];
+        for j in 0..n {
+            angle[j] = ctx.psi[j].rem_euclid(TAU);
+        }
+        for first in 0..n {
+            let plane = self.plane[first];
+            // Each plane once: at its first cargo.
+            if self.plane[..first].contains(&plane) {
+                continue;
+            }
+            let mut m = 0;
+            for j in first..n {
+                if self.plane[j] == plane && self.half_angle[j] > 0.0 {
+                    order[m] = j as u16;
+                    m += 1;
                 }
-                let dir = if d >= 0.0 { 1.0 } else { -1.0 };
-                let overlap_rate = -dir * (ctx.psi_rate[k] - ctx.psi_rate[j]);
-                let k_pair = self.stiffness[j].min(self.stiffness[k]);
-                let c_pair = self.damping[j].min(self.damping[k]);
-                let torque = (k_pair * overlap + c_pair * overlap_rate).max(0.0);
-                forces.cargo[k] += dir * torque;
-                forces.cargo[j] -= dir * torque;
+            }
+            let ring = &mut order[..m];
+            ring.sort_unstable_by(|&a, &b| angle[a as usize].total_cmp(&angle[b as usize]));
+            let pairs = if m > 2 { m } else { m.saturating_sub(1) };
+            for i in 0..pairs {
+                let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
+                self.pair(a.min(b), a.max(b), ctx, forces);
+            }
+        }
+    }
+}
+
+impl Effect for Contact {
+    fn name(&self) -> &'static str {
+        "contact"
+    }
+
+    fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
+        let n = ctx.psi.len();
+        if n <= ALL_PAIRS_UP_TO || n > NEIGHBOUR_BUFFER {
+            self.all_pairs(ctx, forces);
+        } else {
+            self.neighbours(ctx, forces);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic pseudo-random numbers in [0, 1) (no RNG crate needed).
+    fn uniform(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// For many weights, the neighbour search finds exactly the forces of the
+    /// exhaustive one, on packed states where many pairs overlap, in one
+    /// plane and in two.
+    #[test]
+    fn neighbours_give_the_forces_of_all_pairs() {
+        let mut seed = 7;
+        for n in [9_usize, 16, 33, 64, 200] {
+            for planes in [1, 2] {
+                // Weights that fill 90 % of the race when packed (a race
+                // holds no more).
+                let per_plane = n.div_ceil(planes) as f64;
+                let radius = 0.05 * (0.9 * std::f64::consts::PI / per_plane).sin();
+                let cargo: Vec<Cargo> = (0..n)
+                    .map(|j| Cargo {
+                        radius,
+                        plane: j % planes,
+                        ..Cargo::point(0.01, 0.05, 0.1, 1.4)
+                    })
+                    .collect();
+                let contact = Contact::new(&ContactSpec::default(), &cargo, 300.0).unwrap();
+                // Packed: the angular pitch a little under 2α, so neighbours overlap.
+                let pitch = 2.0 * cargo[0].contact_half_angle() * 0.97;
+                let psi: Vec<f64> = (0..n)
+                    .map(|j| (j / planes) as f64 * pitch + 0.2 * pitch * uniform(&mut seed) - 7.0)
+                    .collect();
+                let rate: Vec<f64> = (0..n).map(|_| uniform(&mut seed) - 0.5).collect();
+                let ctx = EffectContext {
+                    t: 0.0,
+                    phi: 0.0,
+                    spin_rate: 300.0,
+                    spin_free: false,
+                    cargo: &cargo,
+                    psi: &psi,
+                    psi_rate: &rate,
+                    rotor_unbalance: (0.0, 0.0),
+                };
+                let run = |neighbours: bool| {
+                    let (mut rotor, mut spin) = ([0.0; crate::model::rotor::MAX_DOF], 0.0);
+                    let mut cargo_f = vec![0.0; n];
+                    let mut forces = Forces {
+                        rotor: &mut rotor,
+                        spin: &mut spin,
+                        cargo: &mut cargo_f,
+                    };
+                    if neighbours {
+                        contact.neighbours(&ctx, &mut forces);
+                    } else {
+                        contact.all_pairs(&ctx, &mut forces);
+                    }
+                    cargo_f
+                };
+                let (fast, exact) = (run(true), run(false));
+                let scale = exact.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+                assert!(scale > 0.0, "n = {n}: the state must hold overlaps");
+                for (a, b) in fast.iter().zip(&exact) {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "n = {n}, planes = {planes}: {a} vs {b}"
+                    );
+                }
             }
         }
     }
