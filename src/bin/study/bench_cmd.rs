@@ -1,6 +1,7 @@
 //! `study bench`: time the ODE core (RHS cost per cargo count, solves per
 //! method and tolerance), the solves `bench/scipy` repeats with SciPy, or a
-//! small study at 1 and 2 threads, and print the figures.
+//! small study at 1 and 2 threads, and print the figures; or write the main
+//! job's runs for the lean reference `bench/lean`.
 
 use crate::UserError;
 use crate::bench::peer::{PeerConfig, PeerReport};
