@@ -78,3 +78,32 @@ fn study_bench_peer_cases_and_thread_scaling_json() {
     let both = study(&["bench", "--peer-cases", "--thread-scaling"]);
     assert_eq!(both.status.code(), Some(2));
 }
+
+#[test]
+fn study_bench_lean_inputs_writes_one_row_per_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("runs.csv");
+    let out = study(&[
+        "bench",
+        "--lean-inputs",
+        path.to_str().unwrap(),
+        "--samples",
+        "1",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    // The main job's 20 designs, one sample each, under one header.
+    assert_eq!(lines.len(), 1 + 20);
+    assert!(lines[0].starts_with("run_id,design_id,sample_id,n,omega,"));
+    let columns = lines[0].split(',').count();
+    assert!(lines.iter().all(|l| l.split(',').count() == columns));
+
+    // --samples means nothing on its own.
+    let alone = study(&["bench", "--samples", "3"]);
+    assert_eq!(alone.status.code(), Some(2));
+}

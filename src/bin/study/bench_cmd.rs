@@ -1,6 +1,7 @@
 //! `study bench`: time the ODE core (RHS cost per cargo count, solves per
 //! method and tolerance), the solves `bench/scipy` repeats with SciPy, or a
-//! small study at 1 and 2 threads, and print the figures.
+//! small study at 1 and 2 threads, and print the figures; or write the main
+//! job's runs for the lean reference `bench/lean`.
 
 use crate::UserError;
 use crate::bench::peer::{PeerConfig, PeerReport};
@@ -17,6 +18,7 @@ pub const EXAMPLES: &str = "Examples:
   study bench --revolutions 2000 --repeats 21
   cargo run --release -- bench --peer-cases --json > autobal.json   # bench/scipy/run.sh does this
   cargo run --release -- bench --thread-scaling --repeats 9
+  study bench --lean-inputs runs.csv --samples 20   # bench/lean/run.sh does this
 
 Timings are only comparable within one run (cases are interleaved and the
 median is reported); build with --release, a debug build says so in the output.";
@@ -49,8 +51,15 @@ pub struct BenchArgs {
     /// with 2 threads, interleaved, and report the speed-up.
     #[arg(long)]
     thread_scaling: bool,
-    /// Samples per design with --thread-scaling (default 25; 1 with --quick).
-    #[arg(long, requires = "thread_scaling")]
+    /// Write every run of the main job (studies/three_balls.toml, --samples
+    /// per design) as one CSV row for the lean reference `bench/lean`: the
+    /// rotating-frame equations' constants, start state, tolerances, observer
+    /// constants and autobal's own answer.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["thread_scaling", "peer_cases", "fidelity"])]
+    lean_inputs: Option<std::path::PathBuf>,
+    /// Samples per design with --thread-scaling (default 25; 1 with --quick)
+    /// or --lean-inputs (default 20).
+    #[arg(long)]
     samples: Option<u32>,
 }
 
@@ -116,6 +125,15 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
             2,
         ));
     }
+    if args.samples.is_some() && !(args.thread_scaling || args.lean_inputs.is_some()) {
+        return Err(UserError(
+            "--samples needs --thread-scaling or --lean-inputs".into(),
+            2,
+        ));
+    }
+    if let Some(path) = &args.lean_inputs {
+        return write_lean_inputs(path, args.samples.unwrap_or(20));
+    }
     if args.peer_cases {
         return run_peer_cases(args);
     }
@@ -140,6 +158,25 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     } else {
         print!("{}", describe(&report));
     }
+    Ok(())
+}
+
+/// Export the main job's runs for `bench/lean` (each run is solved once by autobal).
+fn write_lean_inputs(path: &std::path::Path, samples: u32) -> Result<(), UserError> {
+    let plan = bench::lean_inputs::lean_plan(samples);
+    let rows = bench::lean_inputs::lean_rows(&plan).map_err(UserError::internal)?;
+    let write = || -> std::io::Result<()> {
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        bench::lean_inputs::write_csv(&rows, &mut out)?;
+        std::io::Write::flush(&mut out)
+    };
+    write().map_err(|e| UserError(format!("{}: {e}", path.display()), 2))?;
+    eprintln!(
+        "wrote {} runs of {} to {}",
+        rows.len(),
+        plan.name,
+        path.display()
+    );
     Ok(())
 }
 

@@ -99,6 +99,16 @@ impl Contact {
             damping,
         })
     }
+
+    /// (α_j, k_θ, c_θ, plane) of cargo j: what a re-implementation of this effect needs.
+    pub fn cargo_coefficients(&self, j: usize) -> (f64, f64, f64, usize) {
+        (
+            self.half_angle[j],
+            self.stiffness[j],
+            self.damping[j],
+            self.plane[j],
+        )
+    }
 }
 
 /// Angle b − a wrapped to (−π, π].

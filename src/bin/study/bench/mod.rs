@@ -12,9 +12,11 @@
 //! - [`solve`]: the cost of whole solves per method and tolerance;
 //! - [`fidelity`]: the rotating frame against the full model;
 //! - [`peer`]: the cases the SciPy peer (`bench/scipy`) repeats;
-//! - [`threads`]: a small study at several thread counts.
+//! - [`threads`]: a small study at several thread counts;
+//! - [`lean_inputs`]: the main job's runs for the lean reference (`bench/lean`).
 
 pub mod fidelity;
+pub mod lean_inputs;
 pub mod peer;
 pub mod problem;
 pub mod rhs;
