@@ -106,22 +106,10 @@ pub fn alarms_independent(
     horizon_revs: f64,
     alpha: f64,
 ) -> Result<AlarmCount, CompareError> {
-    let mut count = AlarmCount {
-        alarms: 0,
-        checks: 0,
-    };
-    for (i, base) in runs.iter().enumerate() {
-        for (j, other) in runs.iter().enumerate() {
-            let skip = i == j || (change == Planted::Nothing && j < i);
-            if skip {
-                continue;
-            }
-            let report = compare(base, &plant(other, change, horizon_revs), alpha)?;
-            count.alarms += usize::from(!report.passed());
-            count.checks += 1;
-        }
-    }
-    Ok(count)
+    let pairs = (0..runs.len())
+        .flat_map(|i| (0..runs.len()).map(move |j| (i, j)))
+        .filter(|&(i, j)| i != j && (change != Planted::Nothing || j > i));
+    count_alarms(runs, pairs, change, horizon_revs, alpha)
 }
 
 /// The check at `alpha` of every run against itself with `change` planted
@@ -132,12 +120,29 @@ pub fn alarms_paired(
     horizon_revs: f64,
     alpha: f64,
 ) -> Result<AlarmCount, CompareError> {
+    count_alarms(
+        runs,
+        (0..runs.len()).map(|i| (i, i)),
+        change,
+        horizon_revs,
+        alpha,
+    )
+}
+
+/// Check run `b` with `change` planted against run `a` for every (a, b).
+fn count_alarms(
+    runs: &[Vec<DesignSample>],
+    pairs: impl Iterator<Item = (usize, usize)>,
+    change: Planted,
+    horizon_revs: f64,
+    alpha: f64,
+) -> Result<AlarmCount, CompareError> {
     let mut count = AlarmCount {
         alarms: 0,
         checks: 0,
     };
-    for base in runs {
-        let report = compare(base, &plant(base, change, horizon_revs), alpha)?;
+    for (a, b) in pairs {
+        let report = compare(&runs[a], &plant(&runs[b], change, horizon_revs), alpha)?;
         count.alarms += usize::from(!report.passed());
         count.checks += 1;
     }
