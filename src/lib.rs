@@ -28,6 +28,7 @@
 // chains over several parallel arrays would hide them.
 #![allow(clippy::needless_range_loop)]
 
+pub mod build_info;
 pub mod check;
 pub mod claims;
 pub mod design;

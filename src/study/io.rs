@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 pub struct Provenance {
     /// autobal's version.
     pub version: String,
-    /// Git commit of the autobal source tree, when it can be found.
+    /// Git commit autobal was built from ("+dirty" with uncommitted
+    /// changes, "unknown" outside a git checkout): [`crate::build_info`].
     pub git_commit: String,
     /// SHA-256 of the study file's text (the text is the folder's `study.toml`).
     pub study_sha256: String,
@@ -29,7 +30,7 @@ impl Provenance {
     pub fn new(study_text: &str, seed: u64, shard: &str) -> Self {
         Provenance {
             version: env!("CARGO_PKG_VERSION").to_string(),
-            git_commit: git_commit(),
+            git_commit: crate::build_info::commit_label(),
             study_sha256: sha256_hex(study_text),
             seed,
             shard: shard.to_string(),
@@ -41,6 +42,7 @@ impl Provenance {
         vec![
             ("autobal_version".into(), self.version.clone()),
             ("git_commit".into(), self.git_commit.clone()),
+            ("build".into(), crate::build_info::VERSION_LINE.into()),
             ("study_sha256".into(), self.study_sha256.clone()),
             ("seed".into(), self.seed.to_string()),
             ("shard".into(), self.shard.clone()),
@@ -54,18 +56,6 @@ pub fn sha256_hex(text: &str) -> String {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect()
-}
-
-/// The commit of the source tree autobal was built from, or "unknown".
-fn git_commit() -> String {
-    std::process::Command::new("git")
-        .args(["-C", env!("CARGO_MANIFEST_DIR"), "rev-parse", "HEAD"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .and_then(|o| String::from_utf8(o.stdout).ok())
-        .map(|s| s.trim().to_string())
-        .unwrap_or_else(|| "unknown".into())
 }
 
 /// Temporary sibling path used while writing `path`.

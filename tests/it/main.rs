@@ -7,6 +7,7 @@ mod bench;
 mod check;
 mod claims;
 mod cli_design;
+mod cli_meta;
 mod cli_simulate;
 mod compare;
 mod contact;

@@ -380,6 +380,9 @@ fn provenance_is_stored_in_the_parquet_metadata() {
     assert_eq!(get("shard"), "all");
     assert_eq!(get("study_sha256"), autobal::study::io::sha256_hex(&text));
     assert_eq!(get("autobal_version"), env!("CARGO_PKG_VERSION"));
+    // The build that ran, as `study --version` says it.
+    assert_eq!(get("build"), autobal::build_info::VERSION_LINE);
+    assert_eq!(get("git_commit"), autobal::build_info::commit_label());
 }
 
 /// Runs spanning several row-group windows of `runs.parquet` (32 768 run ids

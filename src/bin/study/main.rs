@@ -11,6 +11,7 @@ mod criterion_cmd;
 mod design_cmd;
 mod linear_cmd;
 mod map_cmd;
+mod meta_cmd;
 mod optimize_cmd;
 mod output;
 mod plot_cmd;
@@ -19,14 +20,14 @@ mod simulate_cmd;
 mod sweep_cmd;
 mod tradeoff_cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Design passive auto-balancers by virtual experiment.
 #[derive(Parser)]
 #[command(
     name = "study",
-    version,
+    version = autobal::build_info::VERSION_LINE,
     about,
     long_about = None,
     after_help = "Exit codes: 0 done; 1 a run or a check failed (e.g. a regression, a solver that did not converge); 2 bad input or usage (the message names the key or flag), nothing written; 130 interrupted (finished runs saved; continue with --resume)."
@@ -86,6 +87,12 @@ enum Command {
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
+    /// Print a shell completion script (bash, zsh, fish, powershell, elvish).
+    #[command(after_help = meta_cmd::COMPLETIONS_EXAMPLES)]
+    Completions(meta_cmd::CompletionsArgs),
+    /// Print the man page (roff) of `study`.
+    #[command(after_help = meta_cmd::MAN_EXAMPLES)]
+    Man,
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -123,6 +130,8 @@ fn main() -> ExitCode {
         Command::Plot(args) => plot_cmd::run(&args),
         Command::Check(args) => check_cmd::check(&args),
         Command::Baseline(args) => check_cmd::baseline(&args),
+        Command::Completions(args) => meta_cmd::completions(&args, Cli::command()),
+        Command::Man => meta_cmd::man(Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

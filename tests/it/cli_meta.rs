@@ -1,0 +1,62 @@
+//! `study --version`, `study completions` and `study man`.
+
+use std::process::Command;
+
+fn study(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn version_names_the_commit_and_the_tree_state() {
+    let out = study(&["--version"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        text.trim(),
+        format!("study {}", autobal::build_info::VERSION_LINE)
+    );
+    assert!(text.starts_with(&format!("study {} (commit ", env!("CARGO_PKG_VERSION"))));
+    let tree = autobal::build_info::GIT_TREE;
+    assert!(["clean", "dirty", "unknown"].contains(&tree), "{tree}");
+    let commit = autobal::build_info::GIT_COMMIT;
+    // The build script asks git: in this checkout it knows the commit.
+    assert!(
+        commit == "unknown"
+            || (commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit())),
+        "{commit}"
+    );
+}
+
+#[test]
+fn completions_cover_every_shell_and_every_verb() {
+    for shell in ["bash", "zsh", "fish", "powershell", "elvish"] {
+        let out = study(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        let script = String::from_utf8(out.stdout).unwrap();
+        for verb in ["run", "compare", "check", "completions", "man"] {
+            assert!(script.contains(verb), "{shell}: no {verb}");
+        }
+    }
+    let out = study(&["completions", "tcsh"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("tcsh"));
+}
+
+#[test]
+fn the_man_page_is_roff_with_the_version_and_the_verbs() {
+    let out = study(&["man"]);
+    assert!(out.status.success());
+    let page = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        page.contains(".TH study 1"),
+        "{}",
+        &page[..200.min(page.len())]
+    );
+    assert!(page.contains(autobal::build_info::GIT_COMMIT));
+    for verb in ["run", "merge", "compare", "check", "completions"] {
+        assert!(page.contains(verb), "no {verb}");
+    }
+}
