@@ -428,3 +428,44 @@ fn runs_spanning_several_windows_are_the_same_however_split() {
     let merged = autobal::study::merge::merge(&dirs, None, false).unwrap();
     assert!(reference.equals_missing(&stable(&merged.dir.join("runs.parquet"))));
 }
+
+/// In a batch log (stderr not a terminal) `study run` says every few
+/// seconds how far it is, and says nothing with `--quiet`.
+#[test]
+fn a_batch_log_shows_progress_lines_and_quiet_silences_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("small.toml");
+    std::fs::write(&file, small_study(tmp.path(), 6, "")).unwrap();
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .arg("run")
+            .arg(&file)
+            .args(["--overwrite", "--threads", "1"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--progress-every", "0.000001"]);
+    assert!(out.status.success());
+    let log = String::from_utf8_lossy(&out.stderr);
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("progress: "))
+        .unwrap_or_else(|| panic!("no progress line in {log}"));
+    for part in ["/12 runs", "runs/s", "ETA", "settled", "failures 0"] {
+        assert!(line.contains(part), "{part}: {line}");
+    }
+    assert!(
+        log.lines().any(|l| l.starts_with("finished: 12 runs in ")),
+        "{log}"
+    );
+    let quiet = run(&["--quiet", "--progress-every", "0.000001"]);
+    let log = String::from_utf8_lossy(&quiet.stderr);
+    assert!(
+        !log.contains("progress:") && !log.contains("finished:"),
+        "{log}"
+    );
+    let bad = run(&["--progress-every", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--progress-every"));
+}

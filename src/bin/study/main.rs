@@ -15,6 +15,7 @@ mod meta_cmd;
 mod optimize_cmd;
 mod output;
 mod plot_cmd;
+mod progress;
 mod run_cmd;
 mod simulate_cmd;
 mod sweep_cmd;

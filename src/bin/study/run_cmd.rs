@@ -2,18 +2,16 @@
 
 use crate::UserError;
 use crate::output::{p_value_text, text_table};
-use autobal::metrics::Outcome;
+use crate::progress::RunProgress;
 use autobal::study::config::load;
 use autobal::study::merge::merge;
-use autobal::study::record::RunRecord;
-use autobal::study::run::{AdaptiveOutcome, Progress, RunError, RunOptions, Shard, run_study};
+use autobal::study::run::{AdaptiveOutcome, RunError, RunOptions, Shard, run_study};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use polars::prelude::DataFrame;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
 
 /// Examples shown under `study run --help`.
 pub const RUN_EXAMPLES: &str = "Examples:
@@ -44,9 +42,12 @@ pub struct RunArgs {
     /// Worker threads (default: all cores, or RAYON_NUM_THREADS).
     #[arg(long)]
     threads: Option<usize>,
-    /// No progress bar.
+    /// No progress output (a bar on a terminal, else a line every --progress-every seconds).
     #[arg(long)]
     quiet: bool,
+    /// Seconds between two progress lines when stderr is not a terminal (a batch log).
+    #[arg(long, default_value_t = 30.0)]
+    progress_every: f64,
     /// Write finished runs to disk after this many, or every 2 s, whichever comes first.
     #[arg(long, default_value_t = 4096)]
     chunk_runs: usize,
@@ -64,54 +65,6 @@ pub struct MergeArgs {
     /// Replace merged results already in the output folder.
     #[arg(long)]
     overwrite: bool,
-}
-
-/// indicatif progress bar on stderr: runs done, rate, ETA, failures so far.
-struct Bar {
-    bar: ProgressBar,
-    failures: AtomicU64,
-}
-
-impl Bar {
-    fn new(quiet: bool) -> Self {
-        let bar = ProgressBar::with_draw_target(
-            None,
-            if quiet {
-                ProgressDrawTarget::hidden()
-            } else {
-                ProgressDrawTarget::stderr()
-            },
-        );
-        bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {per_sec}  ETA {eta}  {msg}")
-                .expect("valid template"),
-        );
-        Bar {
-            bar,
-            failures: AtomicU64::new(0),
-        }
-    }
-}
-
-impl Progress for Bar {
-    fn begin(&self, total: u64, done: u64) {
-        self.bar.set_length(total);
-        self.bar.set_position(done);
-        self.bar.set_message("failures 0");
-    }
-    fn advance(&self, record: &RunRecord) {
-        if matches!(
-            record.metrics.outcome,
-            Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded
-        ) {
-            let f = self.failures.fetch_add(1, Ordering::Relaxed) + 1;
-            self.bar.set_message(format!("failures {f}"));
-        }
-        self.bar.inc(1);
-    }
-    fn end(&self) {
-        self.bar.finish_and_clear();
-    }
 }
 
 /// Run `study run`.
@@ -158,7 +111,16 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         threads,
         ..RunOptions::default()
     };
-    let bar = Bar::new(args.quiet);
+    if !(args.progress_every.is_finite() && args.progress_every > 0.0) {
+        return Err(UserError(
+            format!(
+                "--progress-every {}: seconds between progress lines, a positive number",
+                args.progress_every
+            ),
+            2,
+        ));
+    }
+    let bar = RunProgress::new(args.quiet, Duration::from_secs_f64(args.progress_every));
     let output = run_study(&plan, &options, &bar).map_err(|e| {
         if matches!(e, RunError::Interrupted { .. }) {
             UserError(e.to_string(), 130)

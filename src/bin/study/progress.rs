@@ -1,0 +1,171 @@
+//! How `study run` shows that it is alive: a progress bar on a terminal, a
+//! line every few seconds in a batch log (stderr not a terminal: a Slurm or
+//! Kubernetes log would otherwise show nothing until the end), nothing with
+//! `--quiet`.
+
+use autobal::metrics::Outcome;
+use autobal::study::record::RunRecord;
+use autobal::study::run::Progress;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// Where progress goes.
+pub enum Reporter {
+    /// indicatif bar on a terminal.
+    Bar(ProgressBar),
+    /// One line on stderr every `every`.
+    Log {
+        /// Time between two lines.
+        every: Duration,
+        /// When the run began, and when the last line was printed.
+        clock: Mutex<(Instant, Instant)>,
+    },
+    /// Nothing.
+    Quiet,
+}
+
+/// Counters shared by the worker threads, and the reporter.
+pub struct RunProgress {
+    reporter: Reporter,
+    total: AtomicU64,
+    /// Runs finished before this invocation (a resumed run).
+    earlier: AtomicU64,
+    done: AtomicU64,
+    settled: AtomicU64,
+    failures: AtomicU64,
+}
+
+impl RunProgress {
+    /// A bar when stderr is a terminal, else log lines every `every`;
+    /// nothing when `quiet`.
+    pub fn new(quiet: bool, every: Duration) -> Self {
+        let reporter = if quiet {
+            Reporter::Quiet
+        } else if std::io::stderr().is_terminal() {
+            let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} {wide_bar} {pos}/{len} runs  {per_sec}  ETA {eta}  {msg}",
+                )
+                .expect("valid template"),
+            );
+            Reporter::Bar(bar)
+        } else {
+            let now = Instant::now();
+            Reporter::Log {
+                every,
+                clock: Mutex::new((now, now)),
+            }
+        };
+        RunProgress {
+            reporter,
+            total: AtomicU64::new(0),
+            earlier: AtomicU64::new(0),
+            done: AtomicU64::new(0),
+            settled: AtomicU64::new(0),
+            failures: AtomicU64::new(0),
+        }
+    }
+
+    /// "done/total runs (p %), r runs/s, ETA …, settled s % so far, failures f".
+    fn line(&self, elapsed: Duration) -> String {
+        let total = self.total.load(Ordering::Relaxed);
+        let earlier = self.earlier.load(Ordering::Relaxed);
+        let done = self.done.load(Ordering::Relaxed);
+        let settled = self.settled.load(Ordering::Relaxed);
+        let finished = earlier + done;
+        let rate = done as f64 / elapsed.as_secs_f64().max(1e-9);
+        let eta = if rate > 0.0 {
+            hms((total.saturating_sub(finished)) as f64 / rate)
+        } else {
+            "–".into()
+        };
+        let settled_share = if done > 0 {
+            format!("{:.1} %", 100.0 * settled as f64 / done as f64)
+        } else {
+            "–".into()
+        };
+        format!(
+            "progress: {finished}/{total} runs ({:.1} %), {rate:.0} runs/s, elapsed {}, ETA {eta}, settled {settled_share} so far, failures {}",
+            100.0 * finished as f64 / total.max(1) as f64,
+            hms(elapsed.as_secs_f64()),
+            self.failures.load(Ordering::Relaxed)
+        )
+    }
+}
+
+/// Seconds as h:mm:ss.
+fn hms(seconds: f64) -> String {
+    let s = seconds.round() as u64;
+    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+}
+
+impl Progress for RunProgress {
+    fn begin(&self, total: u64, done: u64) {
+        self.total.store(total, Ordering::Relaxed);
+        self.earlier.store(done, Ordering::Relaxed);
+        if let Reporter::Bar(bar) = &self.reporter {
+            bar.set_length(total);
+            bar.set_position(done);
+            bar.set_message("failures 0");
+        }
+    }
+
+    fn advance(&self, record: &RunRecord) {
+        self.done.fetch_add(1, Ordering::Relaxed);
+        if record.metrics.settled {
+            self.settled.fetch_add(1, Ordering::Relaxed);
+        }
+        let failed = matches!(
+            record.metrics.outcome,
+            Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded
+        );
+        if failed {
+            self.failures.fetch_add(1, Ordering::Relaxed);
+        }
+        match &self.reporter {
+            Reporter::Bar(bar) => {
+                if failed {
+                    let f = self.failures.load(Ordering::Relaxed);
+                    bar.set_message(format!("failures {f}"));
+                }
+                bar.inc(1);
+            }
+            Reporter::Log { every, clock } => {
+                // try_lock: a worker never waits for another one's printing.
+                if let Ok(mut clock) = clock.try_lock() {
+                    let now = Instant::now();
+                    if now - clock.1 >= *every {
+                        clock.1 = now;
+                        eprintln!("{}", self.line(now - clock.0));
+                    }
+                }
+            }
+            Reporter::Quiet => {}
+        }
+    }
+
+    fn end(&self) {
+        match &self.reporter {
+            Reporter::Bar(bar) => bar.finish_and_clear(),
+            Reporter::Log { clock, .. } => {
+                let start = clock.lock().map_or_else(|e| e.into_inner().0, |c| c.0);
+                let elapsed = start.elapsed();
+                let done = self.done.load(Ordering::Relaxed);
+                let settled = self.settled.load(Ordering::Relaxed);
+                eprintln!(
+                    "finished: {} runs in {} ({:.0} runs/s), settled {:.1} %, failures {}",
+                    done,
+                    hms(elapsed.as_secs_f64()),
+                    done as f64 / elapsed.as_secs_f64().max(1e-9),
+                    100.0 * settled as f64 / done.max(1) as f64,
+                    self.failures.load(Ordering::Relaxed)
+                );
+            }
+            Reporter::Quiet => {}
+        }
+    }
+}
