@@ -21,7 +21,14 @@ fn git(args: &[&str]) -> Option<String> {
 }
 
 fn main() {
-    let commit = git(&["rev-parse", "HEAD"]).unwrap_or_else(|| "unknown".into());
+    // A build without git (e.g. in a container) can be told the commit.
+    println!("cargo:rerun-if-env-changed=AUTOBAL_BUILD_COMMIT");
+    let given = std::env::var("AUTOBAL_BUILD_COMMIT")
+        .ok()
+        .filter(|c| !c.is_empty() && c != "unknown");
+    let commit = git(&["rev-parse", "HEAD"])
+        .or(given)
+        .unwrap_or_else(|| "unknown".into());
     let tree = match git(&["status", "--porcelain", "--untracked-files=no"]) {
         Some(changes) if changes.is_empty() => "clean",
         Some(_) => "dirty",
