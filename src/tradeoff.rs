@@ -9,11 +9,11 @@
 use crate::integrate::Method;
 use crate::metrics::RunMetrics;
 use crate::model::frame::rotating_frame_obstacle;
-use crate::simulation::{Fidelity, MethodChoice, Simulation};
+use crate::simulation::{Fidelity, MethodChoice};
 use crate::stats::quantile::{Interpolation, quantile_sorted};
 use crate::study::config::StudyPlan;
 use crate::study::io::{Provenance, write_parquet};
-use crate::study::sample::draw_sample;
+use crate::study::run::sample_simulation;
 use polars::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
@@ -127,21 +127,13 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
 fn simulate(plan: &StudyPlan, run_id: u64, setting: Setting) -> (RunMetrics, f64) {
     let samples = u64::from(plan.file.sampling.samples);
     let design = &plan.designs[(run_id / samples) as usize];
-    let sample = draw_sample(plan, design, run_id % samples);
-    let mut solver = plan.file.solver.clone();
-    solver.fidelity = setting.fidelity;
-    solver.method = setting.method;
+    let (_, mut sim) = sample_simulation(plan, design, run_id % samples);
+    sim.solver.fidelity = setting.fidelity;
+    sim.solver.method = setting.method;
     if setting.rtol > 0.0 {
-        solver.rtol = setting.rtol;
-        solver.atol = None;
+        sim.solver.rtol = setting.rtol;
+        sim.solver.atol = None;
     }
-    let sim = Simulation {
-        scene: plan.scene(design, sample.unbalance, sample.direction),
-        start: plan.file.scene.start,
-        initial_angles: sample.initial_angles,
-        solver,
-        metrics: plan.file.metrics.clone(),
-    };
     let clock = Instant::now();
     let metrics = match sim.run(false) {
         Ok(r) => r.metrics,

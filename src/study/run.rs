@@ -13,7 +13,7 @@ use super::io::{Provenance, read_parquet, sha256_hex, write_parquet, write_text}
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
-use super::sample::draw_sample;
+use super::sample::{Sample, draw_sample};
 use crate::metrics::{Outcome, RunMetrics};
 use crate::simulation::Simulation;
 use polars::prelude::{ChunkCompareIneq, DataFrame, PolarsError, PolarsResult};
@@ -255,6 +255,25 @@ pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
     run_design_sample(plan, design, run_id % samples, run_id)
 }
 
+/// Sample `sample_id` of `design` and the simulation a study runs for it
+/// (the plan's start, solver and metric settings); the one place a run's
+/// inputs are assembled.
+pub fn sample_simulation(
+    plan: &StudyPlan,
+    design: &Design,
+    sample_id: u64,
+) -> (Sample, Simulation) {
+    let sample = draw_sample(plan, design, sample_id);
+    let simulation = Simulation {
+        scene: plan.scene(design, sample.unbalance, sample.direction),
+        start: plan.file.scene.start,
+        initial_angles: sample.initial_angles.clone(),
+        solver: plan.file.solver.clone(),
+        metrics: plan.file.metrics.clone(),
+    };
+    (sample, simulation)
+}
+
 /// Execute sample `sample_id` of any design (also one outside the plan's grid,
 /// as the optimiser's candidates are), recorded under `run_id`.
 pub fn run_design_sample(
@@ -263,16 +282,13 @@ pub fn run_design_sample(
     sample_id: u64,
     run_id: u64,
 ) -> RunRecord {
-    let sample = draw_sample(plan, design, sample_id);
-    let scene = plan.scene(design, sample.unbalance, sample.direction);
-    let contact = scene.effects.contact.as_ref().is_some_and(|c| c.enabled);
-    let simulation = Simulation {
-        scene,
-        start: plan.file.scene.start,
-        initial_angles: sample.initial_angles.clone(),
-        solver: plan.file.solver.clone(),
-        metrics: plan.file.metrics.clone(),
-    };
+    let (sample, simulation) = sample_simulation(plan, design, sample_id);
+    let contact = simulation
+        .scene
+        .effects
+        .contact
+        .as_ref()
+        .is_some_and(|c| c.enabled);
     let clock = Instant::now();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| simulation.run(false)));
     let metrics = match result {

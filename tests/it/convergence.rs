@@ -8,7 +8,6 @@
 use autobal::integrate::Method;
 use autobal::simulation::{MethodChoice, Simulation};
 use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::sample::draw_sample;
 use std::path::PathBuf;
 
 fn plan(name: &str) -> StudyPlan {
@@ -23,15 +22,7 @@ fn plan(name: &str) -> StudyPlan {
 
 /// The first sample of the first design, as `study run` would simulate it.
 fn simulation(plan: &StudyPlan) -> Simulation {
-    let design = &plan.designs[0];
-    let sample = draw_sample(plan, design, 0);
-    Simulation {
-        scene: plan.scene(design, sample.unbalance, sample.direction),
-        start: plan.file.scene.start,
-        initial_angles: sample.initial_angles,
-        solver: plan.file.solver.clone(),
-        metrics: plan.file.metrics.clone(),
-    }
+    autobal::study::run::sample_simulation(plan, &plan.designs[0], 0).1
 }
 
 fn at(sim: &Simulation, method: Method, rtol: f64, atol: Option<f64>) -> (f64, Option<f64>) {

@@ -17,8 +17,7 @@ use autobal::model::frame::RotatingSystem;
 use autobal::model::rotor::PlaneRotor;
 use autobal::simulation::{Fidelity, Simulation, scaled_atol};
 use autobal::study::config::{Design, StudyPlan};
-use autobal::study::run::run_design_sample;
-use autobal::study::sample::draw_sample;
+use autobal::study::run::{run_design_sample, sample_simulation};
 use std::f64::consts::PI;
 use std::io::Write;
 use std::path::Path;
@@ -147,14 +146,7 @@ pub fn lean_rows(plan: &StudyPlan) -> Result<Vec<LeanRow>, String> {
 
 /// The simulation `run_design_sample` builds for this sample.
 pub fn simulation_of(plan: &StudyPlan, design: &Design, sample_id: u64) -> Simulation {
-    let sample = draw_sample(plan, design, sample_id);
-    Simulation {
-        scene: plan.scene(design, sample.unbalance, sample.direction),
-        start: plan.file.scene.start,
-        initial_angles: sample.initial_angles,
-        solver: plan.file.solver.clone(),
-        metrics: plan.file.metrics.clone(),
-    }
+    sample_simulation(plan, design, sample_id).1
 }
 
 /// One run as a row; errors when the run does not use the rotating frame
