@@ -6,7 +6,9 @@
 //! however often the run is interrupted and resumed.
 
 use super::config::{StopWhen, StudyPlan};
-use super::verdict::{DesignRuns, LEVEL, best_versus_rest, design_runs, settling_horizon};
+use super::verdict::{
+    DesignRuns, LEVEL, best_versus_rest, design_runs, restricted_horizon, settling_horizon,
+};
 use crate::stats::survival::Transform;
 use polars::prelude::*;
 use std::ops::Range;
@@ -48,8 +50,9 @@ pub struct Precision {
 /// The precision of the runs in `df` (the columns of
 /// [`super::runs_file::SUMMARY_COLUMNS`]) against `stop`.
 pub fn precision(plan: &StudyPlan, stop: &StopWhen, df: &DataFrame) -> PolarsResult<Precision> {
-    let horizon = settling_horizon(plan);
-    let designs = design_runs(df, horizon)?;
+    let designs = design_runs(df, settling_horizon(plan))?;
+    // The same horizon as the summary's verdicts, so the same best design.
+    let horizon = restricted_horizon(plan, &designs);
     let mut worst = Vec::new();
     if let Some(target) = stop.median_halfwidth_rel {
         worst.push(("median_halfwidth_rel", median_halfwidth(&designs), target));

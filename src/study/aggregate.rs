@@ -9,7 +9,9 @@
 
 use super::config::StudyPlan;
 use super::record::{RunRecord, to_dataframe};
-use super::verdict::{BestVersusRest, LEVEL, best_versus_rest, design_runs, settling_horizon};
+use super::verdict::{
+    BestVersusRest, LEVEL, best_versus_rest, design_runs, restricted_horizon, settling_horizon,
+};
 use crate::model::gap::GapGauge;
 use crate::stats::interval::wilson_interval;
 use crate::stats::quantile::{Interpolation, quantile_sorted};
@@ -53,11 +55,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
     let design_col = df.column("design_id")?.u32()?.clone();
     let mut rows = SummaryColumns::default();
     let by_design = design_runs(df, settling_horizon(plan))?;
-    // The restricted mean is taken up to the latest time any run could show.
-    let horizon = by_design
-        .iter()
-        .flat_map(|d| d.settling.iter().map(|o| o.time))
-        .fold(settling_horizon(plan), f64::max);
+    let horizon = restricted_horizon(plan, &by_design);
     let verdicts = best_versus_rest(
         &by_design,
         horizon,

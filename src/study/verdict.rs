@@ -46,6 +46,16 @@ pub fn settling_horizon(plan: &StudyPlan) -> f64 {
     plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs
 }
 
+/// The time the restricted mean is taken up to, and the best design chosen
+/// by: the latest time any run of `designs` could show (the plan's horizon,
+/// or a later settling time).
+pub fn restricted_horizon(plan: &StudyPlan, designs: &[DesignRuns]) -> f64 {
+    designs
+        .iter()
+        .flat_map(|d| d.settling.iter().map(|o| o.time))
+        .fold(settling_horizon(plan), f64::max)
+}
+
 /// Every design's runs from a runs table holding the columns of
 /// [`super::runs_file::SUMMARY_COLUMNS`], in design order (designs without
 /// runs are left out).
