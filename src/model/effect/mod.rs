@@ -11,6 +11,7 @@
 pub mod contact;
 pub mod drag;
 pub mod gravity;
+pub mod rolling;
 
 use super::cargo::Cargo;
 use super::rotor::DofVec;
@@ -146,6 +147,9 @@ effect_registry! {
         /// other, as the analytic theory assumes).
         #[serde(default = "effect_on")]
         contact: contact::ContactSpec,
+        /// Rolling resistance (pivot friction for pendulums): absent, none.
+        #[serde(default)]
+        rolling_resistance: rolling::RollingResistance,
     },
 }
 
