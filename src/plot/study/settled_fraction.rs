@@ -5,7 +5,7 @@ use super::labels::{
     Labels, category_height, category_label, category_y, geometries, label_width, labels,
 };
 use crate::plot::PlotError;
-use crate::plot::style::{self, Figure, TICK, colour, linear_label, text};
+use crate::plot::style::{self, Figure, TICK, linear_label, point_style, text};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -67,11 +67,11 @@ impl Figure for SettledFraction<'_> {
             }
         );
         let title = format!("{}: fraction of runs that settled", self.data.name);
-        let body = root.titled(&title, text(style::TITLE))?;
+        let body = style::titled(root, &title)?;
+        let body = style::text_block(&body, &caption, TICK)?;
         let key_points: Vec<f64> = (0..count).map(|i| i as f64).collect();
         let label = category_label(&self.labels.per_design);
         let mut chart = ChartBuilder::on(&body)
-            .caption(caption, text(TICK))
             .margin(16)
             .margin_right(30)
             .x_label_area_size(52)
@@ -100,7 +100,8 @@ impl Figure for SettledFraction<'_> {
         let (group, _) = geometries(designs);
         for (i, d) in designs.iter().enumerate() {
             let y = category_y(i, count);
-            let c = colour(group[i]);
+            let look = point_style(group[i]);
+            let c = look.colour;
             let h = 0.22;
             chart.draw_series([
                 PathElement::new(
@@ -116,7 +117,8 @@ impl Figure for SettledFraction<'_> {
                     c.stroke_width(2),
                 ),
             ])?;
-            chart.draw_series([Circle::new((d.settled_fraction, y), 5, c.filled())])?;
+            chart.draw_series([EmptyElement::at((d.settled_fraction, y))
+                + style::marker(look.marker, 6, c.filled())])?;
         }
         Ok(())
     }
