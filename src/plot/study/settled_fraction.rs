@@ -44,13 +44,19 @@ impl Figure for SettledFraction<'_> {
         let designs = &self.data.designs;
         let count = designs.len();
         let lowest = designs.iter().map(|d| d.settled_lo).fold(1.0f64, f64::min);
-        // Zoom in when every design settles nearly always, or the intervals vanish.
-        let x_lo = ((lowest - 0.02) * 10.0).floor().max(0.0) / 10.0;
-        let x_lo = if x_lo > 0.9 {
-            ((lowest - 0.005) * 100.0).floor() / 100.0
+        // Zoom in when every design settles nearly always, or the intervals
+        // vanish: the axis starts a step below the lowest interval, the step
+        // fitting the spread (it started at 0.9 for intervals all above 0.97,
+        // leaving most of the figure empty).
+        let spread = 1.0 - lowest;
+        let step = if spread > 0.3 {
+            0.1
+        } else if spread > 0.1 {
+            0.05
         } else {
-            x_lo
+            0.01
         };
+        let x_lo = (((lowest - 0.1 * spread - 0.002) / step).floor() * step).max(0.0);
         let runs: Vec<u64> = designs.iter().map(|d| d.runs).collect();
         let runs_text = if runs.iter().all(|r| *r == runs[0]) {
             format!("{} runs per design", runs[0])
