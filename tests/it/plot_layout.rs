@@ -388,6 +388,30 @@ fn every_figure_keeps_its_text_inside_and_apart() {
         plot_kaplan_meier(&curves, "Kaplan–Meier: fraction of runs settled by t", p)
     });
 
+    // A label longer than the figure is wide, and the smaller variants.
+    let long = vec![
+        KmCurve {
+            label: format!("A: {}", "a design with a very long description, ".repeat(6)),
+            ..curves[0].clone()
+        },
+        curves[1].clone(),
+    ];
+    check("km_long_label", &dir, &mut defects, |p| {
+        plot_kaplan_meier(&long, "two designs", p)
+    });
+    check("design_rollers", &dir, &mut defects, |p| {
+        plot_design(&[Shape::Roller], &[2, 3, 4, 5], p)
+    });
+    let unsettled = metrics(false, 0.0);
+    let run_unsettled = RunFigure {
+        metrics: &unsettled,
+        title: "did not settle",
+        ..run
+    };
+    check("run_unsettled", &dir, &mut defects, |p| {
+        plot_run(&run_unsettled, p)
+    });
+
     assert!(
         defects.is_empty(),
         "{} layout defects:\n{}",
