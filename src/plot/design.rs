@@ -135,8 +135,9 @@ fn draw_capacity<DB: DrawingBackend>(
         .draw()?;
     let mut placer = style::LabelPlacer::left_first();
     let bounds = style::plot_bounds(&chart);
-    for (i, (_, points)) in c.curves.iter().enumerate() {
+    for (i, (n, points)) in c.curves.iter().enumerate() {
         draw_line(&mut chart, points, series_style(i), 2)?;
+        style::note_series(format!("n = {n}"), series_style(i));
     }
     // Direct labels: a legend of eight colours is slower to read than "n" at
     // each peak. The optima of large n crowd together, so each label takes a

@@ -233,10 +233,17 @@ thread_local! {
     static LEGEND_STYLES: RefCell<Vec<(String, SeriesStyle)>> = const { RefCell::new(Vec::new()) };
 }
 
-/// The label and look of every series legend entry of the last figure
-/// rendered on this thread, so that a test can check none look alike.
+/// The label and look of every series of the last figure rendered on this
+/// thread (legend entries and directly labelled series), so that a test can
+/// check that no two different series look alike.
 pub fn legend_styles() -> Vec<(String, SeriesStyle)> {
     LEGEND_STYLES.with(|l| l.borrow().clone())
+}
+
+/// Note a series that is labelled on the plot rather than in a legend, so
+/// that [`legend_styles`] sees it too.
+pub fn note_series(label: impl Into<String>, look: SeriesStyle) {
+    LEGEND_STYLES.with(|l| l.borrow_mut().push((label.into(), look)));
 }
 
 /// Register the embedded font with plotters once per process.
@@ -532,7 +539,7 @@ pub fn legend<DB: DrawingBackend>(
             style.pos(Pos::new(HPos::Left, VPos::Center)),
         ))?;
         if let Swatch::Series(s) | Swatch::Point(s) = kind {
-            LEGEND_STYLES.with(|l| l.borrow_mut().push((entries[i].0.clone(), s)));
+            note_series(entries[i].0.clone(), s);
         }
     }
     Ok(rest)

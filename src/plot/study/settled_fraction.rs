@@ -103,10 +103,11 @@ impl Figure for SettledFraction<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
-        let (group, _) = geometries(designs);
+        let (group, names) = geometries(designs);
         for (i, d) in designs.iter().enumerate() {
             let y = category_y(i, count);
             let look = point_style(group[i]);
+            style::note_series(names[group[i]].clone(), look);
             let c = look.colour;
             let h = 0.22;
             chart.draw_series([

@@ -154,7 +154,7 @@ impl Figure for SettlingBoxes<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
-        let (group, _) = geometries(designs);
+        let (group, names) = geometries(designs);
         for (i, b) in boxes.iter().enumerate() {
             let y = category_y(i, count);
             let look = point_style(group[i]);
@@ -179,6 +179,7 @@ impl Figure for SettlingBoxes<'_> {
                 marker: style::Marker::None,
                 ..series_style(group[i])
             };
+            style::note_series(names[group[i]].clone(), outline_look);
             // Past the last settling the box runs off the right edge, open.
             let right = b.q3.unwrap_or(hi);
             let mut lines = Vec::new();
