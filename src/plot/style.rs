@@ -229,7 +229,7 @@ where
 pub const REFERENCE: RGBColor = RGBColor(90, 90, 90);
 
 thread_local! {
-    /// Series looks in the legends of the figure being drawn on this thread.
+    /// Series looks of the figure being drawn on this thread (legends and noted series).
     static LEGEND_STYLES: RefCell<Vec<(String, SeriesStyle)>> = const { RefCell::new(Vec::new()) };
 }
 
@@ -461,12 +461,13 @@ fn fit_label<DB: DrawingBackend>(
     Ok(("…".into(), width("…")?))
 }
 
-/// How the entries of a legend sit in `width` pixels: one centred row when
-/// they fit, else a grid of equal columns (labels too wide for the figure
-/// are shortened); returns (label, width) per entry, the column width
-/// (0 for a single row) and the number of rows.
+/// (label, width) per entry, the column width (0 for a single row) and the
+/// number of rows.
 type LegendLayout = (Vec<(String, i32)>, i32, usize);
 
+/// How the entries of a legend sit across `area`: one centred row when they
+/// fit, else a grid of equal columns (labels too wide for the figure are
+/// shortened).
 fn legend_layout<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(String, Swatch)],
