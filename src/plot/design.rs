@@ -2,7 +2,7 @@
 //! optima marked, and the transient measure ã(n) at those optima (Fig. 7).
 
 use super::PlotError;
-use super::style::{self, Figure, Swatch, TICK, colour, short, text};
+use super::style::{self, Figure, Swatch, TICK, colour, draw_line, series_style, short, text};
 use crate::design::Shape;
 use crate::design::capacity::dimensionless_capacity;
 use crate::design::geometry::rho_max;
@@ -80,9 +80,9 @@ impl Figure for DesignFigure {
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
-        let body = root.titled(
+        let body = style::titled(
+            root,
             "Design curves (seed 000): capacity and speed of balancing",
-            text(style::TITLE),
         )?;
         let rows = body.split_evenly((self.shapes.len(), 1));
         for (row, shape) in rows.iter().zip(&self.shapes) {
@@ -133,18 +133,42 @@ fn draw_capacity<DB: DrawingBackend>(
         .light_line_style(WHITE.mix(0.0))
         .bold_line_style(BLACK.mix(0.08))
         .draw()?;
-    for (i, ((n, points), row)) in c.curves.iter().zip(&c.rows).enumerate() {
-        let col = colour(i);
-        chart.draw_series(LineSeries::new(points.iter().copied(), col.stroke_width(2)))?;
-        // Direct labels: a legend of eight colours is slower to read than "n" at each peak.
-        chart.draw_series([EmptyElement::at((row.rho_opt, row.s))
+    let mut placer = style::LabelPlacer::left_first();
+    let bounds = style::plot_bounds(&chart);
+    for (i, (n, points)) in c.curves.iter().enumerate() {
+        draw_line(&mut chart, points, series_style(i), 2)?;
+        style::note_series(format!("n = {n}"), series_style(i));
+    }
+    // Direct labels: a legend of eight colours is slower to read than "n" at
+    // each peak. The optima of large n crowd together, so each label takes a
+    // free spot beside its dot, or is left out (its dot and colour remain).
+    let optima: Vec<_> = c
+        .curves
+        .iter()
+        .zip(&c.rows)
+        .enumerate()
+        .map(|(i, ((n, _), row))| (i, *n, (row.rho_opt, row.s)))
+        .collect();
+    for &(_, _, at) in &optima {
+        let p = chart.backend_coord(&at);
+        placer.reserve((p.0 - 6, p.1 - 6, p.0 + 6, p.1 + 6));
+    }
+    let label_style = text(TICK);
+    for (i, n, at) in optima {
+        let col = series_style(i).colour;
+        chart.draw_series([EmptyElement::at(at)
             + Circle::new((0, 0), 5, col.filled())
-            + Circle::new((0, 0), 5, BLACK.stroke_width(1))
-            + Text::new(
-                n.to_string(),
-                (-3, -8),
-                text(TICK).pos(Pos::new(HPos::Right, VPos::Bottom)),
-            )])?;
+            + Circle::new((0, 0), 5, BLACK.stroke_width(1))])?;
+        let label = n.to_string();
+        let size = area.estimate_text_size(&label, &label_style)?;
+        if let Some(offset) = placer.place(chart.backend_coord(&at), size, bounds) {
+            chart.draw_series([EmptyElement::at(at)
+                + Text::new(
+                    label,
+                    offset,
+                    label_style.pos(Pos::new(HPos::Left, VPos::Top)),
+                )])?;
+        }
     }
     Ok(())
 }

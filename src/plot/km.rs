@@ -4,7 +4,9 @@
 //! every run counts and a curve stops below 1 when some runs did not settle.
 
 use super::PlotError;
-use super::style::{self, Figure, REFERENCE, Swatch, TICK, colour, linear_label, log_ticks, text};
+use super::style::{
+    self, Figure, REFERENCE, Swatch, TICK, draw_line, linear_label, log_ticks, series_style, text,
+};
 use crate::stats::survival::{Interval, KaplanMeier, Observation, Transform};
 use crate::study::verdict::LEVEL;
 use plotters::coord::Shift;
@@ -136,7 +138,7 @@ impl Figure for KmFigure<'_> {
         let ends = self.fitted.iter().map(|f| f.end);
         let (lo, hi) = style::log_extent(first.chain(ends), 1.15)
             .ok_or_else(|| PlotError::NoData("no positive time".into()))?;
-        let body = root.titled(self.title, text(style::TITLE))?;
+        let body = style::titled(root, self.title)?;
         let legend: Vec<(String, Swatch)> = self
             .fitted
             .iter()
@@ -145,17 +147,16 @@ impl Figure for KmFigure<'_> {
                 let n = f.km.n_observations();
                 let unsettled = f.curve.observations.iter().filter(|o| !o.settled).count();
                 let label = format!("{}  ({n} runs, {unsettled} not settled)", f.curve.label);
-                (label, Swatch::Line(colour(i)))
+                (label, Swatch::Series(series_style(i)))
             })
             .collect();
         let caption = format!(
             "every run counted; shaded: {:.0} % pointwise band (log-log); ticks: runs censored unsettled; dashed: ½, where the median reads off",
             100.0 * LEVEL
         );
-        let (strip, area) = body.split_vertically(34);
-        style::legend_row(&strip, &legend)?;
+        let area = style::legend(&body, &legend)?;
+        let area = style::text_block(&area, &caption, TICK)?;
         let mut chart = ChartBuilder::on(&area)
-            .caption(caption, text(TICK))
             .margin(16)
             .margin_top(4)
             .margin_right(30)
@@ -185,7 +186,7 @@ impl Figure for KmFigure<'_> {
         // Time 0 cannot sit on a log axis; the curve starts at its left edge.
         let x = |t: f64| t.clamp(lo, hi);
         for (i, f) in self.fitted.iter().enumerate() {
-            let c = colour(i);
+            let c = series_style(i).colour;
             chart.draw_series(settled_band(&f.km, f.end).into_iter().map(|(a, b, iv)| {
                 Rectangle::new([(x(a), iv.lower), (x(b), iv.upper)], c.mix(0.18).filled())
             }))?;
@@ -199,25 +200,35 @@ impl Figure for KmFigure<'_> {
         let mut horizons: Vec<f64> = self.fitted.iter().map(|f| f.curve.horizon).collect();
         horizons.sort_by(f64::total_cmp);
         horizons.dedup();
-        for h in horizons {
+        let first_horizon = horizons.first().copied().unwrap_or(hi);
+        for (k, h) in horizons.iter().enumerate() {
+            let h = *h;
             chart.draw_series([PathElement::new(
                 vec![(x(h), 0.0), (x(h), 1.02)],
                 REFERENCE.stroke_width(2),
             )])?;
-            // Near the foot of the line: curves are high by the horizon.
+            // Near the foot of the line, where curves are high by the horizon;
+            // several horizons stack their labels instead of printing over each other.
+            let label = if k == 0 {
+                format!("horizon t_end − W = {} rev ", style::short(h))
+            } else {
+                format!("{} rev ", style::short(h))
+            };
+            // All left of the first line, so that no label crosses a line.
             chart.draw_series([Text::new(
-                format!("horizon t_end − W = {} rev ", style::short(h)),
-                (x(h), 0.03),
+                label,
+                (x(first_horizon), 0.03 + 0.05 * k as f64),
                 text(TICK).pos(Pos::new(HPos::Right, VPos::Bottom)),
             )])?;
         }
         for (i, f) in self.fitted.iter().enumerate() {
-            let c = colour(i);
-            let steps = settled_steps(&f.km, f.end);
-            chart.draw_series(LineSeries::new(
-                steps.into_iter().map(|(t, y)| (x(t), y)),
-                c.stroke_width(2),
-            ))?;
+            let look = series_style(i);
+            let c = look.colour;
+            let steps: Vec<(f64, f64)> = settled_steps(&f.km, f.end)
+                .into_iter()
+                .map(|(t, y)| (x(t), y))
+                .collect();
+            draw_line(&mut chart, &steps, look, 2)?;
             chart.draw_series(censoring_times(&f.curve.observations).into_iter().map(|t| {
                 EmptyElement::at((x(t), f.km.settled_by(t)))
                     + PathElement::new(vec![(0, -6), (0, 6)], c.stroke_width(2))

@@ -106,15 +106,17 @@ impl Figure for MapFigure<'_> {
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
-        let body = root.titled(self.title, text(style::TITLE))?;
+        let body = style::titled(root, self.title)?;
         let legend = [
-            ("balanced and stable".to_string(), Swatch::Band(STABLE)),
-            ("balanced, unstable".to_string(), Swatch::Band(UNSTABLE)),
+            ("balanced and stable".to_string(), Swatch::Fill(STABLE)),
+            ("balanced, unstable".to_string(), Swatch::Fill(UNSTABLE)),
             (
                 "cannot be balanced".to_string(),
-                Swatch::Band(UNBALANCEABLE),
+                Swatch::Fill(UNBALANCEABLE),
             ),
         ];
+        // The legend swatches are the cells' own opaque colours (they were
+        // drawn as translucent bands, paler than any cell on the map).
         let area = style::panel_header(&body, "Linear stability of the balanced state", &legend)?;
         let ws = grid(self.points.iter().map(|p| p.omega));
         let us = grid(self.points.iter().map(|p| p.unbalance));
@@ -134,7 +136,8 @@ impl Figure for MapFigure<'_> {
             .y_desc("rotor unbalance U  (kg·m)")
             .axis_desc_style(text(style::AXIS))
             .label_style(text(TICK))
-            .y_label_formatter(&|v| style::short(*v))
+            .x_label_formatter(&style::fixed_decimals(x_lo, x_hi))
+            .y_label_formatter(&style::fixed_decimals(y_lo, y_hi))
             .disable_mesh()
             .draw()?;
         chart.draw_series(self.points.iter().map(|p| {

@@ -3,7 +3,9 @@
 
 use super::PlotError;
 use super::decimate::min_max;
-use super::style::{self, Figure, Swatch, TICK, colour, linear_label, log_ticks, text};
+use super::style::{
+    self, Figure, Swatch, TICK, colour, draw_line, linear_label, log_ticks, series_style, text,
+};
 use crate::metrics::RunMetrics;
 use crate::metrics::observer::Series;
 use crate::simulation::{RunResult, Simulation};
@@ -93,7 +95,7 @@ impl Figure for RunFigure<'_> {
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
-        let body = root.titled(self.title, text(style::TITLE))?;
+        let body = style::titled(root, self.title)?;
         let panels = body.split_evenly((3, 1));
         let t_revs: Vec<f64> = self.series.t.iter().map(|&t| self.revs(t)).collect();
         let t_end = t_revs.last().copied().unwrap_or(1.0).max(1e-9);
@@ -132,6 +134,7 @@ impl RunFigure<'_> {
                 t_end,
                 y: &rel,
                 line_label: "r / A_ref",
+                look: 0,
                 delta: self.delta,
                 mark: ts,
                 mark_label: "t_s (settling time)",
@@ -160,6 +163,7 @@ impl RunFigure<'_> {
                 t_end,
                 y: &self.series.eps,
                 line_label: "ε",
+                look: 1,
                 delta: self.delta,
                 mark: ts,
                 mark_label: "t_s(ε)",
@@ -175,7 +179,7 @@ impl RunFigure<'_> {
         t_end: f64,
     ) -> Result<(), PlotError> {
         let legend: Vec<(String, Swatch)> = (0..self.series.psi.len())
-            .map(|j| (format!("cargo {}", j + 1), Swatch::Line(colour(j))))
+            .map(|j| (format!("cargo {}", j + 1), Swatch::Series(cargo_style(j))))
             .collect();
         let area = style::panel_header(area, "Cargo angles ψ_j relative to the rotor", &legend)?;
         let mut chart = ChartBuilder::on(&area)
@@ -200,13 +204,18 @@ impl RunFigure<'_> {
         for (j, psi) in self.series.psi.iter().enumerate() {
             let deg: Vec<f64> = unwrap_degrees(psi);
             let thin = min_max(t, &deg, MAX_POINTS);
-            let c = colour(j);
             for segment in wrap_segments(&thin) {
-                chart.draw_series(LineSeries::new(segment, c.stroke_width(2)))?;
+                draw_line(&mut chart, &segment, cargo_style(j), 2)?;
             }
         }
         Ok(())
     }
+}
+
+/// The look of cargo j: the series after r/A_ref's and ε's, so that no two
+/// lines of the figure look alike.
+fn cargo_style(j: usize) -> style::SeriesStyle {
+    series_style(j + 2)
 }
 
 /// Inputs of one log-scale time panel with a δ band and a settling mark.
@@ -217,6 +226,8 @@ struct LogPanel<'a> {
     t_end: f64,
     y: &'a [f64],
     line_label: &'a str,
+    /// Index of the line's look in [`series_style`].
+    look: usize,
     delta: f64,
     mark: Option<f64>,
     mark_label: &'a str,
@@ -232,9 +243,10 @@ fn log_panel<DB: DrawingBackend>(
         .ok_or_else(|| PlotError::NoData(format!("{}: no positive values", p.line_label)))?;
     let lo = lo.max(hi * 1e-9);
     let floor_y: Vec<f64> = p.y.iter().map(|v| v.max(lo)).collect();
-    let (line, threshold, band) = (colour(0), colour(1), colour(2));
+    // The threshold is grey, the reference colour, so that it is not taken for a series.
+    let (look, threshold, band) = (series_style(p.look), style::REFERENCE, colour(2));
     let mut legend = vec![
-        (p.line_label.to_string(), Swatch::Line(line)),
+        (p.line_label.to_string(), Swatch::Series(look)),
         (
             format!("δ = {}", style::short(p.delta)),
             Swatch::Dashed(threshold),
@@ -277,10 +289,7 @@ fn log_panel<DB: DrawingBackend>(
             band.mix(0.12).filled(),
         )])?;
     }
-    chart.draw_series(LineSeries::new(
-        min_max(p.t, &floor_y, MAX_POINTS),
-        line.stroke_width(2),
-    ))?;
+    draw_line(&mut chart, &min_max(p.t, &floor_y, MAX_POINTS), look, 2)?;
     chart.draw_series(DashedLineSeries::new(
         [(0.0, p.delta), (p.t_end, p.delta)],
         8,

@@ -2,7 +2,7 @@
 //! cost (RHS calls and wall time), one line per fidelity through its tolerances.
 
 use super::PlotError;
-use super::style::{self, Figure, Swatch, TICK, colour, log_ticks, text};
+use super::style::{self, Figure, Swatch, TICK, draw_line, log_ticks, series_style, text};
 use crate::study::io::read_parquet;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -192,18 +192,17 @@ impl Figure for WorkPrecision<'_> {
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
-        let body = root.titled(self.title, text(style::TITLE))?;
-        let (legend, body) = body.split_vertically(34);
+        let body = style::titled(root, self.title)?;
         let mut entries: Vec<(String, Swatch)> = self
             .fidelities
             .iter()
             .enumerate()
-            .map(|(k, f)| (f.clone(), Swatch::Line(colour(k))))
+            .map(|(k, f)| (f.clone(), Swatch::Series(series_style(k))))
             .collect();
         if self.points.iter().any(|p| p.error_revs == 0.0) {
             entries.push(("error 0 (drawn on the floor)".into(), Swatch::Ring(BLACK)));
         }
-        style::legend_row(&legend, &entries)?;
+        let body = style::legend(&body, &entries)?;
         let panels = body.split_evenly((1, 2));
         self.panel(
             &panels[0],
@@ -238,14 +237,12 @@ impl WorkPrecision<'_> {
         let with_floor = errors().chain(errors().any(|e| e == 0.0).then_some(floor));
         let (y_lo, y_hi) = style::log_extent(with_floor, 1.3)
             .ok_or_else(|| PlotError::NoData("no positive error".into()))?;
-        let area = style::panel_header(
-            area,
-            &format!("Error vs {caption} (points labelled with rtol)"),
-            &[],
-        )?;
+        let area = style::panel_header(area, &format!("Error vs {caption} (labels: rtol)"), &[])?;
         let mut chart = ChartBuilder::on(&area)
             .margin(14)
             .margin_top(4)
+            // Room for half the last x tick label, which is centred on the axis end.
+            .margin_right(30)
             .x_label_area_size(48)
             .y_label_area_size(80)
             .build_cartesian_2d(
@@ -267,8 +264,13 @@ impl WorkPrecision<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
+        let mut placer = style::LabelPlacer::new();
+        let bounds = style::plot_bounds(&chart);
+        let label_style = text(TICK - 3);
+        let mut labels = Vec::new();
         for (k, fidelity) in self.fidelities.iter().enumerate() {
-            let c = colour(k);
+            let look = series_style(k);
+            let c = look.colour;
             let mut mine: Vec<&TradeoffPoint> = self
                 .points
                 .iter()
@@ -277,24 +279,43 @@ impl WorkPrecision<'_> {
             // Loose to tight tolerance: the line walks towards higher cost.
             mine.sort_by(|a, b| b.rtol.total_cmp(&a.rtol));
             let xy = |p: &TradeoffPoint| (cost(p).max(x_lo), p.error_revs.max(floor));
-            chart.draw_series(LineSeries::new(
-                mine.iter().map(|p| xy(p)),
-                c.stroke_width(2),
-            ))?;
-            chart.draw_series(mine.iter().map(|p| {
-                let fill = if p.error_revs > 0.0 { c } else { WHITE };
-                EmptyElement::at(xy(p))
-                    + Circle::new((0, 0), 5, fill.filled())
-                    + Circle::new((0, 0), 5, c.stroke_width(2))
-            }))?;
-            chart.draw_series(mine.iter().map(|p| {
-                EmptyElement::at(xy(p))
+            let line: Vec<(f64, f64)> = mine.iter().map(|p| xy(p)).collect();
+            // Every point is marked here, so the line itself carries no markers.
+            let plain = style::SeriesStyle {
+                marker: style::Marker::None,
+                ..look
+            };
+            draw_line(&mut chart, &line, plain, 2)?;
+            let marker = match look.marker {
+                style::Marker::None => style::Marker::Circle,
+                m => m,
+            };
+            for p in &mine {
+                if p.error_revs > 0.0 {
+                    chart.draw_series([
+                        EmptyElement::at(xy(p)) + style::marker(marker, 5, c.filled())
+                    ])?;
+                } else {
+                    chart.draw_series([EmptyElement::at(xy(p))
+                        + Circle::new((0, 0), 5, WHITE.filled())
+                        + Circle::new((0, 0), 5, c.stroke_width(2))])?;
+                }
+                let at = chart.backend_coord(&xy(p));
+                placer.reserve((at.0 - 6, at.1 - 6, at.0 + 6, at.1 + 6));
+                labels.push((xy(p), at, format!("{:.0e}", p.rtol)));
+            }
+        }
+        // Labels after every marker is known, so that none covers a marker.
+        for (point, at, label) in labels {
+            let size = area.estimate_text_size(&label, &label_style)?;
+            if let Some(offset) = placer.place(at, size, bounds) {
+                chart.draw_series([EmptyElement::at(point)
                     + Text::new(
-                        format!("{:.0e}", p.rtol),
-                        (7, -4),
-                        text(TICK - 3).pos(Pos::new(HPos::Left, VPos::Bottom)),
-                    )
-            }))?;
+                        label,
+                        offset,
+                        label_style.pos(Pos::new(HPos::Left, VPos::Top)),
+                    )])?;
+            }
         }
         Ok(())
     }

@@ -28,6 +28,7 @@ mod model_two_support;
 mod operating_point;
 mod optimize;
 mod plot;
+mod plot_layout;
 mod results_folder;
 mod rolling_resistance;
 mod study_input;

@@ -5,7 +5,7 @@ use super::labels::{
     Labels, category_height, category_label, category_y, geometries, label_width, labels,
 };
 use crate::plot::PlotError;
-use crate::plot::style::{self, Figure, TICK, colour, linear_label, text};
+use crate::plot::style::{self, Figure, TICK, linear_label, point_style, text};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -44,13 +44,19 @@ impl Figure for SettledFraction<'_> {
         let designs = &self.data.designs;
         let count = designs.len();
         let lowest = designs.iter().map(|d| d.settled_lo).fold(1.0f64, f64::min);
-        // Zoom in when every design settles nearly always, or the intervals vanish.
-        let x_lo = ((lowest - 0.02) * 10.0).floor().max(0.0) / 10.0;
-        let x_lo = if x_lo > 0.9 {
-            ((lowest - 0.005) * 100.0).floor() / 100.0
+        // Zoom in when every design settles nearly always, or the intervals
+        // vanish: the axis starts a step below the lowest interval, the step
+        // fitting the spread (it started at 0.9 for intervals all above 0.97,
+        // leaving most of the figure empty).
+        let spread = 1.0 - lowest;
+        let step = if spread > 0.3 {
+            0.1
+        } else if spread > 0.1 {
+            0.05
         } else {
-            x_lo
+            0.01
         };
+        let x_lo = (((lowest - 0.1 * spread - 0.002) / step).floor() * step).max(0.0);
         let runs: Vec<u64> = designs.iter().map(|d| d.runs).collect();
         let runs_text = if runs.iter().all(|r| *r == runs[0]) {
             format!("{} runs per design", runs[0])
@@ -67,11 +73,11 @@ impl Figure for SettledFraction<'_> {
             }
         );
         let title = format!("{}: fraction of runs that settled", self.data.name);
-        let body = root.titled(&title, text(style::TITLE))?;
+        let body = style::titled(root, &title)?;
+        let body = style::text_block(&body, &caption, TICK)?;
         let key_points: Vec<f64> = (0..count).map(|i| i as f64).collect();
         let label = category_label(&self.labels.per_design);
         let mut chart = ChartBuilder::on(&body)
-            .caption(caption, text(TICK))
             .margin(16)
             .margin_right(30)
             .x_label_area_size(52)
@@ -97,10 +103,12 @@ impl Figure for SettledFraction<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
-        let (group, _) = geometries(designs);
+        let (group, names) = geometries(designs);
         for (i, d) in designs.iter().enumerate() {
             let y = category_y(i, count);
-            let c = colour(group[i]);
+            let look = point_style(group[i]);
+            style::note_series(names[group[i]].clone(), look);
+            let c = look.colour;
             let h = 0.22;
             chart.draw_series([
                 PathElement::new(
@@ -116,7 +124,8 @@ impl Figure for SettledFraction<'_> {
                     c.stroke_width(2),
                 ),
             ])?;
-            chart.draw_series([Circle::new((d.settled_fraction, y), 5, c.filled())])?;
+            chart.draw_series([EmptyElement::at((d.settled_fraction, y))
+                + style::marker(look.marker, 6, c.filled())])?;
         }
         Ok(())
     }

@@ -7,7 +7,9 @@ use super::labels::{
     Labels, category_height, category_label, category_y, geometries, label_width, labels,
 };
 use crate::plot::PlotError;
-use crate::plot::style::{self, Figure, TICK, colour, log_ticks, text};
+use crate::plot::style::{
+    self, Figure, TICK, draw_line, log_ticks, point_style, series_style, text,
+};
 use crate::stats::survival::{KaplanMeier, Observation};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -124,21 +126,16 @@ impl Figure for SettlingBoxes<'_> {
                 _ => l.clone(),
             })
             .collect();
-        let body = root.titled(&title, text(style::TITLE))?;
-        let (strip, body) = body.split_vertically(24);
-        let (w, _) = strip.dim_in_pixel();
-        strip.draw(&Text::new(
-            caption,
-            (w as i32 / 2, 2),
-            text(TICK).pos(Pos::new(HPos::Center, VPos::Top)),
-        ))?;
+        let body = style::titled(root, &title)?;
+        let body = style::text_block(&body, &caption, TICK)?;
+        let body = style::text_block(
+            &body,
+            "open box, no bar: that quartile or the median lies beyond the run; whiskers: settled runs within 1.5 IQR; dots: settled runs beyond",
+            TICK,
+        )?;
         let key_points: Vec<f64> = (0..count).map(|i| i as f64).collect();
         let label = category_label(&row_labels);
         let mut chart = ChartBuilder::on(&body)
-            .caption(
-                "open box, no bar: that quartile or the median lies beyond the run; whiskers: settled runs within 1.5 IQR; dots: settled runs beyond",
-                text(TICK),
-            )
             .margin(16)
             .x_label_area_size(52)
             .y_label_area_size(label_width(&row_labels))
@@ -157,10 +154,11 @@ impl Figure for SettlingBoxes<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
-        let (group, _) = geometries(designs);
+        let (group, names) = geometries(designs);
         for (i, b) in boxes.iter().enumerate() {
             let y = category_y(i, count);
-            let c = colour(group[i]);
+            let look = point_style(group[i]);
+            let c = look.colour;
             let Some((b, q1)) = b.as_ref().and_then(|b| Some((b, b.q1?))) else {
                 let why = if b.is_some() {
                     "fewer than a quarter of the runs settled"
@@ -175,7 +173,13 @@ impl Figure for SettlingBoxes<'_> {
                 continue;
             };
             let h = 0.32;
-            let whisker = c.stroke_width(2);
+            // Past seven geometries the colours come round again; the outlines
+            // then turn dashed (series_style), the outlier marks change shape.
+            let outline_look = style::SeriesStyle {
+                marker: style::Marker::None,
+                ..series_style(group[i])
+            };
+            style::note_series(names[group[i]].clone(), outline_look);
             // Past the last settling the box runs off the right edge, open.
             let right = b.q3.unwrap_or(hi);
             let mut lines = Vec::new();
@@ -196,18 +200,18 @@ impl Figure for SettlingBoxes<'_> {
                 [(q1, y - h), (right, y + h)],
                 c.mix(0.25).filled(),
             )])?;
-            chart.draw_series(lines.into_iter().map(|l| PathElement::new(l, whisker)))?;
+            for l in &lines {
+                draw_line(&mut chart, l, outline_look, 2)?;
+            }
             if let Some(median) = b.median {
                 chart.draw_series([PathElement::new(
                     vec![(median, y - h), (median, y + h)],
                     BLACK.stroke_width(3),
                 )])?;
             }
-            chart.draw_series(
-                b.outliers
-                    .iter()
-                    .map(|&x| Circle::new((x, y), 2, c.mix(0.6).filled())),
-            )?;
+            chart.draw_series(b.outliers.iter().map(|&x| {
+                EmptyElement::at((x, y)) + style::marker(look.marker, 3, c.mix(0.6).filled())
+            }))?;
         }
         Ok(())
     }

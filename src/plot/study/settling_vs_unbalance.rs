@@ -5,7 +5,7 @@ use super::StudyData;
 use super::labels::geometries;
 use crate::plot::PlotError;
 use crate::plot::style::{
-    self, Figure, Swatch, TICK, colour, linear_label, log_ticks, short, text,
+    self, Figure, Swatch, TICK, linear_label, log_ticks, point_style, short, text,
 };
 use crate::study::record::RunRecord;
 use plotters::coord::Shift;
@@ -82,13 +82,18 @@ impl Figure for SettlingScatter<'_> {
             "{}: settling time vs unbalance (fraction of capacity)",
             self.data.name
         );
-        let body = root.titled(&title, text(style::TITLE))?;
-        let (legend, body) = body.split_vertically(34);
-        let red = RGBColor(200, 0, 0);
+        let body = style::titled(root, &title)?;
+        // Grey, outside the palette: no drag's colour is mistaken for it.
+        let red = style::REFERENCE;
         let mut entries: Vec<(String, Swatch)> = drags
             .iter()
             .enumerate()
-            .map(|(k, d)| (format!("β = {} N·s/m", short(*d)), Swatch::Dot(colour(k))))
+            .map(|(k, d)| {
+                (
+                    format!("β = {} N·s/m", short(*d)),
+                    Swatch::Point(point_style(k)),
+                )
+            })
             .collect();
         if any_unsettled {
             entries.push((
@@ -96,7 +101,7 @@ impl Figure for SettlingScatter<'_> {
                 Swatch::Cross(red),
             ));
         }
-        style::legend_row(&legend, &entries)?;
+        let body = style::legend(&body, &entries)?;
         let (rows, cols) = self.grid();
         let panels = body.split_evenly((rows, cols));
         for (g, (panel, name)) in panels.iter().zip(&names).enumerate() {
@@ -132,12 +137,15 @@ impl Figure for SettlingScatter<'_> {
                 .bold_line_style(BLACK.mix(0.08))
                 .draw()?;
             for (k, drag) in drags.iter().enumerate() {
-                let c = colour(k);
+                let look = point_style(k);
                 chart.draw_series(
                     mine.iter()
                         .filter(|r| r.drag == *drag && r.metrics.settled)
                         .filter_map(|r| Some((r.unbalance_fraction, r.metrics.settling_revs?)))
-                        .map(|p| Circle::new(p, 2, c.mix(0.55).filled())),
+                        .map(|p| {
+                            EmptyElement::at(p)
+                                + style::marker(look.marker, 3, look.colour.mix(0.6).filled())
+                        }),
                 )?;
             }
             chart.draw_series(
