@@ -29,6 +29,7 @@ mod operating_point;
 mod optimize;
 mod plot;
 mod results_folder;
+mod schema;
 mod study_input;
 mod study_runner;
 mod study_summary;
