@@ -91,6 +91,7 @@ fn rho_rules(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
 impl DesignSpec {
     /// The radius ratio this spec resolves to.
     pub fn resolved_rho(&self) -> Result<f64, DesignError> {
+        // A new rule is also listed in `rho_rules`, the schema's list.
         match &self.rho {
             RhoChoice::Value(rho) => Ok(*rho),
             RhoChoice::Rule(rule) if rule == "optimal" => {
