@@ -38,6 +38,7 @@ pub mod model;
 pub mod optimize;
 pub mod plot;
 pub mod scene_file;
+pub mod schema;
 pub mod simulation;
 pub mod stats;
 pub mod study;

@@ -10,10 +10,11 @@ use crate::model::scene::{DesignSpec, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
 use crate::simulation::{Simulation, SolverSettings, evenly_spaced};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// A scene file as written by the user.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// Rotor and supports (`model = "plane"` by default).
@@ -44,7 +45,7 @@ pub struct SceneFile {
 }
 
 /// How a single run starts.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StartSpec {
     /// Start mode (default `locked_steady`).

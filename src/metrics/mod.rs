@@ -33,10 +33,11 @@ pub mod reference;
 
 use crate::model::speed::SpeedLaw;
 use crate::model::validate::SceneError;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-/// Parameters of the metric definitions above.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// Parameters of the metric definitions (docs/metrics.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct MetricOptions {
     /// Settling band δ as a fraction of A_ref (and of U for ε).
@@ -45,7 +46,7 @@ pub struct MetricOptions {
     pub hold_revs: f64,
     /// Run length T_end in revolutions.
     pub t_end_revs: f64,
-    /// Dense-output samples per revolution (at least [`MIN_SAMPLES_PER_REV`]).
+    /// Dense-output samples per revolution (at least [`MIN_SAMPLES_PER_REV`] = 32).
     pub samples_per_rev: u32,
     /// Stop the run as soon as the hold is satisfied.
     pub stop_when_settled: bool,

@@ -1,5 +1,6 @@
 //! One compensating cargo (ball, roller or pendulum) as the equations see it.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Physical parameters of one cargo, whatever its kind.
@@ -8,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// about its plane's centre; `kappa` (κ) scales its inertia to κ m l² about
 /// that centre; balls and rollers additionally couple with the rotor's
 /// angular acceleration through rolling without slip (seed 004, eqs 15, 17).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Cargo {
     /// Mass m (kg).

@@ -10,6 +10,7 @@ use super::system::RotorSystem;
 use super::validate::{invalid, non_negative, positive};
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Re-exported where it was first defined: most of the crate names it here.
@@ -38,7 +39,7 @@ pub struct Scene {
 }
 
 /// n identical weights of one kind.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DesignSpec {
     /// Ball, roller or pendulum.
@@ -69,18 +70,28 @@ fn steel() -> f64 {
 /// How the radius ratio is chosen: a number, or the name of a rule
 /// (`"optimal"`: the capacity optimum of Table 1; `"half_race"`: the weights
 /// fill exactly half the race).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
 pub enum RhoChoice {
     /// A given ρ.
     Value(f64),
     /// A named rule, checked when the spec is resolved.
-    Rule(String),
+    Rule(#[schemars(schema_with = "rho_rules")] String),
+}
+
+/// The rules [`DesignSpec::resolved_rho`] knows, so that an editor flags a
+/// misspelt one while it is typed rather than when the study starts.
+fn rho_rules(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+    schemars::json_schema!({
+        "type": "string",
+        "enum": ["optimal", "half_race"]
+    })
 }
 
 impl DesignSpec {
     /// The radius ratio this spec resolves to.
     pub fn resolved_rho(&self) -> Result<f64, DesignError> {
+        // A new rule is also listed in `rho_rules`, the schema's list.
         match &self.rho {
             RhoChoice::Value(rho) => Ok(*rho),
             RhoChoice::Rule(rule) if rule == "optimal" => {

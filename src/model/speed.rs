@@ -1,9 +1,10 @@
 //! Speed laws of the rotor: prescribed (constant, ramp) or driven by a torque.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// How the rotor's spin angle φ evolves.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "mode", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SpeedLaw {
     /// φ = ω t (seed 004, eqs 19–20).

@@ -9,11 +9,12 @@
 
 use super::forced::{harmonic_response, unbalance_forcing};
 use super::system::RotorSystem;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// How the rotor and cargoes start.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum StartMode {
     /// Rotor in the forced steady state with the cargoes locked; cargoes released at t = 0.

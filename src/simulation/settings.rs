@@ -3,6 +3,7 @@
 
 use crate::integrate::Method;
 use crate::model::system::RotorSystem;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Integrator choice and accuracy.
@@ -16,7 +17,7 @@ use serde::{Deserialize, Serialize};
 /// converges. A fixed atol with a much smaller rtol would leave the residual
 /// at the absolute tolerance's noise floor, and Radau5, which maps its
 /// tolerances as Hairer does (atol/rtol kept), would even loosen it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
     /// Formulation: analytic, rotating, full, or auto (rotating when exact for the scene).
@@ -29,6 +30,9 @@ pub struct SolverSettings {
     pub rtol: f64,
     /// Absolute tolerance relative to the problem's scales (see above);
     /// `None`: rtol/100.
+    #[schemars(
+        description = "Absolute tolerance relative to the problem's scales (displacements atol·A_ref, velocities atol·A_ref·ω, angles atol rad, angular rates atol·ω); rtol/100 when absent."
+    )]
     pub atol: Option<f64>,
     /// Step budget (accepted plus rejected) per integration segment.
     pub max_steps: u64,
@@ -190,7 +194,7 @@ impl From<MethodChoice> for String {
 }
 
 /// Which formulation computes a run (the fidelity ladder, cheapest first).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
     /// Closed-form slow mode (quasi-static, `model::quasi_static`): microseconds,

@@ -15,13 +15,14 @@ use crate::model::scene::{DesignSpec, RhoChoice, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
 use crate::simulation::SolverSettings;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Seed used when a study file gives none (documented in `docs/study-file.md`).
 pub const DEFAULT_SEED: u64 = 20_261_122;
 
 /// A study file as written by the user.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StudyFile {
     /// Name of the output folder under `output`; defaults to the file's stem.
@@ -54,7 +55,7 @@ pub struct StudyFile {
 }
 
 /// How verdicts between designs are reached.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StatisticsSpec {
     /// Family-wise error rate of the "settles sooner than" verdicts
@@ -84,11 +85,11 @@ fn default_output() -> String {
 }
 
 /// The rotor, speed law, effects and start mode shared by every run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneTemplate {
-    /// Rotor and supports; its unbalance is set per run from the sampled one
-    /// ([`RotorModel::set_unbalance`]).
+    /// Rotor and supports; each run replaces the rotor's own unbalance by the
+    /// sampled one, so the file need not give it.
     pub rotor: RotorModel,
     /// Speed law.
     pub speed: SpeedLaw,
@@ -101,8 +102,9 @@ pub struct SceneTemplate {
 }
 
 /// A one-or-many value in the design grid.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
+#[schemars(inline)]
 pub enum OneOrMany<T> {
     /// A single value.
     One(T),
@@ -157,7 +159,7 @@ pub const MAX_WEIGHTS: u32 = 256;
 pub const MAX_TOTAL_RUNS: u64 = 20_000_000;
 
 /// The design grid: every combination of kind × n × ρ × drag.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DesignGrid {
     /// Balancer kinds: "ball", "roller", "pendulum".
@@ -183,7 +185,7 @@ fn steel() -> f64 {
 }
 
 /// What is drawn for each run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Sampling {
     /// Runs per design.
@@ -217,8 +219,9 @@ fn default_batch() -> u32 {
 }
 
 /// The precision adaptive sampling stops at: every key given must hold.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
+#[schemars(transform = accept_old_win_share_name)]
 pub struct StopWhen {
     /// Half-width of every design's 95 % interval of the Kaplan–Meier median
     /// settling time, relative to the median (e.g. 0.05 for ±5 %).
@@ -234,11 +237,35 @@ fn yes() -> bool {
     true
 }
 
+/// schemars does not list serde aliases, and the schema forbids unknown
+/// keys: without this, a file using the old name would validate as wrong
+/// while the parser reads it.
+fn accept_old_win_share_name(schema: &mut schemars::Schema) {
+    let Some(properties) = schema
+        .get_mut("properties")
+        .and_then(serde_json::Value::as_object_mut)
+    else {
+        return;
+    };
+    if let Some(current) = properties.get("win_share_halfwidth").cloned() {
+        let mut old = current;
+        if let Some(old) = old.as_object_mut() {
+            old.insert(
+                "description".into(),
+                "Old name of `win_share_halfwidth`.".into(),
+            );
+            old.insert("deprecated".into(), true.into());
+        }
+        properties.insert("win_probability_halfwidth".into(), old);
+    }
+}
+
 /// Unbalance magnitude U = M e: a distribution, absolute (kg·m) or as a
 /// fraction of each design's balancing capacity.
 // No deny_unknown_fields here: serde cannot combine it with `flatten`; the
 // flattened distribution rejects unknown keys itself.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[schemars(transform = close_unbalance_tables)]
 pub struct UnbalanceSpec {
     /// The distribution.
     #[serde(flatten)]
@@ -248,8 +275,34 @@ pub struct UnbalanceSpec {
     pub relative_to: Scale,
 }
 
+/// schemars flattens the distribution as one alternative per distribution
+/// beside `relative_to`, and none of them closed: a misspelt key would pass
+/// the schema that the parser refuses. Each alternative gets `relative_to`
+/// and forbids other keys, as the parser does.
+fn close_unbalance_tables(schema: &mut schemars::Schema) {
+    let shared = schema
+        .remove("properties")
+        .and_then(|p| p.as_object().cloned())
+        .unwrap_or_default();
+    let Some(alternatives) = schema
+        .get_mut("oneOf")
+        .and_then(serde_json::Value::as_array_mut)
+    else {
+        return;
+    };
+    for alternative in alternatives.iter_mut().filter_map(|a| a.as_object_mut()) {
+        if let Some(properties) = alternative
+            .get_mut("properties")
+            .and_then(serde_json::Value::as_object_mut)
+        {
+            properties.extend(shared.clone());
+        }
+        alternative.insert("additionalProperties".into(), false.into());
+    }
+}
+
 /// Scale of sampled unbalances.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Scale {
     /// A fraction of the design's capacity.
@@ -260,12 +313,12 @@ pub enum Scale {
 }
 
 /// A distribution of a positive quantity.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "distribution", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Distribution {
     /// Always the same value.
     Fixed {
-        /// The value.
+        /// The value (a fraction of capacity, or kg·m with `relative_to = "absolute"`).
         value: f64,
     },
     /// Uniform on [min, max].
@@ -308,7 +361,7 @@ impl Distribution {
 }
 
 /// Unbalance direction.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum DirectionSpec {
     /// Uniform on [0, 2π).
@@ -319,7 +372,7 @@ pub enum DirectionSpec {
 }
 
 /// Initial cargo positions.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum InitialSpec {
     /// Pressed together (touching) around a uniformly random direction.

@@ -1,10 +1,11 @@
 //! The `[optimize]` table of a study file: objective, free variables, bounds
 //! and constraints (documented in `docs/optimize.md`).
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// What the optimiser maximises or minimises.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Objective {
     /// Analytic dimensional capacity S_AB (maximised): Table 1 of seed 000.
@@ -55,7 +56,7 @@ impl Objective {
 }
 
 /// A continuous design variable the optimiser may move.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Variable {
     /// Radius ratio ρ.
@@ -65,7 +66,7 @@ pub enum Variable {
 }
 
 /// The `[optimize]` table.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OptimizeSpec {
     /// The objective.

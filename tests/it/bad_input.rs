@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::process::Command;
 
-fn study(results: &Path) -> String {
+pub(crate) fn study(results: &Path) -> String {
     format!(
         r#"name = "corpus"
 seed = 5
@@ -45,13 +45,13 @@ t_end_revs = 100
     )
 }
 
-fn scene() -> String {
+pub(crate) fn scene() -> String {
     crate::fixtures::point_weights_scene(2)
         + "[speed]\nmode = \"constant\"\nomega = 4.0\n[start]\nangles_deg = [90, 100]\n[metrics]\nt_end_revs = 100\n"
 }
 
 /// (what to replace, with what, a text the message must contain).
-const STUDY_CASES: &[(&str, &str, &str)] = &[
+pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
     ("mass = 10.0", "mass = -1.0", "mass"),
     ("mass = 10.0", "mass = 0.0", "mass"),
     ("mass = 10.0", "mass = \"heavy\"", "rotor.mass"),
@@ -133,7 +133,7 @@ const STUDY_CASES: &[(&str, &str, &str)] = &[
 ];
 
 /// (what to replace in the scene, with what, a text the message must contain).
-const SCENE_CASES: &[(&str, &str, &str)] = &[
+pub(crate) const SCENE_CASES: &[(&str, &str, &str)] = &[
     ("mass = 1.0", "mass = -1.0", "mass"),
     (
         "eccentricity = 0.01",

@@ -31,6 +31,7 @@ mod plot;
 mod plot_layout;
 mod results_folder;
 mod rolling_resistance;
+mod schema;
 mod study_input;
 mod study_runner;
 mod study_summary;

@@ -94,6 +94,9 @@ enum Command {
     /// Print the man page (roff) of `study`.
     #[command(after_help = meta_cmd::MAN_EXAMPLES)]
     Man,
+    /// Print the JSON Schema of study or scene files, for editors and validators.
+    #[command(after_help = meta_cmd::SCHEMA_EXAMPLES)]
+    Schema(meta_cmd::SchemaArgs),
 }
 
 /// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
@@ -133,6 +136,7 @@ fn main() -> ExitCode {
         Command::Baseline(args) => check_cmd::baseline(&args),
         Command::Completions(args) => meta_cmd::completions(&args, Cli::command()),
         Command::Man => meta_cmd::man(Cli::command()),
+        Command::Schema(args) => meta_cmd::schema(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -8,6 +8,7 @@ pub mod roller;
 
 use super::cargo::Cargo;
 use crate::design::{DesignError, Shape};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Geometry and material of one balancer's weights.
@@ -45,7 +46,7 @@ pub trait WeightModel {
 }
 
 /// The registered balancer kinds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Kind {
     /// Balls rolling in a race ([`ball`]).

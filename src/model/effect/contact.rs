@@ -14,11 +14,12 @@
 
 use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
 /// Parameters of the contact effect in a scene or study file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     /// Weights are solid: contact is on in every scene unless a file sets

@@ -6,10 +6,11 @@
 use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
 use crate::model::validate::{SceneError, invalid, non_negative};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Gravity acting along −Y in the rotor plane.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Gravity {
     /// Gravitational acceleration g (m/s²).

@@ -16,6 +16,7 @@ pub mod rolling;
 use super::cargo::Cargo;
 use super::rotor::DofVec;
 use super::validate::SceneError;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// The state an effect may read.
@@ -87,7 +88,8 @@ fn effect_on<T: Default>() -> Option<T> {
 /// Declares every effect once: the intrinsic ones (built from the cargoes)
 /// and the optional ones, each with its scene key, parameter type and serde
 /// default (`#[serde(default)]`: off unless a file asks; `#[serde(default =
-/// "effect_on")]`: on in every scene unless a file switches it off). The
+/// "effect_on::<Spec>")]`: on in every scene unless a file switches it off;
+/// the type is spelt out for the schema, which calls the default alone). The
 /// right-hand side applies them in this order, which is the order of the
 /// floating-point additions into each force, so a new effect goes last.
 macro_rules! effect_registry {
@@ -105,7 +107,7 @@ macro_rules! effect_registry {
         }
 
         /// Which optional effects a scene enables, with their parameters.
-        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
         #[serde(deny_unknown_fields)]
         pub struct Effects {
             $(
@@ -145,7 +147,7 @@ effect_registry! {
         /// Contact between neighbouring weights of finite size: on unless a
         /// file says `enabled = false` (then weights pass through each
         /// other, as the analytic theory assumes).
-        #[serde(default = "effect_on")]
+        #[serde(default = "effect_on::<contact::ContactSpec>")]
         contact: contact::ContactSpec,
         /// Rolling resistance (pivot friction for pendulums): absent, none.
         #[serde(default)]

@@ -21,6 +21,7 @@
 use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
 use crate::model::validate::{SceneError, invalid, non_negative};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// The Stribeck velocity (where breakaway friction has fallen to μ_k) as a
@@ -28,7 +29,7 @@ use serde::{Deserialize, Serialize};
 pub const STRIBECK_PER_SLIP: f64 = 10.0;
 
 /// Rolling resistance of every weight, `[effects.rolling_resistance]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RollingResistance {
     /// Kinetic coefficient μ_k (dimensionless): resisting torque over N·l.

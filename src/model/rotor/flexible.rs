@@ -21,10 +21,11 @@
 
 use super::{DofVec, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, finite, non_negative, positive};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the flexible rotor (SI or dimensionless).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FlexibleShaft {
     /// Disc mass M (kg).

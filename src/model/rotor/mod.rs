@@ -24,6 +24,9 @@ use crate::model::validate::SceneError;
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 
+/// The model a `[rotor]` table without `model = "…"` gets.
+const DEFAULT_MODEL: &str = "plane";
+
 /// Largest number of rotor coordinates a model may have (x, y and two tilts).
 pub const MAX_DOF: usize = 4;
 
@@ -154,6 +157,25 @@ macro_rules! rotor_registry {
             $( #[serde(rename = $name)] $variant(&'a $model), )*
         }
 
+        /// Written by hand as the `Deserialize` impl is: one alternative per
+        /// model, its parameters plus `model = "name"`.
+        impl schemars::JsonSchema for RotorModel {
+            fn schema_name() -> std::borrow::Cow<'static, str> {
+                "RotorModel".into()
+            }
+
+            fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+                let models = vec![$( model_schema::<$model>(generator, $name) ),*];
+                schemars::json_schema!({
+                    "description": format!(
+                        "Rotor and supports: one of the models {}, chosen by `model` (\"{DEFAULT_MODEL}\" when absent).",
+                        names_list()
+                    ),
+                    "oneOf": models,
+                })
+            }
+        }
+
         impl Serialize for RotorModel {
             fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
                 match self {
@@ -211,6 +233,42 @@ impl RotorModel {
     }
 }
 
+/// The schema of one model's table: its parameters plus the `model` key,
+/// which only the default model may leave out.
+fn model_schema<T: schemars::JsonSchema>(
+    generator: &mut schemars::SchemaGenerator,
+    name: &str,
+) -> schemars::Schema {
+    let mut schema = T::json_schema(generator);
+    let object = schema.ensure_object();
+    let default = name == DEFAULT_MODEL;
+    let key = serde_json::json!({
+        "description": if default {
+            format!("The rotor model (\"{name}\" when absent).")
+        } else {
+            "The rotor model.".to_string()
+        },
+        "type": "string",
+        "enum": [name],
+    });
+    if let Some(properties) = object
+        .entry("properties")
+        .or_insert_with(|| serde_json::json!({}))
+        .as_object_mut()
+    {
+        properties.insert("model".into(), key);
+    }
+    if !default
+        && let Some(required) = object
+            .entry("required")
+            .or_insert_with(|| serde_json::json!([]))
+            .as_array_mut()
+    {
+        required.insert(0, "model".into());
+    }
+    schema
+}
+
 /// `"a", "b" or "c"`: the registered names for error messages.
 fn names_list() -> String {
     let quoted: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
@@ -228,7 +286,7 @@ impl<'de> Deserialize<'de> for RotorModel {
         // deserialize the rest as the chosen model (unknown keys still named).
         let mut table = toml::Table::deserialize(deserializer)?;
         let model = match table.remove("model") {
-            None => "plane".to_string(),
+            None => DEFAULT_MODEL.to_string(),
             Some(toml::Value::String(s)) => s,
             Some(other) => {
                 return Err(D::Error::custom(format!(

@@ -4,10 +4,11 @@
 
 use super::{DofVec, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, invalid, non_negative, positive};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the plane rotor (any consistent units, SI in study files).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneRotor {
     /// Rotor mass M (kg).

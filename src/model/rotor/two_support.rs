@@ -26,10 +26,11 @@
 use super::{DofVec, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, finite, invalid, non_negative, positive};
 use num_complex::Complex64;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// One point unbalance of the rotor: s = m e (kg·m) at axial position z, angle θ.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointUnbalance {
     /// Size s = m e (kg·m).
@@ -43,7 +44,7 @@ pub struct PointUnbalance {
 }
 
 /// Parameters of the two-support rotor (SI or dimensionless).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TwoSupportRotor {
     /// Rotor mass M (kg).
