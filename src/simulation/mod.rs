@@ -98,7 +98,7 @@ impl Simulation {
         let t_end = self.metrics.t_end_revs * 2.0 * PI / omega;
         let method = self.solver.method.resolve(
             self.solver.rtol,
-            frame.is_some() && !self.metrics.stop_when_settled,
+            (frame.is_some() && !self.metrics.stop_when_settled) || self.scene.effects.stiff(),
         );
         let explicit = !method.is_implicit();
         let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);

@@ -70,6 +70,12 @@ pub trait EffectSpec {
     fn rotating_frame_obstacle(&self) -> Option<&'static str> {
         None
     }
+    /// True when the effect makes the equations stiff by construction, so
+    /// that the `auto` method starts implicit instead of waiting for a
+    /// stiffness test to notice.
+    fn stiff(&self) -> bool {
+        false
+    }
 }
 
 /// An effect with no scene table of its own: it reads its parameters from
@@ -174,6 +180,11 @@ impl Effects {
                 .filter_map(|(_, spec)| spec.build(cargo, omega)),
         );
         list
+    }
+
+    /// Whether an enabled effect is stiff by construction.
+    pub fn stiff(&self) -> bool {
+        self.enabled().any(|(_, spec)| spec.stiff())
     }
 
     /// Why an enabled effect rules out the rotating-frame formulation, if one does.

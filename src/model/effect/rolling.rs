@@ -72,6 +72,12 @@ impl EffectSpec for RollingResistance {
         Ok(())
     }
 
+    /// The regularised sign is a damping μ N l / v_s, 10⁷ times the
+    /// friction torque's scale per rad/s at the default v_s = 1e-7 ω.
+    fn stiff(&self) -> bool {
+        self.coefficient > 0.0
+    }
+
     fn build(&self, cargo: &[Cargo], omega: f64) -> Option<Box<dyn Effect>> {
         (self.coefficient > 0.0).then(|| {
             Box::new(RollingTorque {
