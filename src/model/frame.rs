@@ -153,6 +153,7 @@ impl OdeSystem for RotatingSystem {
                 t,
                 phi: 0.0,
                 spin_rate: w,
+                spin_accel: 0.0,
                 spin_free: false,
                 cargo: &self.cargo,
                 psi,

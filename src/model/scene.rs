@@ -3,8 +3,8 @@
 
 use super::balancer::{self, Geometry, Kind};
 use super::cargo::Cargo;
-use super::effect::Effects;
-use super::rotor::RotorModel;
+use super::effect::{Effects, SceneFacts};
+use super::rotor::{PlaneRotor, RotorModel};
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
 use super::validate::{invalid, non_negative, positive};
@@ -162,7 +162,10 @@ impl Scene {
             }
             SpeedLaw::Free { omega_start } => non_negative("speed.omega_start", *omega_start)?,
         }
-        self.effects.validate()?;
+        self.effects.validate(&SceneFacts {
+            plane_rotor: self.rotor.downcast_ref::<PlaneRotor>().is_some(),
+            prescribed_speed: self.speed.is_prescribed(),
+        })?;
         let designs: Vec<(String, &DesignSpec)> = self
             .balancer
             .iter()

@@ -204,6 +204,7 @@ impl OdeSystem for RotorSystem {
                 t,
                 phi,
                 spin_rate,
+                spin_accel,
                 spin_free: lay.spin_free,
                 cargo: &self.cargo,
                 psi,

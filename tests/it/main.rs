@@ -29,6 +29,7 @@ mod operating_point;
 mod optimize;
 mod plot;
 mod plot_layout;
+mod race_eccentricity;
 mod results_folder;
 mod rolling_resistance;
 mod schema;

@@ -252,6 +252,7 @@ mod tests {
                     t: 0.0,
                     phi: 0.0,
                     spin_rate: 300.0,
+                    spin_accel: 0.0,
                     spin_free: false,
                     cargo: &cargo,
                     psi: &psi,

@@ -11,6 +11,7 @@
 pub mod contact;
 pub mod drag;
 pub mod gravity;
+pub mod race_eccentricity;
 pub mod rolling;
 
 use super::cargo::Cargo;
@@ -27,6 +28,8 @@ pub struct EffectContext<'a> {
     pub phi: f64,
     /// Spin rate φ̇.
     pub spin_rate: f64,
+    /// Spin acceleration φ̈ of a prescribed speed law (0 when φ is free).
+    pub spin_accel: f64,
     /// True when φ is a free coordinate (torques on it matter).
     pub spin_free: bool,
     /// The cargoes.
@@ -57,10 +60,23 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>);
 }
 
+/// What an effect may need to know of the rest of the scene to accept it.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneFacts {
+    /// The rotor is the plane (Jeffcott) rotor: one race, (x, y) coordinates.
+    pub plane_rotor: bool,
+    /// The speed law is prescribed (constant or ramp), not a motor or free.
+    pub prescribed_speed: bool,
+}
+
 /// An effect's parameters as a scene file gives them (`[effects.<key>]`).
 pub trait EffectSpec {
     /// Check the parameters; `key` is the field prefix, e.g. `effects.gravity`.
     fn validate(&self, _key: &str) -> Result<(), SceneError> {
+        Ok(())
+    }
+    /// Refuse a scene the effect's equations do not cover.
+    fn check_scene(&self, _key: &str, _facts: &SceneFacts) -> Result<(), SceneError> {
         Ok(())
     }
     /// The effect for these cargoes at nominal speed `omega`; `None` when it
@@ -158,14 +174,20 @@ effect_registry! {
         /// Rolling resistance (pivot friction for pendulums): absent, none.
         #[serde(default)]
         rolling_resistance: rolling::RollingResistance,
+        /// The race's centre off the rotation axis: absent, none.
+        #[serde(default)]
+        race_eccentricity: race_eccentricity::RaceEccentricity,
     },
 }
 
 impl Effects {
-    /// Check the parameters of every enabled effect; the first problem found is returned.
-    pub fn validate(&self) -> Result<(), SceneError> {
+    /// Check the parameters of every enabled effect, and that the scene is
+    /// one its equations cover; the first problem found is returned.
+    pub fn validate(&self, facts: &SceneFacts) -> Result<(), SceneError> {
         for (key, spec) in self.enabled() {
-            spec.validate(&format!("effects.{key}"))?;
+            let key = format!("effects.{key}");
+            spec.validate(&key)?;
+            spec.check_scene(&key, facts)?;
         }
         Ok(())
     }
