@@ -114,7 +114,16 @@ impl Contact {
 
 /// Angle b − a wrapped to (−π, π].
 pub fn wrapped(d: f64) -> f64 {
-    let w = d.rem_euclid(TAU);
+    // Within one turn `rem_euclid` is d or d + 2π (fmod returns d exactly
+    // when |d| < 2π): the same bits without the fmod call, which was 2 % of
+    // a study's time in the gap gauge and the contact effect.
+    let w = if (0.0..TAU).contains(&d) {
+        d
+    } else if d < 0.0 && d > -TAU {
+        d + TAU
+    } else {
+        d.rem_euclid(TAU)
+    };
     if w > PI { w - TAU } else { w }
 }
 
@@ -206,6 +215,30 @@ impl Effect for Contact {
             self.all_pairs(ctx, forces);
         } else {
             self.neighbours(ctx, forces);
+        }
+    }
+}
+
+#[cfg(test)]
+mod wrap_tests {
+    use super::*;
+
+    #[test]
+    fn the_fast_path_gives_the_bits_of_rem_euclid() {
+        let slow = |d: f64| {
+            let w = d.rem_euclid(TAU);
+            if w > PI { w - TAU } else { w }
+        };
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut cases = vec![0.0, -0.0, PI, -PI, TAU, -TAU, 1e-300, -1e-300, 7.0, -7.0];
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            cases.push(((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 30.0);
+        }
+        for d in cases {
+            assert_eq!(wrapped(d).to_bits(), slow(d).to_bits(), "d = {d}");
         }
     }
 }
