@@ -36,5 +36,6 @@ mod study_input;
 mod study_runner;
 mod study_summary;
 mod study_sweep;
+mod tolerances;
 mod toy_effect;
 mod tradeoff;
