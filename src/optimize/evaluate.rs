@@ -13,6 +13,29 @@ use crate::study::sample::{Purpose, stream};
 use crate::study::verdict::settling_horizon;
 use rayon::prelude::*;
 
+/// A run's residual vibration for the robust-design objectives: the
+/// measured `residual_abs` (m) of a run simulated to its end or to its
+/// settling (settled or censored: the residual is observed either way, as
+/// the RMS over the last hold window), +∞ for a run that has none (diverged,
+/// failed, out of budget, or only estimated), so that it never meets a spec.
+pub fn measured_residual(m: &crate::metrics::RunMetrics) -> f64 {
+    use crate::metrics::Outcome;
+    match m.outcome {
+        Outcome::Settled | Outcome::Censored if m.residual_abs.is_finite() => m.residual_abs,
+        _ => f64::INFINITY,
+    }
+}
+
+/// Share of runs whose [`measured_residual`] lies below `spec` (m): the
+/// value of `p_residual_below`.
+pub fn share_below(metrics: &[crate::metrics::RunMetrics], spec: f64) -> f64 {
+    let below = metrics
+        .iter()
+        .filter(|m| measured_residual(m) < spec)
+        .count();
+    below as f64 / metrics.len() as f64
+}
+
 /// A point of the design space.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
@@ -176,6 +199,25 @@ impl Evaluator<'_> {
             }
             Objective::Residual => {
                 mean_se(&metrics.iter().map(|m| m.residual_rel).collect::<Vec<_>>())
+            }
+            Objective::ResidualP95 => {
+                let residuals: Vec<f64> = metrics.iter().map(measured_residual).collect();
+                let at = |v: &[f64]| {
+                    quantile(v, 0.95, Interpolation::Linear).expect("at least one sample")
+                };
+                let value = at(&residuals);
+                let se = bootstrap::std_error(
+                    &residuals,
+                    at,
+                    &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
+                );
+                // Resamples that reach a +∞ run make the spread +∞ or NaN.
+                (value, if se.is_finite() { se } else { 0.0 })
+            }
+            Objective::PResidualBelow => {
+                let spec = self.spec.residual_spec.expect("validated");
+                let p = share_below(&metrics, spec);
+                (p, (p * (1.0 - p) / n).sqrt())
             }
             Objective::Capacity | Objective::ATilde => {
                 unreachable!("analytic objectives are not simulated")

@@ -118,6 +118,33 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             "give safety_factor and max_unbalance together",
         ));
     }
+    match (spec.objective, spec.residual_spec) {
+        (Objective::PResidualBelow, None) => {
+            return Err(bad(
+                "residual_spec",
+                "missing".into(),
+                "p_residual_below needs the residual a machine may show (m), e.g. residual_spec = 2e-5",
+            ));
+        }
+        (Objective::PResidualBelow, Some(v)) if !(v.is_finite() && v > 0.0) => {
+            return Err(bad(
+                "residual_spec",
+                v.to_string(),
+                "must be positive and finite (m)",
+            ));
+        }
+        (Objective::PResidualBelow, Some(_)) | (_, None) => {}
+        (other, Some(v)) => {
+            return Err(bad(
+                "residual_spec",
+                v.to_string(),
+                &format!(
+                    "only used by objective = \"p_residual_below\", not \"{}\"",
+                    other.name()
+                ),
+            ));
+        }
+    }
     if spec.samples == Some(0) {
         return Err(bad(
             "samples",

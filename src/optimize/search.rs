@@ -38,6 +38,9 @@ impl CandidateCost<'_> {
         };
         let e = self.evaluator.evaluate(c, self.phase);
         let cost = match e.value {
+            // A p95 that reaches a run without a residual is +∞: as bad as
+            // infeasible, and finite for the solvers.
+            Some(v) if !v.is_finite() => INFEASIBLE,
             Some(v) if self.evaluator.spec.objective.maximise() => -v,
             Some(v) => v,
             None => INFEASIBLE,

@@ -212,6 +212,9 @@ pub struct Sampling {
     /// Samples per design in each batch of adaptive sampling.
     #[serde(default = "default_batch")]
     pub batch: u32,
+    /// Manufacturing tolerances of the weights, sampled per run (off unless given).
+    #[serde(default)]
+    pub tolerances: Option<super::tolerance::Tolerances>,
 }
 
 fn default_batch() -> u32 {
@@ -612,6 +615,10 @@ impl StudyFile {
         let designs = self
             .resolve_designs()
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+        if let Some(t) = &s.tolerances {
+            super::tolerance::validate(t, &designs)
+                .map_err(|(k, v, r)| invalid(&format!("sampling.tolerances.{k}"), v, &r))?;
+        }
         if s.unbalance.relative_to == Scale::Absolute && s.require_balanceable {
             let upper = s.unbalance.distribution.upper();
             if let Some(d) = designs.iter().find(|d| d.capacity < upper) {

@@ -3,6 +3,7 @@
 //!
 //! - [`config`]: the study file schema, validation and the resolved plan.
 //! - [`sample`]: per-run random streams and draws.
+//! - [`tolerance`]: manufacturing tolerances of the weights, sampled per run.
 //! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
 //! - [`record`]: one row of `runs.parquet`.
@@ -29,4 +30,5 @@ pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
 pub mod sweep;
+pub mod tolerance;
 pub mod verdict;

@@ -25,6 +25,13 @@ pub enum Objective {
     SettledFraction,
     /// Mean residual vibration relative to A_ref (minimised).
     Residual,
+    /// 95th percentile of the absolute residual vibration `residual_abs` (m)
+    /// over every run (minimised); a run without a measured residual
+    /// (diverged, failed, out of budget) counts as +∞.
+    ResidualP95,
+    /// Share of runs whose absolute residual vibration is below
+    /// `residual_spec` (maximised); a run without a measured residual fails.
+    PResidualBelow,
 }
 
 impl Objective {
@@ -32,7 +39,10 @@ impl Objective {
     pub fn maximise(self) -> bool {
         matches!(
             self,
-            Objective::Capacity | Objective::ATilde | Objective::SettledFraction
+            Objective::Capacity
+                | Objective::ATilde
+                | Objective::SettledFraction
+                | Objective::PResidualBelow
         )
     }
 
@@ -51,6 +61,8 @@ impl Objective {
             Objective::SettlingP90 => "settling_p90",
             Objective::SettledFraction => "settled_fraction",
             Objective::Residual => "residual",
+            Objective::ResidualP95 => "residual_p95",
+            Objective::PResidualBelow => "p_residual_below",
         }
     }
 }
@@ -98,6 +110,10 @@ pub struct OptimizeSpec {
     /// Objective evaluations per (kind, n) at most.
     #[serde(default = "default_evaluations")]
     pub max_evaluations: u64,
+    /// The residual vibration a machine may show (m, against `residual_abs`):
+    /// required by, and only used by, `objective = "p_residual_below"`.
+    #[serde(default)]
+    pub residual_spec: Option<f64>,
 }
 
 fn rho_only() -> Vec<Variable> {

@@ -1,11 +1,12 @@
 //! One row of `runs.parquet`: the design, the sample, every metric, the
 //! outcome and the solver's cost; and its conversion to and from polars.
 
+use super::tolerance::SampledWeights;
 use crate::metrics::{Outcome, RunMetrics};
 use polars::prelude::*;
 
 /// Everything recorded about one run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct RunRecord {
     /// Global run index: design_id × samples + sample_id.
     pub run_id: u64,
@@ -44,7 +45,45 @@ pub struct RunRecord {
     pub contact: bool,
     /// Wall-clock time of the run (s); excluded from determinism checks.
     pub wall_time_s: f64,
+    /// The weights as built, when the study samples tolerances (columns
+    /// `weight_masses`, `weight_radii`, `track_radii`; absent otherwise).
+    pub weights: Option<SampledWeights>,
 }
+
+/// As derived, but `weights` is shown only when the study sampled them: the
+/// golden files print records with `{:?}`, and a study without tolerances
+/// must print exactly what it printed before they existed.
+impl std::fmt::Debug for RunRecord {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("RunRecord");
+        s.field("run_id", &self.run_id)
+            .field("design_id", &self.design_id)
+            .field("sample_id", &self.sample_id)
+            .field("kind", &self.kind)
+            .field("n", &self.n)
+            .field("rho", &self.rho)
+            .field("race_radius", &self.race_radius)
+            .field("weight_mass", &self.weight_mass)
+            .field("capacity", &self.capacity)
+            .field("drag", &self.drag)
+            .field("unbalance", &self.unbalance)
+            .field("unbalance_fraction", &self.unbalance_fraction)
+            .field("direction_deg", &self.direction_deg)
+            .field("initial_angles_deg", &self.initial_angles_deg)
+            .field("metrics", &self.metrics)
+            .field("method", &self.method)
+            .field("contact", &self.contact)
+            .field("wall_time_s", &self.wall_time_s);
+        if let Some(w) = &self.weights {
+            s.field("weights", w);
+        }
+        s.finish()
+    }
+}
+
+/// Columns of the sampled weights, in order; written only by studies with
+/// `[sampling.tolerances]`, so that other studies' files keep their schema.
+pub const WEIGHT_COLUMNS: [&str; 3] = ["weight_masses", "weight_radii", "track_radii"];
 
 fn list_column(name: &str, rows: impl Iterator<Item = Vec<f64>>) -> Column {
     let series: Vec<Series> = rows.map(|v| Series::new(PlSmallStr::EMPTY, v)).collect();
@@ -58,7 +97,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             Column::new($name.into(), rows.iter().map($f).collect::<Vec<_>>())
         };
     }
-    let columns = vec![
+    let mut columns = vec![
         col!("run_id", |r: &RunRecord| r.run_id),
         col!("design_id", |r: &RunRecord| r.design_id),
         col!("sample_id", |r: &RunRecord| r.sample_id),
@@ -115,6 +154,17 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             .final_min_gap_rad),
         col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
     ];
+    // All rows of a study sample tolerances or none do.
+    if rows.iter().any(|r| r.weights.is_some()) {
+        let weights = |pick: fn(&SampledWeights) -> &Vec<f64>| {
+            rows.iter()
+                .map(move |r| r.weights.as_ref().map(pick).cloned().unwrap_or_default())
+        };
+        let [masses, radii, tracks] = WEIGHT_COLUMNS;
+        columns.push(list_column(masses, weights(|w| &w.masses)));
+        columns.push(list_column(radii, weights(|w| &w.radii)));
+        columns.push(list_column(tracks, weights(|w| &w.track_radii)));
+    }
     DataFrame::new(rows.len(), columns)
 }
 
@@ -227,6 +277,23 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let contact = bools("contact")?;
     let (min_gap, final_gap) = (f64s("min_gap_rad")?, f64s("final_min_gap_rad")?);
     let censoring = f64s("censoring_revs")?;
+    let weights: Option<Vec<SampledWeights>> = if df.column(WEIGHT_COLUMNS[0]).is_ok() {
+        let [masses, radii, tracks] = WEIGHT_COLUMNS;
+        let (m, r, l) = (lists(masses)?, lists(radii)?, lists(tracks)?);
+        Some(
+            m.into_iter()
+                .zip(r)
+                .zip(l)
+                .map(|((masses, radii), track_radii)| SampledWeights {
+                    masses,
+                    radii,
+                    track_radii,
+                })
+                .collect(),
+        )
+    } else {
+        None
+    };
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -272,6 +339,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
             contact: contact[i],
             method: method[i].clone(),
             wall_time_s: wall[i],
+            weights: weights.as_ref().map(|w| w[i].clone()),
         });
     }
     Ok(out)

@@ -263,9 +263,11 @@ pub fn sample_simulation(
     design: &Design,
     sample_id: u64,
 ) -> (Sample, Simulation) {
-    let sample = draw_sample(plan, design, sample_id);
+    let mut sample = draw_sample(plan, design, sample_id);
+    let mut scene = plan.scene(design, sample.unbalance, sample.direction);
+    sample.weights = super::tolerance::apply(plan, design, sample_id, &mut scene);
     let simulation = Simulation {
-        scene: plan.scene(design, sample.unbalance, sample.direction),
+        scene,
         start: plan.file.scene.start,
         initial_angles: sample.initial_angles.clone(),
         solver: plan.file.solver.clone(),
@@ -330,6 +332,7 @@ pub fn run_design_sample(
         metrics,
         contact,
         wall_time_s: clock.elapsed().as_secs_f64(),
+        weights: sample.weights,
     }
 }
 

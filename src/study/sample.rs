@@ -8,6 +8,7 @@
 //! designs are not sampling noise.
 
 use super::config::{Design, DirectionSpec, Distribution, InitialSpec, Scale, StudyPlan};
+use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
 use crate::model::start::balanced_fan;
 use rand::{RngExt, SeedableRng};
@@ -35,6 +36,10 @@ pub enum Purpose {
     Bootstrap = 3,
     /// Bootstrap resampling of a comparison of two designs.
     Comparison = 4,
+    /// Each weight's mass ([`super::tolerance`]).
+    MassTolerance = 5,
+    /// Each weight's radius ([`super::tolerance`]).
+    RadiusTolerance = 6,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for
@@ -59,6 +64,9 @@ pub struct Sample {
     pub direction: f64,
     /// Initial cargo angles relative to the rotor (rad).
     pub initial_angles: Vec<f64>,
+    /// The weights as built, when the study samples tolerances (filled by
+    /// [`super::run::sample_simulation`], which builds the scene).
+    pub weights: Option<SampledWeights>,
 }
 
 fn draw(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
@@ -133,6 +141,7 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         fraction,
         direction,
         initial_angles,
+        weights: None,
     }
 }
 

@@ -130,6 +130,36 @@ pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
     ("name = \"corpus\"", "name = \"../escape\"", "name"),
     ("mass = 10.0", "mass = = 10.0", "line"),
     ("[designs]", "[designz]", "designz"),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ntolerances = { mass = { sigma = -0.01, relative = true } }",
+        "sampling.tolerances.mass.sigma",
+    ),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ntolerances = { masss = { sigma = 0.01 } }",
+        "masss",
+    ),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ntolerances = { mass = { sigma = 0.01, sd = 0.1 } }",
+        "sd",
+    ),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ntolerances = { mass = { sigma = 1e-3, limit = 0.0 } }",
+        "sampling.tolerances.mass.limit",
+    ),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ntolerances = { radius = { sigma = 0.5, relative = true } }",
+        "sampling.tolerances.radius.sigma",
+    ),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ntolerances = { radius = { sigma = 2e-3 } }",
+        "sampling.tolerances.radius.sigma",
+    ),
 ];
 
 /// (what to replace in the scene, with what, a text the message must contain).

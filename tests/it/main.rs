@@ -37,5 +37,6 @@ mod study_input;
 mod study_runner;
 mod study_summary;
 mod study_sweep;
+mod tolerances;
 mod toy_effect;
 mod tradeoff;

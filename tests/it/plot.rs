@@ -283,6 +283,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                 method: "dp5".into(),
                 contact: true,
                 wall_time_s: 0.001,
+                weights: None,
             });
         }
     }

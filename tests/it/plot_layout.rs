@@ -269,6 +269,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                     method: "dp5".into(),
                     contact: true,
                     wall_time_s: 0.001,
+                    weights: None,
                 });
             }
             let p = settled_count as f64 / f64::from(samples);

@@ -77,6 +77,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
         method: "dp5".into(),
         contact: true,
         wall_time_s: 0.001,
+        weights: None,
     }
 }
 

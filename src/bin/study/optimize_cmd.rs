@@ -3,6 +3,7 @@
 use crate::UserError;
 use crate::output::text_table;
 use autobal::optimize::optimize;
+use autobal::optimize::spec::Objective;
 use autobal::study::config::load;
 use clap::Args;
 use std::path::PathBuf;
@@ -28,6 +29,20 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         .optimize
         .as_ref()
         .map_or("", |o| o.objective.name());
+    // A residual in metres (µm-sized) would print as 0.00000 at the other
+    // objectives' five decimals.
+    let metres = plan
+        .file
+        .optimize
+        .as_ref()
+        .is_some_and(|o| o.objective == Objective::ResidualP95);
+    let shown = |v: f64| {
+        if metres {
+            format!("{v:.4e}")
+        } else {
+            format!("{v:.5}")
+        }
+    };
     let rows: Vec<Vec<String>> = out
         .best
         .iter()
@@ -39,8 +54,8 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
                 e.candidate.n.to_string(),
                 format!("{:.4}", e.candidate.rho),
                 format!("{:.3}", e.candidate.drag),
-                e.value.map_or("–".into(), |v| format!("{v:.5}")),
-                format!("{:.5}", e.std_err),
+                e.value.map_or("–".into(), shown),
+                shown(e.std_err),
                 e.capacity.map_or("–".into(), |c| format!("{c:.4e}")),
                 if e.feasible {
                     "ok".into()
