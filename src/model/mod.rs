@@ -27,6 +27,7 @@ pub mod scene;
 pub mod speed;
 pub mod start;
 pub mod system;
+pub mod tilt_inertia;
 pub mod unbalance;
 pub mod validate;
 pub mod zero_approx;

@@ -162,6 +162,13 @@ impl Scene {
             }
             SpeedLaw::Free { omega_start } => non_negative("speed.omega_start", *omega_start)?,
         }
+        if self.rotor.as_rotor().tilt_map(0).is_some() && !self.speed.is_prescribed() {
+            return Err(SceneError::Invalid {
+                field: "rotor.weights_tilt_inertia".into(),
+                value: "true".into(),
+                reason: "the weights' tilt inertia is modelled at a prescribed speed (constant or ramp) only: with a motor or a free rotor the spin equation's share is missing".into(),
+            });
+        }
         self.effects.validate(&SceneFacts {
             plane_rotor: self.rotor.downcast_ref::<PlaneRotor>().is_some(),
             prescribed_speed: self.speed.is_prescribed(),

@@ -16,6 +16,7 @@ use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
 use super::rotor::{DofVec, MAX_DOF, Rotor};
 use super::speed::SpeedLaw;
+use super::tilt_inertia::TiltTerms;
 use crate::integrate::OdeSystem;
 
 /// Largest head block: rotor coordinates plus the spin angle.
@@ -63,6 +64,8 @@ pub struct RotorSystem {
     /// κ m l² per cargo (cached: used twice per cargo per call).
     inertia: Vec<f64>,
     plane_maps: Vec<[DofVec; 2]>,
+    /// Tilt maps of the planes whose weights' tilt inertia is modelled.
+    tilt_maps: Vec<Option<[DofVec; 2]>>,
     speed: SpeedLaw,
     effects: Vec<Box<dyn Effect>>,
     layout: Layout,
@@ -84,6 +87,7 @@ impl RotorSystem {
     ) -> Self {
         let k = rotor.dof();
         let plane_maps: Vec<_> = (0..rotor.planes()).map(|p| rotor.plane_map(p)).collect();
+        let tilt_maps: Vec<_> = (0..rotor.planes()).map(|p| rotor.tilt_map(p)).collect();
         let mut head_mass = rotor.mass_matrix();
         for c in &cargo {
             let [gu, gv] = plane_maps[c.plane];
@@ -106,6 +110,7 @@ impl RotorSystem {
             rotor,
             cargo,
             plane_maps,
+            tilt_maps,
             speed,
             effects,
             layout,
@@ -255,6 +260,29 @@ impl OdeSystem for RotorSystem {
                 qj -= (inertia - jc) * spin_accel;
                 cargo_f[j] = qj;
             }
+            if let Some(tilt) = &self.tilt_maps[c.plane] {
+                // The m R² terms (src/model/tilt_inertia.rs); the scene
+                // guarantees a prescribed speed.
+                let t = TiltTerms::at(
+                    tilt,
+                    k,
+                    c.mass,
+                    c.track_radius,
+                    (s, co),
+                    rate,
+                    &q[..k],
+                    &qd[..k],
+                );
+                for r in 0..k {
+                    for col in 0..k {
+                        a[r][col] += t.mu * t.jac[r] * t.jac[col];
+                    }
+                    g[r] -= t.rotor_force * t.jac[r] + t.coupling[r] * spin_accel;
+                    w[r] += t.coupling[r];
+                }
+                qj += t.cargo_force;
+                cargo_f[j] = qj;
+            }
             let inv = 1.0 / inertia;
             for r in 0..k {
                 let er = w[r] * inv;
@@ -299,6 +327,20 @@ impl OdeSystem for RotorSystem {
             let mut wz = 0.0;
             for i in 0..k {
                 wz += ml * (co * gv[i] - s * gu[i]) * z_rotor[i];
+            }
+            if let Some(tilt) = &self.tilt_maps[c.plane] {
+                let rate = spin_rate + psi_rate[j];
+                let t = TiltTerms::at(
+                    tilt,
+                    k,
+                    c.mass,
+                    c.track_radius,
+                    (s, co),
+                    rate,
+                    &q[..k],
+                    &qd[..k],
+                );
+                wz += (0..k).map(|i| t.coupling[i] * z_rotor[i]).sum::<f64>();
             }
             let spin_term = (self.inertia[j] - c.rolling_coupling) * z_spin;
             cargo_f[j] = (cargo_f[j] - wz - spin_term) / self.inertia[j];

@@ -37,6 +37,7 @@ mod study_input;
 mod study_runner;
 mod study_summary;
 mod study_sweep;
+mod tilt_inertia;
 mod tolerances;
 mod toy_effect;
 mod tradeoff;

@@ -53,6 +53,7 @@ fn long_rotor(planes: Vec<f64>, unbalances: Vec<PointUnbalance>) -> RotorModel {
         moment_unbalance: 0.0,
         moment_angle: 0.0,
         unbalances,
+        weights_tilt_inertia: false,
     }
     .into()
 }

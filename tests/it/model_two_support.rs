@@ -38,6 +38,7 @@ fn long_rotor(planes: Vec<f64>) -> TwoSupportRotor {
         moment_unbalance: 0.0,
         moment_angle: 0.0,
         unbalances: Vec::new(),
+        weights_tilt_inertia: false,
     }
 }
 
@@ -91,6 +92,7 @@ fn tilt_locked_rotor_with_a_balancer_at_the_centre_of_mass_is_the_plane_rotor() 
         moment_unbalance: 0.0,
         moment_angle: 0.0,
         unbalances: Vec::new(),
+        weights_tilt_inertia: false,
     };
     let mut plane = PlaneRotor::isotropic(1.0, 0.01, 2.0, 0.2);
     plane.unbalance_angle = 0.3;
@@ -170,6 +172,7 @@ fn free_rotor() -> TwoSupportRotor {
             z: 0.3,
             angle: -0.7,
         }],
+        weights_tilt_inertia: false,
     }
 }
 

@@ -37,6 +37,7 @@ fn rotor(planes: Vec<f64>, a: f64, c: f64, damping: f64) -> TwoSupportRotor {
             z: 0.0,
             angle: 0.0,
         }],
+        weights_tilt_inertia: false,
     }
 }
 

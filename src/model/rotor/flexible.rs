@@ -15,9 +15,9 @@
 //! α̇ and β̇ (eqs 22–23 in the rotating frame: (J_z − 2J)ω and (J_z − J)ω²).
 //! The disc's eccentricity ε is its static unbalance M ε.
 //!
-//! As in `two_support`, the balls are point masses in the disc plane: the
-//! m R² terms of eqs 22–23 (their axial motion when the disc tilts) are left
-//! out, about m R²/J = 4 m/M of the tilt inertia.
+//! As in `two_support`, the balls are point masses in the disc plane; the
+//! m R² terms of eqs 22–23 (their motion with the tilting disc, about
+//! m R²/J = 4 m/M of the tilt inertia) are added by `weights_tilt_inertia`.
 
 use super::{DofVec, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, finite, non_negative, positive};
@@ -50,6 +50,11 @@ pub struct FlexibleShaft {
     /// Direction of the eccentricity at φ = 0 (rad).
     #[serde(default)]
     pub unbalance_angle: f64,
+    /// Model the weights' tilt inertia, the m R² terms of seed 002's eqs
+    /// 22–23: a weight at radius l adds m l² (α̇ sin φ_j − β̇ cos φ_j)²/2 and
+    /// m l² φ̇_j (α̇β − αβ̇)/2 to the kinetic energy (prescribed speed only).
+    #[serde(default)]
+    pub weights_tilt_inertia: bool,
 }
 
 impl FlexibleShaft {
@@ -71,6 +76,7 @@ impl FlexibleShaft {
             c_r: 4.0 * zeta_r * (j * ei / length).sqrt(),
             eccentricity: eps_over_r * r,
             unbalance_angle: 0.0,
+            weights_tilt_inertia: false,
         }
     }
 
@@ -111,6 +117,11 @@ impl Rotor for FlexibleShaft {
 
     fn plane_map(&self, _plane: usize) -> [DofVec; 2] {
         [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]
+    }
+
+    fn tilt_map(&self, _plane: usize) -> Option<[DofVec; 2]> {
+        self.weights_tilt_inertia
+            .then_some([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
     }
 
     fn mass_matrix(&self) -> [DofVec; MAX_DOF] {

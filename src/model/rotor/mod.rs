@@ -49,6 +49,14 @@ pub trait Rotor: Any + Send + Sync + std::fmt::Debug {
     /// Rows G_u, G_v of the map from rotor coordinates to the displacement
     /// (u, v) of balancer plane `plane`'s centre.
     fn plane_map(&self, plane: usize) -> [DofVec; 2];
+    /// Rows T_α, T_β of the map from rotor coordinates to the tilt (α, β) of
+    /// balancer plane `plane` (axis direction (β, −α, 1)), when the weights'
+    /// tilt inertia (the m R² terms, `src/model/tilt_inertia.rs`) is
+    /// modelled; `None` (the default) leaves the weights point masses that
+    /// see only their plane's translation.
+    fn tilt_map(&self, _plane: usize) -> Option<[DofVec; 2]> {
+        None
+    }
     /// Constant mass matrix of the rotor alone over its coordinates (k × k).
     fn mass_matrix(&self) -> [DofVec; MAX_DOF];
     /// Polar moment of inertia J_P of the rotor about its spin axis.

@@ -15,10 +15,11 @@
 //! ½C(β, −α) at variable speed, and conserves the angular momentum about the
 //! axis. Potential: ½k11(x² + y²) + ½k33(α² + β²) + k14(xβ − yα).
 //!
-//! Cargoes are point masses in their plane: they see the plane centre's
-//! displacement only. Their axial velocity l(α̇ sin φ_j − β̇ cos φ_j + …),
-//! second order in the tilt in T, is neglected: it would add about m l² to
-//! the tilt inertia, small against |A − C| for the balancers considered here.
+//! Cargoes are point masses in their plane: by default they see the plane
+//! centre's displacement only. With `weights_tilt_inertia` their motion
+//! with the tilting plane (the m R² terms, second order in the tilt in T)
+//! is added by `src/model/tilt_inertia.rs`; docs/rotors.md measures when it
+//! matters.
 //!
 //! The rotor's own unbalance: static S and moment I (eq 6) as point
 //! unbalances s at z and angle θ, or directly as |S|, arg S, |I|, arg I.
@@ -84,6 +85,11 @@ pub struct TwoSupportRotor {
     /// Point unbalances.
     #[serde(default)]
     pub unbalances: Vec<PointUnbalance>,
+    /// Model the weights' tilt inertia, the m R² terms of seed 002's eqs
+    /// 22–23: a weight at radius l adds m l² (α̇ sin φ_j − β̇ cos φ_j)²/2 and
+    /// m l² φ̇_j (α̇β − αβ̇)/2 to the kinetic energy (prescribed speed only).
+    #[serde(default)]
+    pub weights_tilt_inertia: bool,
 }
 
 impl TwoSupportRotor {
@@ -145,6 +151,11 @@ impl Rotor for TwoSupportRotor {
     fn plane_map(&self, plane: usize) -> [DofVec; 2] {
         let z = self.planes[plane];
         [[1.0, 0.0, 0.0, z], [0.0, 1.0, -z, 0.0]]
+    }
+
+    fn tilt_map(&self, _plane: usize) -> Option<[DofVec; 2]> {
+        self.weights_tilt_inertia
+            .then_some([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
     }
 
     fn mass_matrix(&self) -> [DofVec; MAX_DOF] {
