@@ -616,7 +616,15 @@ impl StudyFile {
             .resolve_designs()
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;
         if let Some(t) = &s.tolerances {
-            super::tolerance::validate(t, &designs)
+            let facts = crate::model::effect::SceneFacts {
+                plane_rotor: self
+                    .scene
+                    .rotor
+                    .downcast_ref::<crate::model::rotor::PlaneRotor>()
+                    .is_some(),
+                prescribed_speed: self.scene.speed.is_prescribed(),
+            };
+            super::tolerance::validate(t, &designs, &facts)
                 .map_err(|(k, v, r)| invalid(&format!("sampling.tolerances.{k}"), v, &r))?;
         }
         if s.unbalance.relative_to == Scale::Absolute && s.require_balanceable {

@@ -85,6 +85,10 @@ impl std::fmt::Debug for RunRecord {
 /// `[sampling.tolerances]`, so that other studies' files keep their schema.
 pub const WEIGHT_COLUMNS: [&str; 3] = ["weight_masses", "weight_radii", "track_radii"];
 
+/// Columns of the race centre's offset (m) and direction (degrees), written
+/// with the weight columns; null when neither sampled nor set by the scene.
+pub const RACE_COLUMNS: [&str; 2] = ["race_offset", "race_angle_deg"];
+
 fn list_column(name: &str, rows: impl Iterator<Item = Vec<f64>>) -> Column {
     let series: Vec<Series> = rows.map(|v| Series::new(PlSmallStr::EMPTY, v)).collect();
     Column::new(name.into(), series)
@@ -164,6 +168,14 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         columns.push(list_column(masses, weights(|w| &w.masses)));
         columns.push(list_column(radii, weights(|w| &w.radii)));
         columns.push(list_column(tracks, weights(|w| &w.track_radii)));
+        let race = |pick: fn(&(f64, f64)) -> f64| {
+            rows.iter()
+                .map(move |r| r.weights.as_ref().and_then(|w| w.race.as_ref()).map(pick))
+                .collect::<Vec<_>>()
+        };
+        let [offset, angle] = RACE_COLUMNS;
+        columns.push(Column::new(offset.into(), race(|r| r.0)));
+        columns.push(Column::new(angle.into(), race(|r| r.1)));
     }
     DataFrame::new(rows.len(), columns)
 }
@@ -280,14 +292,18 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let weights: Option<Vec<SampledWeights>> = if df.column(WEIGHT_COLUMNS[0]).is_ok() {
         let [masses, radii, tracks] = WEIGHT_COLUMNS;
         let (m, r, l) = (lists(masses)?, lists(radii)?, lists(tracks)?);
+        let [offset, angle] = RACE_COLUMNS;
+        let (offsets, angles) = (f64s(offset)?, f64s(angle)?);
         Some(
             m.into_iter()
                 .zip(r)
                 .zip(l)
-                .map(|((masses, radii), track_radii)| SampledWeights {
+                .zip(offsets.into_iter().zip(angles))
+                .map(|(((masses, radii), track_radii), race)| SampledWeights {
                     masses,
                     radii,
                     track_radii,
+                    race: race.0.zip(race.1),
                 })
                 .collect(),
         )

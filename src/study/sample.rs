@@ -40,6 +40,8 @@ pub enum Purpose {
     MassTolerance = 5,
     /// Each weight's radius ([`super::tolerance`]).
     RadiusTolerance = 6,
+    /// The race centre's offset from the axis ([`super::tolerance`]).
+    EccentricityTolerance = 7,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for

@@ -20,15 +20,21 @@
 //! tolerance rebuilds the weight from its kind's model at r_j; a mass
 //! tolerance (density, bores, inclusions) scales the mass at fixed geometry.
 //!
-//! Extension point: race eccentricity (issue 19, item 2) is a property of the
-//! race, not of a weight. It would add a field to [`Tolerances`], a
-//! [`Purpose`] of its own (so that no draw here moves), its draw in [`apply`]
-//! and a column beside the ones of [`SampledWeights`].
+//! Race eccentricity (issue 19, item 2) is a property of the race, not of a
+//! weight: `eccentricity = { sigma }` draws the race centre's offset as two
+//! independent truncated normals (x, y in the rotor frame, σ each, so the
+//! offset's size is Rayleigh-distributed) from a stream of its own
+//! ([`Purpose::EccentricityTolerance`]), adds it to the scene's nominal
+//! `[effects.race_eccentricity]` if any, and records it in the columns
+//! `race_offset` (m) and `race_angle_deg`. The effect models the plane rotor
+//! at a prescribed speed; other studies are refused when validated.
 
 use super::config::{Design, StudyPlan};
 use super::sample::{Purpose, stream};
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
+use crate::model::effect::SceneFacts;
+use crate::model::effect::race_eccentricity::RaceEccentricity;
 use crate::model::scene::Scene;
 use rand_distr::{Distribution as _, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -48,6 +54,11 @@ pub struct Tolerances {
     /// l = R − r_j, its mass and its contact size follow.
     #[serde(default)]
     pub radius: Option<Tolerance>,
+    /// Spread of the race centre's offset from the rotation axis, per axis
+    /// of the rotor frame (m; absolute only): see
+    /// [`crate::model::effect::race_eccentricity`].
+    #[serde(default)]
+    pub eccentricity: Option<Tolerance>,
 }
 
 /// A normal spread truncated at ±`limit`·σ.
@@ -102,6 +113,9 @@ pub struct SampledWeights {
     pub radii: Vec<f64>,
     /// Track radius l_j of the centre of mass (m).
     pub track_radii: Vec<f64>,
+    /// The race centre's offset (m) and its direction (degrees) when the
+    /// study samples it or the scene sets one.
+    pub race: Option<(f64, f64)>,
 }
 
 /// A bad tolerance: (key under `sampling.tolerances`, value, reason).
@@ -109,8 +123,45 @@ pub type ToleranceError = (String, String, String);
 
 /// Check the table against its domain and against every design (masses
 /// and radii stay positive, the largest weights still fit, every radius in
-/// reach builds a weight of the design's kind).
-pub fn validate(t: &Tolerances, designs: &[Design]) -> Result<(), ToleranceError> {
+/// reach builds a weight of the design's kind) and the scene (`facts`: race
+/// eccentricity needs the plane rotor at a prescribed speed).
+pub fn validate(
+    t: &Tolerances,
+    designs: &[Design],
+    facts: &SceneFacts,
+) -> Result<(), ToleranceError> {
+    if let Some(tol) = &t.eccentricity {
+        let key = |k: &str| format!("eccentricity.{k}");
+        if !(tol.sigma.is_finite() && tol.sigma >= 0.0) {
+            return Err((
+                key("sigma"),
+                tol.sigma.to_string(),
+                "a standard deviation in m: finite and ≥ 0".into(),
+            ));
+        }
+        if !(tol.limit > 0.0 && tol.limit <= 10.0) {
+            return Err((
+                key("limit"),
+                tol.limit.to_string(),
+                "a truncation in standard deviations, in (0, 10]".into(),
+            ));
+        }
+        if tol.relative {
+            return Err((
+                key("relative"),
+                "true".into(),
+                "an offset has no nominal size to be relative to: give sigma in m".into(),
+            ));
+        }
+        if !(facts.plane_rotor && facts.prescribed_speed) {
+            return Err((
+                key("sigma"),
+                tol.sigma.to_string(),
+                "race eccentricity is modelled for the plane rotor at a prescribed speed only"
+                    .into(),
+            ));
+        }
+    }
     // Radius first: it sets the lightest nominal mass the mass tolerance meets.
     for (name, tol) in [("radius", &t.radius), ("mass", &t.mass)] {
         let Some(tol) = tol else { continue };
@@ -273,10 +324,35 @@ pub fn apply(
         }
         cargo.push(c);
     }
+    if let Some(tol) = &t.eccentricity {
+        let mut rng = stream(seed, shared, sample, Purpose::EccentricityTolerance);
+        let (dx, dy) = (
+            tol.sigma * truncated(&mut rng, tol.limit),
+            tol.sigma * truncated(&mut rng, tol.limit),
+        );
+        let (x0, y0) = scene
+            .effects
+            .race_eccentricity
+            .as_ref()
+            .map_or((0.0, 0.0), |e| {
+                let a = e.angle_deg.to_radians();
+                (e.offset * a.cos(), e.offset * a.sin())
+            });
+        let (x, y) = (x0 + dx, y0 + dy);
+        scene.effects.race_eccentricity = Some(RaceEccentricity {
+            offset: x.hypot(y),
+            angle_deg: y.atan2(x).to_degrees(),
+        });
+    }
     let weights = SampledWeights {
         masses: cargo.iter().map(|c| c.mass).collect(),
         radii: cargo.iter().map(|c| c.radius).collect(),
         track_radii: cargo.iter().map(|c| c.track_radius).collect(),
+        race: scene
+            .effects
+            .race_eccentricity
+            .as_ref()
+            .map(|e| (e.offset, e.angle_deg)),
     };
     scene.balancer = None;
     scene.balancers.clear();

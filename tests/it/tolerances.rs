@@ -254,3 +254,68 @@ fn p_residual_below_needs_its_spec_and_other_objectives_refuse_it() {
         assert!(err.contains(needle), "{optimize}: {err}");
     }
 }
+
+#[test]
+fn race_eccentricity_is_drawn_per_run_recorded_and_leaves_r_at_the_offset() {
+    use autobal::study::record::RACE_COLUMNS;
+    let a = tempfile::tempdir().unwrap();
+    let b = tempfile::tempdir().unwrap();
+    let table = "[sampling.tolerances]\neccentricity = { sigma = 2e-6 }";
+    let run = |dir: &Path, threads| {
+        let p = plan(&study(dir, 8, table, ""));
+        let opts = RunOptions {
+            threads: Some(threads),
+            ..RunOptions::default()
+        };
+        run_study(&p, &opts, &NoProgress).unwrap().dir
+    };
+    let (one, two) = (run(a.path(), 1), run(b.path(), 2));
+    let df = stable(&one.join("runs.parquet"));
+    assert!(df.equals_missing(&stable(&two.join("runs.parquet"))));
+    let offsets: Vec<f64> = df
+        .column(RACE_COLUMNS[0])
+        .unwrap()
+        .f64()
+        .unwrap()
+        .no_null_iter()
+        .collect();
+    assert_eq!(offsets.len(), 16);
+    // Rayleigh-sized, within the ±3σ box, not all alike.
+    assert!(
+        offsets
+            .iter()
+            .all(|&e| e > 0.0 && e <= 3.0 * 2e-6 * 2f64.sqrt())
+    );
+    assert!(offsets.iter().any(|&e| (e - offsets[0]).abs() > 1e-8));
+    // Common random numbers: sample k of both designs meets the same race.
+    assert_eq!(offsets[..8], offsets[8..]);
+    // Three balls centre the race: by the end (300 revolutions, no early
+    // stop) every run of the n = 3 design is left whirling at r = e_r, also
+    // the ones whose band δ·A_ref is below e_r and so never settle. Two
+    // balls need not (they are on one line through w + e_r e^{iθ}): measured
+    // 0.87–95 e_r.
+    let residual: Vec<f64> = df
+        .column("residual_abs")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .no_null_iter()
+        .collect();
+    for (r, e) in residual[8..].iter().zip(&offsets[8..]) {
+        assert!(
+            (r / e - 1.0).abs() < 1e-3,
+            "residual {r:.4e} against e_r {e:.4e}"
+        );
+    }
+    // A motor-driven study is refused, naming the key.
+    let motor = study(a.path(), 2, table, "").replace(
+        "mode = \"constant\"\nomega = 300.0",
+        "mode = \"motor\"\nstall_torque = 20.0\nomega_sync = 300.0",
+    );
+    let err = StudyFile::parse(&motor, "m.toml")
+        .unwrap()
+        .plan(&motor, "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("sampling.tolerances.eccentricity"), "{err}");
+}
