@@ -32,6 +32,7 @@ mod plot_layout;
 mod results_folder;
 mod rolling_resistance;
 mod schema;
+mod sommerfeld;
 mod study_input;
 mod study_runner;
 mod study_summary;

@@ -279,9 +279,12 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     min_gap_rad: None,
                     final_min_gap_rad: None,
                     censoring_revs: None,
+                    operating_time: Some(0.0),
+                    final_spin_rate: None,
                 },
                 method: "dp5".into(),
                 contact: true,
+                stall_torque: None,
                 wall_time_s: 0.001,
             });
         }
