@@ -270,28 +270,44 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             ]
         })
         .collect();
+    // A stall-torque sweep gets its own column after β (designs differ by
+    // it alone); other studies print exactly as before.
+    let torque: Vec<Option<f64>> = match summary.column("stall_torque") {
+        Ok(c) => c.f64()?.iter().collect(),
+        Err(_) => vec![None; summary.height()],
+    };
+    let swept = torque.iter().any(Option::is_some);
+    let rows: Vec<Vec<String>> = if swept {
+        rows.into_iter()
+            .zip(&order)
+            .map(|(mut row, &i)| {
+                row.insert(5, f(torque[i], 3));
+                row
+            })
+            .collect()
+    } else {
+        rows
+    };
+    let mut header = vec!["rank", "kind", "n", "ρ", "β"];
+    if swept {
+        header.push("M_s (N·m)");
+    }
+    header.extend([
+        "settled [95% CI]",
+        "t_s median [95% CI]",
+        "t_s restricted mean [95% CI]",
+        "t_s p90",
+        "residual/A_ref",
+        "best sooner in (paired runs) [95% CI], Holm p",
+    ]);
     let per_design = runs.iter().flatten().max().copied().unwrap_or(0);
     let alpha = col_f("vs_best_alpha")?
         .first()
         .copied()
         .flatten()
         .unwrap_or(f64::NAN);
-    Ok(text_table(
-        &[
-            "rank",
-            "kind",
-            "n",
-            "ρ",
-            "β",
-            "settled [95% CI]",
-            "t_s median [95% CI]",
-            "t_s restricted mean [95% CI]",
-            "t_s p90",
-            "residual/A_ref",
-            "best sooner in (paired runs) [95% CI], Holm p",
-        ],
-        &rows,
-    ) + "(settling times in revolutions over every run, a run that did not settle counting as censored: Kaplan–Meier median with its Brookmeyer–Crowley interval (∞: not bounded within the run), restricted mean up to the horizon, p90; residual: median RMS vibration over the last hold window relative to A_ref)\n"
+    Ok(text_table(&header, &rows)
+        + "(settling times in revolutions over every run, a run that did not settle counting as censored: Kaplan–Meier median with its Brookmeyer–Crowley interval (∞: not bounded within the run), restricted mean up to the horizon, p90; residual: median RMS vibration over the last hold window relative to A_ref)\n"
         + &verdict_line(summary, &order, alpha, per_design)?
         + &contact_line(summary)?
         + &passage_table(summary)?)
