@@ -215,3 +215,30 @@ fn a_bad_stall_torque_list_is_refused_naming_the_key() {
         assert!(err.contains(why), "{err}");
     }
 }
+
+#[test]
+fn study_run_prints_the_stall_torque_and_the_passage_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.toml");
+    let text = format!(
+        "output = {:?}\n{}",
+        dir.path().display().to_string(),
+        torque_study("[4.0, 12.0]", MOTOR)
+    );
+    std::fs::write(&path, text).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg("run")
+        .arg(&path)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("M_s (N·m)"), "{stdout}");
+    assert!(stdout.contains("reached operating speed"), "{stdout}");
+    // 100 revolutions at 300 rad/s are 2.1 s: too short for 4 N·m to get there.
+    assert!(stdout.contains("0/1"), "{stdout}");
+}
