@@ -156,6 +156,12 @@ pub struct RunMetrics {
     /// revolutions (the end of the run less the hold window, and no earlier
     /// than the operating point).
     pub censoring_revs: Option<f64>,
+    /// When the speed first reached its operating value (s): 0 at constant
+    /// speed, the ramp's end, or for a motor the first sample with
+    /// |φ̇ − ω| ≤ δ·ω; `None` if it never did (captured below it).
+    pub operating_time: Option<f64>,
+    /// Spin rate φ̇ at the end of the run (rad/s); `None` for estimates.
+    pub final_spin_rate: Option<f64>,
 }
 
 impl RunMetrics {
@@ -187,6 +193,8 @@ impl RunMetrics {
             min_gap_rad: None,
             final_min_gap_rad: None,
             censoring_revs: None,
+            operating_time: None,
+            final_spin_rate: None,
         }
     }
 }

@@ -305,6 +305,8 @@ impl<'a> SettlingObserver<'a> {
                 ((report.t - self.window).max(t_op) - self.t0) / rev
             }),
             final_min_gap_rad: self.gap.as_ref().map(|g| g.min_gap(psi)),
+            operating_time: self.operating_since,
+            final_spin_rate: Some(self.system.spin(report.t, &report.y).1),
         };
         (metrics, self.series)
     }

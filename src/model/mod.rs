@@ -11,6 +11,7 @@
 //! - [`invariants`]: energy and angular momentum, for validation.
 //! - [`linear`]: linear stability of the balanced state (rotating frame).
 //! - [`validate`]: why a scene is rejected (a leaf every layer may use).
+//! - [`sommerfeld`]: the whirl's load on a limited drive (passage through resonance).
 //! - [`zero_approx`]: seed 003's empirical criterion for any rotor model.
 
 pub mod balancer;
@@ -24,6 +25,7 @@ pub mod linear;
 pub mod quasi_static;
 pub mod rotor;
 pub mod scene;
+pub mod sommerfeld;
 pub mod speed;
 pub mod start;
 pub mod system;

@@ -145,6 +145,20 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
                 .zip(touching)
                 .map(|(gap, angle)| (-gap).max(0.0) / angle),
         );
+        // Variable speed: how many runs passed through to the operating
+        // speed, and where the others were held (the Sommerfeld effect).
+        rows.stall_torque.push(design.stall_torque);
+        let t_op = mine.column("operating_time_s")?.f64()?;
+        rows.reached_operating
+            .push(t_op.is_not_null().sum().unwrap_or(0) as u64);
+        rows.operating_median.push(quantile_sorted(
+            &sorted_values(t_op),
+            0.5,
+            Interpolation::Linear,
+        ));
+        let spin = sorted_values(mine.column("final_spin_rate")?.f64()?);
+        rows.spin_median
+            .push(quantile_sorted(&spin, 0.5, Interpolation::Linear));
     }
     rows.into_dataframe()
 }
@@ -192,6 +206,10 @@ struct SummaryColumns {
     contact: Vec<bool>,
     min_gap: Vec<Option<f64>>,
     max_overlap: Vec<Option<f64>>,
+    stall_torque: Vec<Option<f64>>,
+    reached_operating: Vec<u64>,
+    operating_median: Vec<Option<f64>>,
+    spin_median: Vec<Option<f64>>,
 }
 
 /// A finite value, or `None` (an infinite paired median difference means
@@ -278,6 +296,10 @@ impl SummaryColumns {
                 Column::new("contact".into(), self.contact),
                 Column::new("min_gap_rad".into(), self.min_gap),
                 Column::new("max_overlap_fraction".into(), self.max_overlap),
+                Column::new("stall_torque".into(), self.stall_torque),
+                Column::new("reached_operating_speed".into(), self.reached_operating),
+                Column::new("operating_time_s_median".into(), self.operating_median),
+                Column::new("final_spin_rate_median".into(), self.spin_median),
             ],
         )
     }

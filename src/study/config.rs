@@ -178,6 +178,10 @@ pub struct DesignGrid {
     pub roller_height: f64,
     /// Viscous coefficients β (N·s/m).
     pub drag: OneOrMany<f64>,
+    /// Motor stall torques M_s (N·m), one more axis of the grid; each
+    /// replaces `scene.speed.stall_torque` (needs `mode = "motor"`).
+    #[serde(default)]
+    pub stall_torque: Option<OneOrMany<f64>>,
 }
 
 fn steel() -> f64 {
@@ -407,6 +411,9 @@ pub struct Design {
     /// Balancing capacity (kg·m): S_AB of seed 000 for balls and rollers
     /// (weights pressed together), n m l for pendulums (they can pass each other).
     pub capacity: f64,
+    /// The motor's stall torque M_s (N·m) when the grid sweeps it
+    /// (`designs.stall_torque`); `None`: the scene's own speed law.
+    pub stall_torque: Option<f64>,
 }
 
 /// A validated study: the file plus its resolved designs.
@@ -445,8 +452,29 @@ impl StudyPlan {
                 })
                 .collect(),
             cargo: Vec::new(),
-            speed: t.speed.clone(),
+            speed: design.speed(&t.speed),
             effects: t.effects.clone(),
+        }
+    }
+}
+
+impl Design {
+    /// The study's speed law with this design's stall torque, if it has one.
+    pub fn speed(&self, law: &SpeedLaw) -> SpeedLaw {
+        match (self.stall_torque, law.clone()) {
+            (
+                Some(torque),
+                SpeedLaw::Motor {
+                    omega_sync,
+                    omega_start,
+                    ..
+                },
+            ) => SpeedLaw::Motor {
+                stall_torque: torque,
+                omega_sync,
+                omega_start,
+            },
+            (_, law) => law,
         }
     }
 }
@@ -713,6 +741,7 @@ impl StudyFile {
             weight_mass: cargo.mass,
             track_radius: cargo.track_radius,
             capacity,
+            stall_torque: None,
         })
     }
 
@@ -725,6 +754,7 @@ impl StudyFile {
             g.rho.values(),
             g.drag.values(),
         );
+        let torques = self.stall_torques()?;
         for (key, empty) in [
             ("designs.kind", kinds.is_empty()),
             ("designs.n", ns.is_empty()),
@@ -739,22 +769,58 @@ impl StudyFile {
             for &n in &ns {
                 for rho in &rhos {
                     for &drag in &drags {
-                        let spec = DesignSpec {
-                            kind: *kind,
-                            n,
-                            rho: rho.clone(),
-                            race_radius: g.race_radius,
-                            density: g.density,
-                            roller_height: g.roller_height,
-                            drag,
-                            plane: 0,
-                        };
-                        designs.push(self.resolve_design(designs.len() as u32, spec)?);
+                        for &stall_torque in &torques {
+                            let spec = DesignSpec {
+                                kind: *kind,
+                                n,
+                                rho: rho.clone(),
+                                race_radius: g.race_radius,
+                                density: g.density,
+                                roller_height: g.roller_height,
+                                drag,
+                                plane: 0,
+                            };
+                            let design = self.resolve_design(designs.len() as u32, spec)?;
+                            designs.push(Design {
+                                stall_torque,
+                                ..design
+                            });
+                        }
                     }
                 }
             }
         }
         Ok(designs)
+    }
+}
+
+impl StudyFile {
+    /// The grid's stall torques: `[None]` when it sweeps none, else each
+    /// value checked (positive, finite, a motor to apply it to).
+    fn stall_torques(&self) -> Result<Vec<Option<f64>>, (String, String, String)> {
+        let Some(list) = &self.designs.stall_torque else {
+            return Ok(vec![None]);
+        };
+        let key = "designs.stall_torque".to_string();
+        let values = list.values();
+        if !matches!(self.scene.speed, SpeedLaw::Motor { .. }) {
+            return Err((
+                key,
+                format!("{values:?}"),
+                "a stall torque needs a motor: set scene.speed.mode = \"motor\"".into(),
+            ));
+        }
+        if values.is_empty() {
+            return Err((key, "[]".into(), "needs at least one value".into()));
+        }
+        if let Some(bad) = values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+            return Err((
+                key,
+                bad.to_string(),
+                "a stall torque (N·m) must be positive and finite".into(),
+            ));
+        }
+        Ok(values.into_iter().map(Some).collect())
     }
 }
 

@@ -43,6 +43,9 @@ pub struct RunRecord {
     /// Whether contact between the weights was on (it is unless the study
     /// switched it off; off, weights may pass through each other).
     pub contact: bool,
+    /// The motor's stall torque M_s (N·m) when the study sweeps it
+    /// (`designs.stall_torque`), else empty.
+    pub stall_torque: Option<f64>,
     /// Wall-clock time of the run (s); excluded from determinism checks.
     pub wall_time_s: f64,
     /// The weights as built, when the study samples tolerances (columns
@@ -73,6 +76,7 @@ impl std::fmt::Debug for RunRecord {
             .field("metrics", &self.metrics)
             .field("method", &self.method)
             .field("contact", &self.contact)
+            .field("stall_torque", &self.stall_torque)
             .field("wall_time_s", &self.wall_time_s);
         if let Some(w) = &self.weights {
             s.field("weights", w);
@@ -156,6 +160,10 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("final_min_gap_rad", |r: &RunRecord| r
             .metrics
             .final_min_gap_rad),
+        // Variable speed (the Sommerfeld effect, docs/realism.md).
+        col!("stall_torque", |r: &RunRecord| r.stall_torque),
+        col!("operating_time_s", |r: &RunRecord| r.metrics.operating_time),
+        col!("final_spin_rate", |r: &RunRecord| r.metrics.final_spin_rate),
         col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
     ];
     // All rows of a study sample tolerances or none do.
@@ -310,6 +318,18 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     } else {
         None
     };
+    // Absent from tables written before the Sommerfeld columns existed.
+    let optional = |name: &str| -> PolarsResult<Vec<Option<f64>>> {
+        match df.column(name) {
+            Ok(_) => f64s(name),
+            Err(_) => Ok(vec![None; df.height()]),
+        }
+    };
+    let (stall, t_op, spin) = (
+        optional("stall_torque")?,
+        optional("operating_time_s")?,
+        optional("final_spin_rate")?,
+    );
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -351,9 +371,12 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 min_gap_rad: min_gap[i],
                 final_min_gap_rad: final_gap[i],
                 censoring_revs: censoring[i],
+                operating_time: t_op[i],
+                final_spin_rate: spin[i],
             },
             contact: contact[i],
             method: method[i].clone(),
+            stall_torque: stall[i],
             wall_time_s: wall[i],
             weights: weights.as_ref().map(|w| w[i].clone()),
         });

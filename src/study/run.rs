@@ -331,6 +331,7 @@ pub fn run_design_sample(
         },
         metrics,
         contact,
+        stall_torque: design.stall_torque,
         wall_time_s: clock.elapsed().as_secs_f64(),
         weights: sample.weights,
     }

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 pub const WINDOW_RUNS: u64 = 32_768;
 
 /// Columns the per-design summary reads (a slim projection of the runs).
-pub const SUMMARY_COLUMNS: [&str; 9] = [
+pub const SUMMARY_COLUMNS: [&str; 11] = [
     "design_id",
     "sample_id",
     "outcome",
@@ -25,6 +25,8 @@ pub const SUMMARY_COLUMNS: [&str; 9] = [
     "residual_rel",
     "contact",
     "min_gap_rad",
+    "operating_time_s",
+    "final_spin_rate",
 ];
 
 /// One Parquet file of runs, with its run ids (ascending).

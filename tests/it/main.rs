@@ -33,6 +33,7 @@ mod race_eccentricity;
 mod results_folder;
 mod rolling_resistance;
 mod schema;
+mod sommerfeld;
 mod study_input;
 mod study_runner;
 mod study_summary;

@@ -279,9 +279,12 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     min_gap_rad: None,
                     final_min_gap_rad: None,
                     censoring_revs: None,
+                    operating_time: Some(0.0),
+                    final_spin_rate: None,
                 },
                 method: "dp5".into(),
                 contact: true,
+                stall_torque: None,
                 wall_time_s: 0.001,
                 weights: None,
             });
@@ -823,4 +826,40 @@ fn stability_map_is_drawn_from_the_map_table() {
         text.contains("map test") && text.contains("speed ω") && text.contains("rotor unbalance U")
     );
     assert!(plot_stability_map(&[], "empty", &svg).is_err());
+}
+
+#[test]
+fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
+    let plan = study_plan();
+    let mut runs = study_runs(&plan, 10);
+    let without = StudyData {
+        name: "no_sweep".into(),
+        runs: runs.clone(),
+        designs: vec![],
+    };
+    let dir = out_dir("passage");
+    let path = dir.path.join("passage.svg");
+    assert!(StudyFigure::Passage.plot(&without, &path).is_err());
+    for (i, r) in runs.iter_mut().enumerate() {
+        r.stall_torque = Some(2.0 + (i % 3) as f64 * 4.0);
+        let held = i % 3 == 0;
+        r.metrics.final_spin_rate = Some(if held { 150.0 } else { 299.0 });
+        r.metrics.operating_time = (!held).then_some(3.0);
+    }
+    let summary = summarize(&plan, &runs).unwrap();
+    let data = StudyData {
+        name: "sweep".into(),
+        runs,
+        designs: autobal::plot::study::design_stats(&summary).unwrap(),
+    };
+    StudyFigure::Passage.plot(&data, &path).unwrap();
+    check_svg(
+        &path,
+        3_000,
+        &[
+            "spin rate at the end of the run-up vs motor stall torque",
+            "motor stall torque M_s  (N·m)",
+            "held below the operating speed",
+        ],
+    );
 }

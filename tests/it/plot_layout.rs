@@ -232,6 +232,8 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         min_gap_rad: None,
         final_min_gap_rad: None,
         censoring_revs: None,
+        operating_time: Some(0.0),
+        final_spin_rate: None,
     }
 }
 
@@ -268,6 +270,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                     metrics: metrics(settled, revs),
                     method: "dp5".into(),
                     contact: true,
+                    stall_torque: None,
                     wall_time_s: 0.001,
                     weights: None,
                 });

@@ -73,9 +73,12 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             min_gap_rad: None,
             final_min_gap_rad: None,
             censoring_revs: None,
+            operating_time: Some(0.0),
+            final_spin_rate: None,
         },
         method: "dp5".into(),
         contact: true,
+        stall_torque: None,
         wall_time_s: 0.001,
         weights: None,
     }

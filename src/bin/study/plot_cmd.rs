@@ -80,7 +80,8 @@ struct StudyArgs {
     /// Image format of the figures.
     #[arg(long, value_enum, default_value = "svg")]
     format: FormatArg,
-    /// Write only this figure (default: all three).
+    /// Write only this figure (default: all three, and `passage` when the
+    /// study sweeps the stall torque).
     #[arg(long, value_enum)]
     only: Option<StudyFigureArg>,
 }
@@ -90,6 +91,7 @@ enum StudyFigureArg {
     SettlingTime,
     SettledFraction,
     SettlingVsUnbalance,
+    Passage,
 }
 
 impl From<StudyFigureArg> for StudyFigure {
@@ -98,6 +100,7 @@ impl From<StudyFigureArg> for StudyFigure {
             StudyFigureArg::SettlingTime => StudyFigure::SettlingTime,
             StudyFigureArg::SettledFraction => StudyFigure::SettledFraction,
             StudyFigureArg::SettlingVsUnbalance => StudyFigure::SettlingVsUnbalance,
+            StudyFigureArg::Passage => StudyFigure::Passage,
         }
     }
 }
@@ -203,6 +206,12 @@ fn plot_one_study(a: &StudyArgs) -> Result<Vec<PathBuf>, UserError> {
     };
     let figures: Vec<StudyFigure> = match a.only {
         Some(f) => vec![f.into()],
+        // The passage figure only where the study sweeps the stall torque.
+        None if data.runs.iter().any(|r| r.stall_torque.is_some()) => {
+            let mut all = StudyFigure::ALL.to_vec();
+            all.push(StudyFigure::Passage);
+            all
+        }
         None => StudyFigure::ALL.to_vec(),
     };
     plot_study(&data, &a.out, format, &figures).map_err(plot_error)

@@ -270,30 +270,103 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             ]
         })
         .collect();
+    // A stall-torque sweep gets its own column after β (designs differ by
+    // it alone); other studies print exactly as before.
+    let torque: Vec<Option<f64>> = match summary.column("stall_torque") {
+        Ok(c) => c.f64()?.iter().collect(),
+        Err(_) => vec![None; summary.height()],
+    };
+    let swept = torque.iter().any(Option::is_some);
+    let rows: Vec<Vec<String>> = if swept {
+        rows.into_iter()
+            .zip(&order)
+            .map(|(mut row, &i)| {
+                row.insert(5, f(torque[i], 3));
+                row
+            })
+            .collect()
+    } else {
+        rows
+    };
+    let mut header = vec!["rank", "kind", "n", "ρ", "β"];
+    if swept {
+        header.push("M_s (N·m)");
+    }
+    header.extend([
+        "settled [95% CI]",
+        "t_s median [95% CI]",
+        "t_s restricted mean [95% CI]",
+        "t_s p90",
+        "residual/A_ref",
+        "best sooner in (paired runs) [95% CI], Holm p",
+    ]);
     let per_design = runs.iter().flatten().max().copied().unwrap_or(0);
     let alpha = col_f("vs_best_alpha")?
         .first()
         .copied()
         .flatten()
         .unwrap_or(f64::NAN);
+    Ok(text_table(&header, &rows)
+        + "(settling times in revolutions over every run, a run that did not settle counting as censored: Kaplan–Meier median with its Brookmeyer–Crowley interval (∞: not bounded within the run), restricted mean up to the horizon, p90; residual: median RMS vibration over the last hold window relative to A_ref)\n"
+        + &verdict_line(summary, &order, alpha, per_design)?
+        + &contact_line(summary)?
+        + &passage_table(summary)?)
+}
+
+/// For a study that sweeps the motor's stall torque: per design, how many
+/// runs reached the operating speed and where the rest were held (the
+/// Sommerfeld effect, docs/realism.md); empty otherwise.
+fn passage_table(summary: &DataFrame) -> Result<String, UserError> {
+    let Ok(torque) = summary.column("stall_torque") else {
+        return Ok(String::new());
+    };
+    let torque: Vec<Option<f64>> = torque.f64()?.iter().collect();
+    if torque.iter().all(Option::is_none) {
+        return Ok(String::new());
+    }
+    let kind: Vec<Option<&str>> = summary.column("kind")?.str()?.iter().collect();
+    let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
+    let runs: Vec<Option<u64>> = summary.column("runs")?.u64()?.iter().collect();
+    let reached: Vec<Option<u64>> = summary
+        .column("reached_operating_speed")?
+        .u64()?
+        .iter()
+        .collect();
+    let t_op: Vec<Option<f64>> = summary
+        .column("operating_time_s_median")?
+        .f64()?
+        .iter()
+        .collect();
+    let spin: Vec<Option<f64>> = summary
+        .column("final_spin_rate_median")?
+        .f64()?
+        .iter()
+        .collect();
+    let rows: Vec<Vec<String>> = (0..summary.height())
+        .map(|i| {
+            vec![
+                i.to_string(),
+                kind[i].unwrap_or("–").to_string(),
+                n[i].map_or("–".into(), |v| v.to_string()),
+                torque[i].map_or("–".into(), |v| format!("{v:.3}")),
+                format!("{}/{}", reached[i].unwrap_or(0), runs[i].unwrap_or(0)),
+                t_op[i].map_or("–".into(), |v| format!("{v:.2}")),
+                spin[i].map_or("–".into(), |v| format!("{v:.1}")),
+            ]
+        })
+        .collect();
     Ok(text_table(
         &[
-            "rank",
+            "design",
             "kind",
             "n",
-            "ρ",
-            "β",
-            "settled [95% CI]",
-            "t_s median [95% CI]",
-            "t_s restricted mean [95% CI]",
-            "t_s p90",
-            "residual/A_ref",
-            "best sooner in (paired runs) [95% CI], Holm p",
+            "M_s (N·m)",
+            "reached operating speed",
+            "after (s, median)",
+            "final φ̇ median (rad/s)",
         ],
         &rows,
-    ) + "(settling times in revolutions over every run, a run that did not settle counting as censored: Kaplan–Meier median with its Brookmeyer–Crowley interval (∞: not bounded within the run), restricted mean up to the horizon, p90; residual: median RMS vibration over the last hold window relative to A_ref)\n"
-        + &verdict_line(summary, &order, alpha, per_design)?
-        + &contact_line(summary)?)
+    ) + "(passage through resonance: a run that never reached |φ̇ − ω_sync| ≤ δ ω_sync was held below it for the whole run)\n")
 }
 
 /// Where adaptive sampling stopped: how many samples it took, and the

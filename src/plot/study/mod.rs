@@ -5,10 +5,12 @@
 //! study's data and lists the figures; `labels.rs` names and groups designs.
 
 mod labels;
+pub mod passage;
 pub mod settled_fraction;
 pub mod settling_time;
 pub mod settling_vs_unbalance;
 
+pub use passage::plot_passage;
 pub use settled_fraction::plot_settled_fraction;
 pub use settling_time::plot_settling_times;
 pub use settling_vs_unbalance::plot_settling_vs_unbalance;
@@ -183,6 +185,9 @@ pub enum StudyFigure {
     SettledFraction,
     /// Settling time against unbalance / capacity.
     SettlingVsUnbalance,
+    /// Final spin rate against the motor's stall torque (studies that sweep
+    /// it; not in [`StudyFigure::ALL`]).
+    Passage,
 }
 
 impl StudyFigure {
@@ -199,6 +204,7 @@ impl StudyFigure {
             StudyFigure::SettlingTime => "settling_time",
             StudyFigure::SettledFraction => "settled_fraction",
             StudyFigure::SettlingVsUnbalance => "settling_vs_unbalance",
+            StudyFigure::Passage => "passage",
         }
     }
 
@@ -208,6 +214,7 @@ impl StudyFigure {
             StudyFigure::SettlingTime => plot_settling_times(data, path),
             StudyFigure::SettledFraction => plot_settled_fraction(data, path),
             StudyFigure::SettlingVsUnbalance => plot_settling_vs_unbalance(data, path),
+            StudyFigure::Passage => plot_passage(data, path),
         }
     }
 }
