@@ -162,6 +162,11 @@ pub struct RunMetrics {
     pub operating_time: Option<f64>,
     /// Spin rate φ̇ at the end of the run (rad/s); `None` for estimates.
     pub final_spin_rate: Option<f64>,
+    /// With rolling resistance: the largest angle (degrees) between a
+    /// weight's final position and the balanced position nearest the final
+    /// ones (`None` without it, at variable speed, or with no balanced state
+    /// near).
+    pub balance_angle_error_deg: Option<f64>,
 }
 
 impl RunMetrics {
@@ -195,6 +200,7 @@ impl RunMetrics {
             censoring_revs: None,
             operating_time: None,
             final_spin_rate: None,
+            balance_angle_error_deg: None,
         }
     }
 }

@@ -307,6 +307,7 @@ impl<'a> SettlingObserver<'a> {
             final_min_gap_rad: self.gap.as_ref().map(|g| g.min_gap(psi)),
             operating_time: self.operating_since,
             final_spin_rate: Some(self.system.spin(report.t, &report.y).1),
+            balance_angle_error_deg: None,
         };
         (metrics, self.series)
     }

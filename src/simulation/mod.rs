@@ -81,6 +81,12 @@ impl Simulation {
             Fidelity::Full | Fidelity::Auto => self.integrate(&system, &system, &y0, None, record),
         };
         metrics.fidelity = fidelity.name().to_string();
+        if self.scene.effects.rolling_resistance.is_some()
+            && !metrics.final_rel_angles_deg.is_empty()
+        {
+            metrics.balance_angle_error_deg =
+                balance_angle_error(&self.scene, &metrics.final_rel_angles_deg);
+        }
         Ok(RunResult { metrics, series })
     }
 
@@ -132,6 +138,30 @@ impl Simulation {
         }
         (metrics, series)
     }
+}
+
+/// The largest angle (degrees) from the final cargo angles to the nearest
+/// balanced state, found by the linear analysis' Newton iteration from them.
+/// At rest the friction torque vanishes, so the balanced states are those of
+/// the scene without it; it is left out because its regularised sign has a
+/// slope that no finite-difference Jacobian resolves. `None` at variable
+/// speed or with no balanced state near.
+fn balance_angle_error(scene: &Scene, final_deg: &[f64]) -> Option<f64> {
+    let mut frictionless = scene.clone();
+    frictionless.effects.rolling_resistance = None;
+    let system = frictionless.build().ok()?;
+    let frame = crate::model::linear::RotatingFrame::new(&system).ok()?;
+    let psi: Vec<f64> = final_deg.iter().map(|d| d.to_radians()).collect();
+    let state = crate::model::linear::steady_state(&frame, &psi).ok()?;
+    let head = system.layout().head();
+    psi.iter()
+        .zip(&state[head..head + psi.len()])
+        .map(|(a, b)| {
+            crate::model::effect::contact::wrapped(a - b)
+                .abs()
+                .to_degrees()
+        })
+        .reduce(f64::max)
 }
 
 /// n angles evenly spaced around the race (a regular polygon: p = 0 and no net unbalance).

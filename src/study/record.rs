@@ -164,6 +164,9 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("stall_torque", |r: &RunRecord| r.stall_torque),
         col!("operating_time_s", |r: &RunRecord| r.metrics.operating_time),
         col!("final_spin_rate", |r: &RunRecord| r.metrics.final_spin_rate),
+        col!("balance_angle_error_deg", |r: &RunRecord| r
+            .metrics
+            .balance_angle_error_deg),
         col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
     ];
     // All rows of a study sample tolerances or none do.
@@ -330,6 +333,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
         optional("operating_time_s")?,
         optional("final_spin_rate")?,
     );
+    let angle_error = optional("balance_angle_error_deg")?;
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -373,6 +377,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 censoring_revs: censoring[i],
                 operating_time: t_op[i],
                 final_spin_rate: spin[i],
+                balance_angle_error_deg: angle_error[i],
             },
             contact: contact[i],
             method: method[i].clone(),

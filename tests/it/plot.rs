@@ -281,6 +281,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     censoring_revs: None,
                     operating_time: Some(0.0),
                     final_spin_rate: None,
+                    balance_angle_error_deg: None,
                 },
                 method: "dp5".into(),
                 contact: true,

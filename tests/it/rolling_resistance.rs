@@ -127,3 +127,26 @@ fn a_zero_coefficient_is_the_scene_without_the_effect() {
     assert_eq!(a.rhs_calls, b.rhs_calls);
     assert_eq!(a.final_rel_angles_deg, b.final_rel_angles_deg);
 }
+
+#[test]
+fn the_angular_error_from_balance_grows_with_friction_and_is_absent_without() {
+    let error = |coefficient: f64| {
+        let text = scene(coefficient, 1.0, [10.0, 130.0, 250.0], 40.0);
+        let file = SceneFile::parse(&text, "x.toml").expect("valid");
+        let m = file
+            .simulation("x.toml")
+            .expect("sim")
+            .run(false)
+            .expect("runs")
+            .metrics;
+        m.balance_angle_error_deg
+    };
+    assert_eq!(error(0.0), None);
+    let (small, large) = (
+        error(2e-4).expect("computed"),
+        error(5e-4).expect("computed"),
+    );
+    // The weights stop where their loads fall to μ_k l: a dead band 2.5
+    // times wider leaves them further from balance.
+    assert!(small > 0.0 && large > small, "{small}° then {large}°");
+}

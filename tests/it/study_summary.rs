@@ -75,6 +75,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             censoring_revs: None,
             operating_time: Some(0.0),
             final_spin_rate: None,
+            balance_angle_error_deg: None,
         },
         method: "dp5".into(),
         contact: true,
