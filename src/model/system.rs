@@ -161,6 +161,30 @@ impl RotorSystem {
         self.effects.iter().map(|e| e.name()).collect()
     }
 
+    /// The tilt-inertia terms of cargo `c` at angle (sin, cos) φ_j and rate
+    /// φ̇_j, when its plane models them.
+    fn tilt_terms(
+        &self,
+        c: &Cargo,
+        angle: (f64, f64),
+        rate: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Option<TiltTerms> {
+        let tilt = self.tilt_maps[c.plane].as_ref()?;
+        let k = self.layout.rotor_dof;
+        Some(TiltTerms::at(
+            tilt,
+            k,
+            c.mass,
+            c.track_radius,
+            angle,
+            rate,
+            q,
+            qd,
+        ))
+    }
+
     /// Spin angle and rate at time t in state y.
     pub fn spin(&self, t: f64, y: &[f64]) -> (f64, f64) {
         if self.layout.spin_free {
@@ -260,19 +284,9 @@ impl OdeSystem for RotorSystem {
                 qj -= (inertia - jc) * spin_accel;
                 cargo_f[j] = qj;
             }
-            if let Some(tilt) = &self.tilt_maps[c.plane] {
-                // The m R² terms (src/model/tilt_inertia.rs); the scene
-                // guarantees a prescribed speed.
-                let t = TiltTerms::at(
-                    tilt,
-                    k,
-                    c.mass,
-                    c.track_radius,
-                    (s, co),
-                    rate,
-                    &q[..k],
-                    &qd[..k],
-                );
+            // The m R² terms (src/model/tilt_inertia.rs); the scene
+            // guarantees a prescribed speed.
+            if let Some(t) = self.tilt_terms(c, (s, co), rate, &q[..k], &qd[..k]) {
                 for r in 0..k {
                     for col in 0..k {
                         a[r][col] += t.mu * t.jac[r] * t.jac[col];
@@ -328,18 +342,8 @@ impl OdeSystem for RotorSystem {
             for i in 0..k {
                 wz += ml * (co * gv[i] - s * gu[i]) * z_rotor[i];
             }
-            if let Some(tilt) = &self.tilt_maps[c.plane] {
-                let rate = spin_rate + psi_rate[j];
-                let t = TiltTerms::at(
-                    tilt,
-                    k,
-                    c.mass,
-                    c.track_radius,
-                    (s, co),
-                    rate,
-                    &q[..k],
-                    &qd[..k],
-                );
+            let rate = spin_rate + psi_rate[j];
+            if let Some(t) = self.tilt_terms(c, (s, co), rate, &q[..k], &qd[..k]) {
                 wz += (0..k).map(|i| t.coupling[i] * z_rotor[i]).sum::<f64>();
             }
             let spin_term = (self.inertia[j] - c.rolling_coupling) * z_spin;

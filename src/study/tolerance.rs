@@ -132,20 +132,7 @@ pub fn validate(
 ) -> Result<(), ToleranceError> {
     if let Some(tol) = &t.eccentricity {
         let key = |k: &str| format!("eccentricity.{k}");
-        if !(tol.sigma.is_finite() && tol.sigma >= 0.0) {
-            return Err((
-                key("sigma"),
-                tol.sigma.to_string(),
-                "a standard deviation in m: finite and ≥ 0".into(),
-            ));
-        }
-        if !(tol.limit > 0.0 && tol.limit <= 10.0) {
-            return Err((
-                key("limit"),
-                tol.limit.to_string(),
-                "a truncation in standard deviations, in (0, 10]".into(),
-            ));
-        }
+        check_spread("eccentricity", tol)?;
         if tol.relative {
             return Err((
                 key("relative"),
@@ -166,20 +153,7 @@ pub fn validate(
     for (name, tol) in [("radius", &t.radius), ("mass", &t.mass)] {
         let Some(tol) = tol else { continue };
         let key = |k: &str| format!("{name}.{k}");
-        if !(tol.sigma.is_finite() && tol.sigma >= 0.0) {
-            return Err((
-                key("sigma"),
-                tol.sigma.to_string(),
-                "a standard deviation: finite and ≥ 0".into(),
-            ));
-        }
-        if !(tol.limit > 0.0 && tol.limit <= 10.0) {
-            return Err((
-                key("limit"),
-                tol.limit.to_string(),
-                "a truncation in standard deviations, in (0, 10]".into(),
-            ));
-        }
+        check_spread(name, tol)?;
         if tol.relative && tol.limit * tol.sigma >= 1.0 {
             return Err((
                 key("sigma"),
@@ -235,6 +209,25 @@ pub fn validate(
                 }
             }
         }
+    }
+    Ok(())
+}
+
+/// σ finite and ≥ 0, the truncation in (0, 10] standard deviations.
+fn check_spread(name: &str, tol: &Tolerance) -> Result<(), ToleranceError> {
+    if !(tol.sigma.is_finite() && tol.sigma >= 0.0) {
+        return Err((
+            format!("{name}.sigma"),
+            tol.sigma.to_string(),
+            "a standard deviation: finite and ≥ 0".into(),
+        ));
+    }
+    if !(tol.limit > 0.0 && tol.limit <= 10.0) {
+        return Err((
+            format!("{name}.limit"),
+            tol.limit.to_string(),
+            "a truncation in standard deviations, in (0, 10]".into(),
+        ));
     }
     Ok(())
 }
