@@ -6,7 +6,7 @@
 use autobal::scene_file::SceneFile;
 use autobal::study::config::StudyFile;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 
 fn repo() -> PathBuf {
@@ -91,13 +91,6 @@ fn shipped() -> Vec<(PathBuf, Kind)> {
     files
 }
 
-/// `studies/regression.toml` is hashed into its committed baseline
-/// (`study check` refuses a baseline made from another text), so it goes
-/// without the line; `.taplo.toml` maps it to the schema all the same.
-fn carries_schema_line(path: &Path) -> bool {
-    !path.ends_with("studies/regression.toml")
-}
-
 #[test]
 fn committed_schemas_are_what_study_schema_prints() {
     let bless = std::env::var_os("AUTOBAL_BLESS").is_some();
@@ -180,18 +173,18 @@ fn every_shipped_study_and_scene_validates_and_names_its_schema() {
         if !errors.is_empty() {
             failures.push(format!("{shown}: {}", errors.join("; ")));
         }
-        if carries_schema_line(path) {
-            let dir = path.parent().unwrap();
-            let first = text.lines().next().unwrap_or("");
-            let target = first.strip_prefix("#:schema ").map(|t| dir.join(t));
-            if target.as_ref().and_then(|t| t.canonicalize().ok())
-                != kind.schema_path().canonicalize().ok()
-            {
-                failures.push(format!(
-                    "{shown}: first line {first:?} is not `#:schema <relative path to {}.schema.json>`",
-                    kind.name()
-                ));
-            }
+        // Every shipped file carries the line (`studies/regression.toml` too:
+        // its baseline was refreshed with the line in its text).
+        let dir = path.parent().unwrap();
+        let first = text.lines().next().unwrap_or("");
+        let target = first.strip_prefix("#:schema ").map(|t| dir.join(t));
+        if target.as_ref().and_then(|t| t.canonicalize().ok())
+            != kind.schema_path().canonicalize().ok()
+        {
+            failures.push(format!(
+                "{shown}: first line {first:?} is not `#:schema <relative path to {}.schema.json>`",
+                kind.name()
+            ));
         }
     }
     assert!(files.len() >= 14, "{} files", files.len());
