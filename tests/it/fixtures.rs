@@ -37,3 +37,21 @@ pub fn simulate_text(text: &str) -> std::process::Output {
         .output()
         .unwrap()
 }
+
+/// The metrics of one run of the scene file `text` (in the library, no CLI).
+pub fn scene_metrics(text: &str) -> autobal::metrics::RunMetrics {
+    let file = autobal::scene_file::SceneFile::parse(text, "scene.toml").expect("valid scene");
+    file.simulation("scene.toml")
+        .expect("simulation")
+        .run(false)
+        .expect("runs")
+        .metrics
+}
+
+/// Two runs are the same run, bit for bit: an effect that adds nothing must
+/// leave the right-hand side exactly as it was.
+pub fn assert_same_run(a: &autobal::metrics::RunMetrics, b: &autobal::metrics::RunMetrics) {
+    assert_eq!(a.residual_abs.to_bits(), b.residual_abs.to_bits());
+    assert_eq!(a.rhs_calls, b.rhs_calls);
+    assert_eq!(a.final_rel_angles_deg, b.final_rel_angles_deg);
+}

@@ -2,6 +2,7 @@
 //! axis, leaving the rotor whirling at exactly r = e_r (docs/model.md, "Race
 //! eccentricity"), whatever their mass; both formulations agree.
 
+use crate::fixtures::{assert_same_run, scene_metrics};
 use autobal::scene_file::SceneFile;
 
 /// The dimensionless three-ball scene (ω = 4 ω_n, e = 0.01, capacity 3 M e)
@@ -86,18 +87,7 @@ fn both_formulations_agree_with_an_off_centre_race() {
 fn a_zero_offset_is_the_scene_without_the_effect() {
     let base = std::fs::read_to_string("scenes/three_balls.toml").expect("scene");
     let with_table = format!("{base}\n[effects.race_eccentricity]\noffset = 0.0\nangle_deg = 30\n");
-    let metrics = |text: &str| {
-        let file = SceneFile::parse(text, "x.toml").expect("valid");
-        file.simulation("x.toml")
-            .expect("sim")
-            .run(false)
-            .expect("runs")
-            .metrics
-    };
-    let (a, b) = (metrics(&with_table), metrics(&base));
-    assert_eq!(a.residual_abs.to_bits(), b.residual_abs.to_bits());
-    assert_eq!(a.rhs_calls, b.rhs_calls);
-    assert_eq!(a.final_rel_angles_deg, b.final_rel_angles_deg);
+    assert_same_run(&scene_metrics(&with_table), &scene_metrics(&base));
 }
 
 #[test]

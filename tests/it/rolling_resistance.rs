@@ -9,6 +9,7 @@
 //! level μ_k l, so the weight that stops last leaves the largest load close
 //! to μ_k l.
 
+use crate::fixtures::{assert_same_run, scene_metrics};
 use autobal::scene_file::SceneFile;
 
 /// The dimensionless three-ball scene (ω = 4 ω_n, capacity 3 M e) with
@@ -114,32 +115,14 @@ fn a_zero_coefficient_is_the_scene_without_the_effect() {
     let with_table = scene(1e-3, 1.0, [90.0, 100.0, 110.0], 0.0)
         .replace("coefficient = 0.001", "coefficient = 0");
     let without = scene(0.0, 1.0, [90.0, 100.0, 110.0], 0.0);
-    let run = |text: &str| {
-        let file = SceneFile::parse(text, "x.toml").expect("valid");
-        file.simulation("x.toml")
-            .expect("sim")
-            .run(false)
-            .expect("runs")
-            .metrics
-    };
-    let (a, b) = (run(&with_table), run(&without));
-    assert_eq!(a.residual_abs.to_bits(), b.residual_abs.to_bits());
-    assert_eq!(a.rhs_calls, b.rhs_calls);
-    assert_eq!(a.final_rel_angles_deg, b.final_rel_angles_deg);
+    assert_same_run(&scene_metrics(&with_table), &scene_metrics(&without));
 }
 
 #[test]
 fn the_angular_error_from_balance_grows_with_friction_and_is_absent_without() {
     let error = |coefficient: f64| {
         let text = scene(coefficient, 1.0, [10.0, 130.0, 250.0], 40.0);
-        let file = SceneFile::parse(&text, "x.toml").expect("valid");
-        let m = file
-            .simulation("x.toml")
-            .expect("sim")
-            .run(false)
-            .expect("runs")
-            .metrics;
-        m.balance_angle_error_deg
+        scene_metrics(&text).balance_angle_error_deg
     };
     assert_eq!(error(0.0), None);
     let (small, large) = (
