@@ -38,6 +38,19 @@ impl RealLu {
         for i in 0..n {
             self.a[i * n + i] += s;
         }
+        self.factor()
+    }
+
+    /// Factor the matrix that `fill` writes (row-major, n×n); false if
+    /// singular or not finite.
+    pub(crate) fn factor_from(&mut self, fill: impl FnOnce(&mut [f64])) -> bool {
+        fill(&mut self.a);
+        self.a.iter().all(|v| v.is_finite()) && self.factor()
+    }
+
+    /// Factor the buffer in place.
+    fn factor(&mut self) -> bool {
+        let n = self.n;
         let a = &mut self.a;
         for k in 0..n {
             let mut p = k;
@@ -58,13 +71,15 @@ impl RealLu {
                     a.swap(k * n + j, p * n + j);
                 }
             }
-            let pivot = a[k * n + k];
-            for i in k + 1..n {
-                let l = a[i * n + k] / pivot;
-                a[i * n + k] = l;
+            let (upper, lower) = a.split_at_mut((k + 1) * n);
+            let pivot_row = &upper[k * n..];
+            let pivot = pivot_row[k];
+            for row in lower.chunks_exact_mut(n) {
+                let l = row[k] / pivot;
+                row[k] = l;
                 if l != 0.0 {
-                    for j in k + 1..n {
-                        a[i * n + j] -= l * a[k * n + j];
+                    for (x, u) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
+                        *x -= l * u;
                     }
                 }
             }
@@ -72,25 +87,31 @@ impl RealLu {
         true
     }
 
-    /// Overwrite b with the solution x of (s·I − J)·x = b.
+    /// Overwrite b with the solution x of (s·I − J)·x = b (or of the matrix
+    /// given to [`RealLu::factor_from`]).
     pub(crate) fn solve(&self, b: &mut [f64]) {
-        let (n, a) = (self.n, &self.a);
-        for k in 0..n {
-            b.swap(k, self.piv[k]);
+        let n = self.n;
+        let b = &mut b[..n];
+        for (k, &p) in self.piv.iter().enumerate() {
+            b.swap(k, p);
         }
-        for i in 0..n {
-            let mut s = b[i];
-            for j in 0..i {
-                s -= a[i * n + j] * b[j];
+        // Slices rather than indices: no bounds checks in the inner loops,
+        // the same operations in the same order.
+        for (i, row) in self.a.chunks_exact(n).enumerate() {
+            let (done, rest) = b.split_at_mut(i);
+            let mut s = rest[0];
+            for (l, x) in row[..i].iter().zip(done.iter()) {
+                s -= l * x;
             }
-            b[i] = s;
+            rest[0] = s;
         }
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for j in i + 1..n {
-                s -= a[i * n + j] * b[j];
+        for (i, row) in self.a.chunks_exact(n).enumerate().rev() {
+            let (head, done) = b.split_at_mut(i + 1);
+            let mut s = head[i];
+            for (u, x) in row[i + 1..].iter().zip(done.iter()) {
+                s -= u * x;
             }
-            b[i] = s / a[i * n + i];
+            head[i] = s / row[i];
         }
     }
 }
@@ -128,6 +149,19 @@ impl ComplexLu {
             self.re[i * n + i] += alpha;
             self.im[i * n + i] = beta;
         }
+        self.factor()
+    }
+
+    /// Factor the matrix whose real and imaginary parts `fill` writes
+    /// (row-major, n×n); false if singular or not finite.
+    pub(crate) fn factor_from(&mut self, fill: impl FnOnce(&mut [f64], &mut [f64])) -> bool {
+        fill(&mut self.re, &mut self.im);
+        self.re.iter().chain(&self.im).all(|v| v.is_finite()) && self.factor()
+    }
+
+    /// Factor the buffers in place.
+    fn factor(&mut self) -> bool {
+        let n = self.n;
         let (re, im) = (&mut self.re, &mut self.im);
         for k in 0..n {
             let mut p = k;
@@ -149,20 +183,27 @@ impl ComplexLu {
                     im.swap(k * n + j, p * n + j);
                 }
             }
-            let (pr, pi) = (re[k * n + k], im[k * n + k]);
+            let (re_upper, re_lower) = re.split_at_mut((k + 1) * n);
+            let (im_upper, im_lower) = im.split_at_mut((k + 1) * n);
+            let (ur_row, ui_row) = (&re_upper[k * n..], &im_upper[k * n..]);
+            let (pr, pi) = (ur_row[k], ui_row[k]);
             let den = pr * pr + pi * pi;
-            for i in k + 1..n {
-                let (ar, ai) = (re[i * n + k], im[i * n + k]);
+            for (row_r, row_i) in re_lower
+                .chunks_exact_mut(n)
+                .zip(im_lower.chunks_exact_mut(n))
+            {
+                let (ar, ai) = (row_r[k], row_i[k]);
                 // l = a / pivot
                 let lr = (ar * pr + ai * pi) / den;
                 let li = (ai * pr - ar * pi) / den;
-                re[i * n + k] = lr;
-                im[i * n + k] = li;
+                row_r[k] = lr;
+                row_i[k] = li;
                 if lr != 0.0 || li != 0.0 {
-                    for j in k + 1..n {
-                        let (ur, ui) = (re[k * n + j], im[k * n + j]);
-                        re[i * n + j] -= lr * ur - li * ui;
-                        im[i * n + j] -= lr * ui + li * ur;
+                    let pivot_part = ur_row[k + 1..].iter().zip(&ui_row[k + 1..]);
+                    let row_part = row_r[k + 1..].iter_mut().zip(row_i[k + 1..].iter_mut());
+                    for ((xr, xi), (ur, ui)) in row_part.zip(pivot_part) {
+                        *xr -= lr * ur - li * ui;
+                        *xi -= lr * ui + li * ur;
                     }
                 }
             }
@@ -170,34 +211,43 @@ impl ComplexLu {
         true
     }
 
-    /// Overwrite (br, bi) with the solution of ((α + iβ)·I − J)·x = br + i·bi.
+    /// Overwrite (br, bi) with the solution of ((α + iβ)·I − J)·x = br + i·bi
+    /// (or of the matrix given to [`ComplexLu::factor_from`]).
     pub(crate) fn solve(&self, br: &mut [f64], bi: &mut [f64]) {
-        let (n, re, im) = (self.n, &self.re, &self.im);
-        for k in 0..n {
-            br.swap(k, self.piv[k]);
-            bi.swap(k, self.piv[k]);
+        let n = self.n;
+        let (br, bi) = (&mut br[..n], &mut bi[..n]);
+        for (k, &p) in self.piv.iter().enumerate() {
+            br.swap(k, p);
+            bi.swap(k, p);
         }
-        for i in 0..n {
-            let (mut sr, mut si) = (br[i], bi[i]);
-            for j in 0..i {
-                let (lr, li) = (re[i * n + j], im[i * n + j]);
-                sr -= lr * br[j] - li * bi[j];
-                si -= lr * bi[j] + li * br[j];
+        let rows = || self.re.chunks_exact(n).zip(self.im.chunks_exact(n));
+        // Slices rather than indices: no bounds checks in the inner loops,
+        // the same operations in the same order.
+        for (i, (row_r, row_i)) in rows().enumerate() {
+            let (done_r, rest_r) = br.split_at_mut(i);
+            let (done_i, rest_i) = bi.split_at_mut(i);
+            let (mut sr, mut si) = (rest_r[0], rest_i[0]);
+            let factors = row_r[..i].iter().zip(&row_i[..i]);
+            for ((lr, li), (xr, xi)) in factors.zip(done_r.iter().zip(done_i.iter())) {
+                sr -= lr * xr - li * xi;
+                si -= lr * xi + li * xr;
             }
-            br[i] = sr;
-            bi[i] = si;
+            rest_r[0] = sr;
+            rest_i[0] = si;
         }
-        for i in (0..n).rev() {
-            let (mut sr, mut si) = (br[i], bi[i]);
-            for j in i + 1..n {
-                let (ur, ui) = (re[i * n + j], im[i * n + j]);
-                sr -= ur * br[j] - ui * bi[j];
-                si -= ur * bi[j] + ui * br[j];
+        for (i, (row_r, row_i)) in rows().enumerate().rev() {
+            let (head_r, done_r) = br.split_at_mut(i + 1);
+            let (head_i, done_i) = bi.split_at_mut(i + 1);
+            let (mut sr, mut si) = (head_r[i], head_i[i]);
+            let factors = row_r[i + 1..].iter().zip(&row_i[i + 1..]);
+            for ((ur, ui), (xr, xi)) in factors.zip(done_r.iter().zip(done_i.iter())) {
+                sr -= ur * xr - ui * xi;
+                si -= ur * xi + ui * xr;
             }
-            let (dr, di) = (re[i * n + i], im[i * n + i]);
+            let (dr, di) = (row_r[i], row_i[i]);
             let den = dr * dr + di * di;
-            br[i] = (sr * dr + si * di) / den;
-            bi[i] = (si * dr - sr * di) / den;
+            head_r[i] = (sr * dr + si * di) / den;
+            head_i[i] = (si * dr - sr * di) / den;
         }
     }
 }

@@ -128,6 +128,11 @@ impl OdeSystem for RotatingSystem {
         2 * (2 + self.cargo.len())
     }
 
+    fn second_order_split(&self) -> Option<usize> {
+        // `rhs` copies (u̇, v̇, ψ̇) into the first half as it is.
+        Some(2 + self.cargo.len())
+    }
+
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let n = self.cargo.len();
         let nq = 2 + n;

@@ -202,6 +202,11 @@ impl OdeSystem for RotorSystem {
         self.layout.dim()
     }
 
+    fn second_order_split(&self) -> Option<usize> {
+        // `rhs` copies q̇ into the first half as it is.
+        Some(self.layout.nq())
+    }
+
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let lay = self.layout;
         let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());

@@ -120,6 +120,7 @@ impl Simulation {
             max_wall: Some(std::time::Duration::from_secs_f64(
                 self.solver.max_wall_seconds,
             )),
+            reduce_second_order: !self.solver.full_newton,
             stiffness: if explicit && self.solver.implicit_fallback {
                 Stiffness::SwitchToImplicit
             } else {

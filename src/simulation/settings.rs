@@ -43,6 +43,11 @@ pub struct SolverSettings {
     /// underflows its step size, re-run the whole simulation with Radau5 and
     /// record the switch (`method` becomes e.g. "dp5→radau5").
     pub implicit_fallback: bool,
+    /// Radau5 solves its full Newton systems instead of the reduced ones of
+    /// a second-order system (the reference for the reduction's test; not a
+    /// file key).
+    #[serde(skip)]
+    pub full_newton: bool,
 }
 
 impl Default for SolverSettings {
@@ -55,6 +60,7 @@ impl Default for SolverSettings {
             max_steps: 5_000_000,
             max_wall_seconds: 600.0,
             implicit_fallback: true,
+            full_newton: false,
         }
     }
 }

@@ -3,35 +3,18 @@
 //! (Radau5 throughout in the rotating frame), run by run, on every shipped
 //! study: the same outcome, the same settling time, the residual within 1 %.
 
+use crate::fixtures::{shipped_plan, shipped_studies};
 use autobal::integrate::Method;
 use autobal::simulation::MethodChoice;
-use autobal::study::config::{StudyFile, StudyPlan};
 use autobal::study::run::run_one;
 use std::path::PathBuf;
 
-/// A shipped study at `samples` per design, with `method`.
-fn shipped(path: &std::path::Path, samples: u32, method: MethodChoice) -> StudyPlan {
-    let text = std::fs::read_to_string(path).unwrap();
-    let shown = path.display().to_string();
-    let mut file = StudyFile::parse(&text, &shown).unwrap();
-    file.sampling.samples = samples;
-    file.solver.method = method;
-    file.plan(&text, &shown).unwrap()
-}
-
 #[test]
 fn auto_settles_when_and_where_radau5_does_on_every_shipped_study() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("studies");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    let mut compared = 0;
-    for path in &files {
-        let auto = shipped(path, 4, MethodChoice::Auto);
-        let radau5 = shipped(path, 4, MethodChoice::Fixed(Method::Radau5));
+    let (mut compared, mut one_sample_apart) = (0, 0);
+    for path in &shipped_studies() {
+        let auto = shipped_plan(path, 4, |s| s.method = MethodChoice::Auto);
+        let radau5 = shipped_plan(path, 4, |s| s.method = MethodChoice::Fixed(Method::Radau5));
         for id in 0..auto.total_runs() {
             let new = run_one(&auto, id);
             // Only the rotating frame's default changed (the inertial frame's
@@ -42,10 +25,18 @@ fn auto_settles_when_and_where_radau5_does_on_every_shipped_study() {
             let old = run_one(&radau5, id);
             let what = format!("{} run {id}", path.display());
             assert_eq!(new.metrics.outcome, old.metrics.outcome, "{what}");
-            assert_eq!(
-                new.metrics.settling_revs, old.metrics.settling_revs,
-                "{what}"
-            );
+            // Settling times are read on the observer's sample grid: where r
+            // crosses the band within rounding of a sample, two methods that
+            // agree to their tolerance may read it one sample apart.
+            let (a, b) = (new.metrics.settling_revs, old.metrics.settling_revs);
+            if a != b {
+                let apart = (a.unwrap() - b.unwrap()).abs();
+                assert!(
+                    (apart - 1.0 / 32.0).abs() < 1e-9,
+                    "{what}: settling {a:?} vs {b:?}"
+                );
+                one_sample_apart += 1;
+            }
             let rel = (new.metrics.residual_rel / old.metrics.residual_rel - 1.0).abs();
             assert!(
                 rel <= 0.01,
@@ -60,7 +51,14 @@ fn auto_settles_when_and_where_radau5_does_on_every_shipped_study() {
         compared > 100,
         "only {compared} rotating-frame runs compared"
     );
-    // Measured when written: 320 runs, worst residual difference 3.0e-4.
+    assert!(
+        one_sample_apart * 100 <= compared,
+        "{one_sample_apart} of {compared} runs settle a sample apart"
+    );
+    eprintln!("{compared} runs, {one_sample_apart} settle a sample apart");
+    // Measured when written: 320 runs, worst residual difference 3.0e-4, none
+    // a sample apart; after Radau5's Newton systems were reduced, one of the
+    // 416 runs of today's shipped studies.
 }
 
 /// RHS calls per run of the default path on the main job (4 samples per
@@ -72,7 +70,7 @@ fn auto_settles_when_and_where_radau5_does_on_every_shipped_study() {
 #[test]
 fn the_main_job_costs_no_more_rhs_calls_per_run_than_measured() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("studies/three_balls.toml");
-    let plan = shipped(&path, 4, MethodChoice::Auto);
+    let plan = shipped_plan(&path, 4, |s| s.method = MethodChoice::Auto);
     let total: u64 = (0..plan.total_runs())
         .map(|id| run_one(&plan, id).metrics.rhs_calls)
         .sum();

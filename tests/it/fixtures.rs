@@ -55,3 +55,29 @@ pub fn assert_same_run(a: &autobal::metrics::RunMetrics, b: &autobal::metrics::R
     assert_eq!(a.rhs_calls, b.rhs_calls);
     assert_eq!(a.final_rel_angles_deg, b.final_rel_angles_deg);
 }
+
+/// Every study shipped in `studies/`, sorted.
+pub fn shipped_studies() -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// A shipped study at `samples` per design, its solver settings edited.
+pub fn shipped_plan(
+    path: &std::path::Path,
+    samples: u32,
+    edit: impl FnOnce(&mut autobal::simulation::SolverSettings),
+) -> autobal::study::config::StudyPlan {
+    let text = std::fs::read_to_string(path).unwrap();
+    let shown = path.display().to_string();
+    let mut file = autobal::study::config::StudyFile::parse(&text, &shown).unwrap();
+    file.sampling.samples = samples;
+    edit(&mut file.solver);
+    file.plan(&text, &shown).unwrap()
+}

@@ -25,6 +25,7 @@ mod model_flexible;
 mod model_linear;
 mod model_physics;
 mod model_two_support;
+mod newton_reduction;
 mod operating_point;
 mod optimize;
 mod plot;

@@ -42,6 +42,9 @@ impl<S: OdeSystem + ?Sized> OdeSystem for Counted<'_, S> {
     fn dim(&self) -> usize {
         self.inner.dim()
     }
+    fn second_order_split(&self) -> Option<usize> {
+        self.inner.second_order_split()
+    }
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         self.calls.set(self.calls.get() + 1);
         self.inner.rhs(t, y, dydt);
