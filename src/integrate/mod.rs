@@ -49,7 +49,9 @@ pub trait OdeSystem {
 
 /// Continuous solution over the last accepted step, valid on [t_prev, t].
 pub trait DenseOutput {
-    /// Write the interpolated state at time `t` into `out`.
+    /// Write the interpolated state at time `t` into `out`: its first
+    /// `out.len()` components, so that a caller who needs only the leading
+    /// ones (e.g. positions) pays only for them.
     fn eval(&self, t: f64, out: &mut [f64]);
 }
 

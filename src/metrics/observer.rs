@@ -7,6 +7,7 @@ use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, SolveReport, Status, Step, StepObserver};
 use crate::model::gap::GapGauge;
 use crate::model::system::RotorSystem;
+use crate::model::unbalance::BalancingGauge;
 use std::f64::consts::PI;
 
 /// A sampled time history: t, x, y, r, ε and every ψ_j.
@@ -63,6 +64,7 @@ pub struct SettlingObserver<'a> {
     options: MetricOptions,
     a_ref: f64,
     u_ref: f64,
+    balancing: BalancingGauge,
     band: f64,
     window: f64,
     dt: f64,
@@ -105,6 +107,7 @@ impl<'a> SettlingObserver<'a> {
             system,
             a_ref: a,
             u_ref: reference_unbalance(system),
+            balancing: BalancingGauge::new(system, reference_unbalance(system)),
             band: options.delta * a,
             window: options.hold_revs * rev,
             dt: rev / f64::from(samples),
@@ -164,7 +167,7 @@ impl<'a> SettlingObserver<'a> {
         let y = &self.scratch;
         let r = vibration(self.system, y);
         let psi = &y[lay.head()..lay.nq()];
-        let eps = balancing_error(self.system, psi, self.u_ref);
+        let eps = self.balancing.error(self.system, psi);
         if !r.is_finite() || !eps.is_finite() {
             self.diverged = Some(format!("non-finite state at t = {t}"));
             return Flow::Stop;
@@ -328,7 +331,14 @@ impl StepObserver for SettlingObserver<'_> {
             if t > step.t {
                 return Flow::Continue;
             }
-            step.dense.eval(t, &mut self.scratch);
+            // Samples read only positions, except a free rotor's spin rate
+            // until it reaches its operating speed.
+            let needed = if self.t_op.is_none() && self.operating_since.is_none() {
+                self.scratch.len()
+            } else {
+                self.system.layout().nq()
+            };
+            step.dense.eval(t, &mut self.scratch[..needed]);
             self.next_index += 1;
             if self.sample(t) == Flow::Stop {
                 return Flow::Stop;

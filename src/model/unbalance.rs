@@ -30,3 +30,42 @@ pub fn balancing_error(system: &RotorSystem, psi: &[f64], unbalance_ref: f64) ->
     let (fc, _) = unbalance_forcing(system, psi, true);
     system.rotor().unbalance_size(&fc) / unbalance_ref
 }
+
+/// [`balancing_error`] for repeated use on one system: what does not depend
+/// on the angles (the rotor's unbalance vector, each cargo's m l, which
+/// formula applies) is worked out once. Gives the same bits.
+#[derive(Debug, Clone)]
+pub struct BalancingGauge {
+    /// (U_x, U_y) of the rotor itself for the plane rotor; None otherwise.
+    plane: Option<(f64, f64)>,
+    cargo_unbalance: Vec<f64>,
+    unbalance_ref: f64,
+}
+
+impl BalancingGauge {
+    /// A gauge for `system`, relative to `unbalance_ref`.
+    pub fn new(system: &RotorSystem, unbalance_ref: f64) -> Self {
+        let plane = is_plane_translation(system).then(|| {
+            let (me, angle) = system.rotor().static_unbalance();
+            (me * angle.cos(), me * angle.sin())
+        });
+        BalancingGauge {
+            plane,
+            cargo_unbalance: system.cargo().iter().map(|c| c.unbalance()).collect(),
+            unbalance_ref,
+        }
+    }
+
+    /// ε at cargo angles ψ, as [`balancing_error`] computes it.
+    pub fn error(&self, system: &RotorSystem, psi: &[f64]) -> f64 {
+        let Some((mut ux, mut uy)) = self.plane else {
+            return balancing_error(system, psi, self.unbalance_ref);
+        };
+        for (u, &p) in self.cargo_unbalance.iter().zip(psi) {
+            let (s, c) = p.sin_cos();
+            ux += u * c;
+            uy += u * s;
+        }
+        ux.hypot(uy) / self.unbalance_ref
+    }
+}
