@@ -51,6 +51,9 @@ pub struct RotatingSystem {
     unbalance_force: (f64, f64),
     cargo: Vec<Cargo>,
     inertia: Vec<f64>,
+    /// 1/I of each cargo: the elimination multiplies by it (the same value
+    /// it computed per call before), the back-substitution still divides.
+    inv_inertia: Vec<f64>,
     /// m·l of each cargo (constant per run).
     mass_track: Vec<f64>,
     /// (sin ψ, cos ψ) of each cargo, evaluated once per call: the trig is a
@@ -89,6 +92,7 @@ impl RotatingSystem {
             b: r.bx,
             unbalance_force: (me * omega * omega * c, me * omega * omega * s),
             inertia: cargo.iter().map(Cargo::inertia).collect(),
+            inv_inertia: cargo.iter().map(|c| 1.0 / c.inertia()).collect(),
             mass_track: cargo.iter().map(|c| c.mass * c.track_radius).collect(),
             trig: RefCell::new(vec![(0.0, 0.0); cargo.len()]),
             cargo,
@@ -180,18 +184,20 @@ impl OdeSystem for RotatingSystem {
         }
         let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
         let mut trig = self.trig.borrow_mut();
-        for j in 0..n {
-            let (s, co) = psi[j].sin_cos();
-            trig[j] = (s, co);
-            let ml = self.mass_track[j];
-            let rate = w + psi_rate[j];
+        // Zipped slices: no bounds checks in the loop.
+        let per_cargo = psi.iter().zip(psi_rate).zip(cargo_f.iter_mut());
+        let constants = self.mass_track.iter().zip(&self.inv_inertia);
+        for (((&p, &p_rate), f), ((&ml, &inv), tr)) in per_cargo.zip(constants.zip(trig.iter_mut()))
+        {
+            let (s, co) = p.sin_cos();
+            *tr = (s, co);
+            let rate = w + p_rate;
             gr += ml * rate * rate * co;
             gi += ml * rate * rate * s;
             // Cargo row: I ψ̈ + (−ml s, ml co)·a = Q − ml Im[(fr + i fi) e^{−iψ}].
-            let q = cargo_f[j] - ml * (fi * co - fr * s);
-            cargo_f[j] = q;
+            let q = *f - ml * (fi * co - fr * s);
+            *f = q;
             let (wr, wi) = (-ml * s, ml * co);
-            let inv = 1.0 / self.inertia[j];
             a11 -= wr * wr * inv;
             a12 -= wr * wi * inv;
             a22 -= wi * wi * inv;
@@ -201,10 +207,9 @@ impl OdeSystem for RotatingSystem {
         let det = a11 * a22 - a12 * a12;
         let ar = (gr * a22 - gi * a12) / det;
         let ai = (gi * a11 - gr * a12) / det;
-        for j in 0..n {
-            let (s, co) = trig[j];
-            let ml = self.mass_track[j];
-            cargo_f[j] = (cargo_f[j] - ml * (co * ai - s * ar)) / self.inertia[j];
+        let constants = self.mass_track.iter().zip(&self.inertia);
+        for ((f, &(s, co)), (&ml, &inertia)) in cargo_f.iter_mut().zip(trig.iter()).zip(constants) {
+            *f = (*f - ml * (co * ai - s * ar)) / inertia;
         }
         dydt[nq] = ar;
         dydt[nq + 1] = ai;
