@@ -8,6 +8,7 @@ use crate::model::system::RotorSystem;
 
 // The unbalance measures are model quantities (the linear analysis needs
 // them too); they are defined there and named here with the other scales.
+use crate::model::unbalance::planar_norm;
 pub use crate::model::unbalance::{balancing_error, reference_unbalance};
 
 /// A_ref at speed ω: the largest balancer-plane orbit radius of the locked
@@ -57,7 +58,7 @@ fn plane_a_ref(system: &RotorSystem, omega: f64) -> f64 {
 pub fn vibration(system: &RotorSystem, q: &[f64]) -> f64 {
     let rotor = system.rotor();
     if is_plane_translation(system) {
-        return q[0].hypot(q[1]);
+        return planar_norm(q[0], q[1]);
     }
     let k = rotor.dof();
     (0..rotor.planes())
@@ -65,7 +66,7 @@ pub fn vibration(system: &RotorSystem, q: &[f64]) -> f64 {
             let [gu, gv] = rotor.plane_map(p);
             let u: f64 = (0..k).map(|i| gu[i] * q[i]).sum();
             let v: f64 = (0..k).map(|i| gv[i] * q[i]).sum();
-            u.hypot(v)
+            planar_norm(u, v)
         })
         .fold(0.0, |acc: f64, r| {
             if acc.is_nan() || r.is_nan() {

@@ -25,7 +25,7 @@ pub fn reference_unbalance(system: &RotorSystem) -> f64 {
 pub fn balancing_error(system: &RotorSystem, psi: &[f64], unbalance_ref: f64) -> f64 {
     if is_plane_translation(system) {
         let (ux, uy) = crate::model::start::total_unbalance(system, psi);
-        return ux.hypot(uy) / unbalance_ref;
+        return planar_norm(ux, uy) / unbalance_ref;
     }
     let (fc, _) = unbalance_forcing(system, psi, true);
     system.rotor().unbalance_size(&fc) / unbalance_ref
@@ -66,6 +66,19 @@ impl BalancingGauge {
             ux += u * c;
             uy += u * s;
         }
-        ux.hypot(uy) / self.unbalance_ref
+        planar_norm(ux, uy) / self.unbalance_ref
+    }
+}
+
+/// |(x, y)| for the observer's per-sample sizes (r and ε): sqrt(x² + y²),
+/// which costs a third of `hypot` (its scaling against overflow and
+/// underflow was 6 % of a study's time); `hypot` only where x² + y² would
+/// overflow or underflow, far outside any vibration or unbalance.
+pub(crate) fn planar_norm(x: f64, y: f64) -> f64 {
+    let sq = x * x + y * y;
+    if sq.is_finite() && sq >= f64::MIN_POSITIVE {
+        sq.sqrt()
+    } else {
+        x.hypot(y)
     }
 }
