@@ -32,7 +32,7 @@ pub fn unbalance_forcing(system: &RotorSystem, psi: &[f64], with_rotor: bool) ->
     }
     for (j, (c, &p)) in system.cargo().iter().zip(psi).enumerate() {
         let [gu, gv] = system.cargo_plane_map(j);
-        let (s, co) = p.sin_cos();
+        let (s, co) = super::trig::sin_cos(p);
         let ml = c.unbalance();
         for i in 0..k {
             fc[i] += ml * (co * gu[i] + s * gv[i]);

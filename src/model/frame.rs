@@ -83,7 +83,7 @@ impl RotatingSystem {
             unreachable!("checked above")
         };
         let me = r.mass * r.eccentricity;
-        let (s, c) = r.unbalance_angle.sin_cos();
+        let (s, c) = super::trig::sin_cos(r.unbalance_angle);
         let effects = scene.effects.build(&cargo, omega);
         Ok(RotatingSystem {
             omega,
@@ -115,7 +115,7 @@ impl RotatingSystem {
 
     /// Rotating-frame state (u, u̇, v, v̇) from the inertial (x, ẋ, y, ẏ) at time t.
     pub fn from_inertial(&self, t: f64, x: f64, xd: f64, y: f64, yd: f64) -> [f64; 4] {
-        let (s, c) = (self.omega * t).sin_cos();
+        let (s, c) = super::trig::sin_cos(self.omega * t);
         // ẇ = (ż − iω z) e^{−iωt}
         let (zr, zi) = (xd + self.omega * y, yd - self.omega * x);
         [
@@ -189,7 +189,7 @@ impl OdeSystem for RotatingSystem {
         let constants = self.mass_track.iter().zip(&self.inv_inertia);
         for (((&p, &p_rate), f), ((&ml, &inv), tr)) in per_cargo.zip(constants.zip(trig.iter_mut()))
         {
-            let (s, co) = p.sin_cos();
+            let (s, co) = super::trig::sin_cos(p);
             *tr = (s, co);
             let rate = w + p_rate;
             gr += ml * rate * rate * co;

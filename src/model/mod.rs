@@ -30,6 +30,7 @@ pub mod speed;
 pub mod start;
 pub mod system;
 pub mod tilt_inertia;
+pub mod trig;
 pub mod unbalance;
 pub mod validate;
 pub mod zero_approx;

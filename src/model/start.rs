@@ -111,10 +111,12 @@ pub fn locked_response(system: &RotorSystem, psi0: &[f64], omega: f64) -> [f64; 
 /// Total unbalance (kg·m) of rotor and cargoes at φ = 0 as (U_x, U_y).
 pub fn total_unbalance(system: &RotorSystem, psi: &[f64]) -> (f64, f64) {
     let (me, angle) = system.rotor().static_unbalance();
-    let (mut ux, mut uy) = (me * angle.cos(), me * angle.sin());
+    let (sa, ca) = super::trig::sin_cos(angle);
+    let (mut ux, mut uy) = (me * ca, me * sa);
     for (c, &p) in system.cargo().iter().zip(psi) {
-        ux += c.unbalance() * p.cos();
-        uy += c.unbalance() * p.sin();
+        let (s, co) = super::trig::sin_cos(p);
+        ux += c.unbalance() * co;
+        uy += c.unbalance() * s;
     }
     (ux, uy)
 }

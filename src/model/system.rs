@@ -271,7 +271,7 @@ impl OdeSystem for RotorSystem {
         // and contributes e_j·ψ̈_j to the head rows, e_j = (w_j, −J_j), with
         // w_j = m l (−sin φ_j G_u + cos φ_j G_v) and J_j the rolling coupling.
         for (j, c) in self.cargo.iter().enumerate() {
-            let (s, co) = (phi + psi[j]).sin_cos();
+            let (s, co) = super::trig::sin_cos(phi + psi[j]);
             let ml = c.mass * c.track_radius;
             let [gu, gv] = &self.plane_maps[c.plane];
             let rate = spin_rate + psi_rate[j];
@@ -340,7 +340,7 @@ impl OdeSystem for RotorSystem {
         z_rotor[..k].copy_from_slice(&z[..k]);
         let z_spin = if lay.spin_free { z[k] } else { 0.0 };
         for (j, c) in self.cargo.iter().enumerate() {
-            let (s, co) = (phi + psi[j]).sin_cos();
+            let (s, co) = super::trig::sin_cos(phi + psi[j]);
             let ml = c.mass * c.track_radius;
             let [gu, gv] = &self.plane_maps[c.plane];
             let mut wz = 0.0;

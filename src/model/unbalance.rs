@@ -47,7 +47,8 @@ impl BalancingGauge {
     pub fn new(system: &RotorSystem, unbalance_ref: f64) -> Self {
         let plane = is_plane_translation(system).then(|| {
             let (me, angle) = system.rotor().static_unbalance();
-            (me * angle.cos(), me * angle.sin())
+            let (s, c) = super::trig::sin_cos(angle);
+            (me * c, me * s)
         });
         BalancingGauge {
             plane,
@@ -62,7 +63,7 @@ impl BalancingGauge {
             return balancing_error(system, psi, self.unbalance_ref);
         };
         for (u, &p) in self.cargo_unbalance.iter().zip(psi) {
-            let (s, c) = p.sin_cos();
+            let (s, c) = super::trig::sin_cos(p);
             ux += u * c;
             uy += u * s;
         }

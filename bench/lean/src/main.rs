@@ -159,7 +159,7 @@ impl Model {
         // Eliminate the weights' rows into the 2×2 head (the arrowhead system).
         let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
         for j in 0..n {
-            let (s, co) = psi[j].sin_cos();
+            let (s, co) = libm::sincos(psi[j]);
             trig[j] = (s, co);
             let ml = self.ml[j];
             let rt = w + rate[j];

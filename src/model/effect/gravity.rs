@@ -67,11 +67,12 @@ impl Effect for Gravity {
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
         let g = self.in_plane();
         for (j, cargo) in ctx.cargo.iter().enumerate() {
-            forces.cargo[j] -= cargo.mass * g * cargo.track_radius * (ctx.phi + ctx.psi[j]).cos();
+            forces.cargo[j] -=
+                cargo.mass * g * cargo.track_radius * crate::model::trig::cos(ctx.phi + ctx.psi[j]);
         }
         if ctx.spin_free {
             let (me, angle) = ctx.rotor_unbalance;
-            *forces.spin -= me * g * (ctx.phi + angle).cos();
+            *forces.spin -= me * g * crate::model::trig::cos(ctx.phi + angle);
         }
     }
 }

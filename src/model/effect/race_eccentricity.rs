@@ -111,11 +111,11 @@ impl Effect for OffCentreRace {
             .zip(&self.mass_offset_track)
             .zip(ctx.psi)
         {
-            let (s, c) = (psi - self.angle).sin_cos();
+            let (s, c) = crate::model::trig::sin_cos(psi - self.angle);
             *f -= mel * (rate * rate * s + accel * c);
         }
         // ctx.phi is 0 in the rotating frame: the force is then in rotor axes.
-        let (s, c) = (ctx.phi + self.angle).sin_cos();
+        let (s, c) = crate::model::trig::sin_cos(ctx.phi + self.angle);
         let (radial, tangential) = (self.mass_offset * rate * rate, self.mass_offset * accel);
         forces.rotor[0] += radial * c + tangential * s;
         forces.rotor[1] += radial * s - tangential * c;

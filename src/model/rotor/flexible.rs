@@ -150,14 +150,14 @@ impl Rotor for FlexibleShaft {
 
     fn spin_coupling(&self, phi: f64, q: &[f64]) -> DofVec {
         let me = self.mass * self.eccentricity;
-        let (s, c) = (phi + self.unbalance_angle).sin_cos();
+        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
         let half = 0.5 * self.polar_inertia;
         [-me * s, me * c, half * q[3], -half * q[2]]
     }
 
     fn unbalance_forces(&self, phi: f64, spin_rate: f64, f: &mut DofVec) {
         let me = self.mass * self.eccentricity * spin_rate * spin_rate;
-        let (s, c) = (phi + self.unbalance_angle).sin_cos();
+        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
         f[0] += me * c;
         f[1] += me * s;
     }

@@ -89,13 +89,13 @@ impl Rotor for PlaneRotor {
 
     fn spin_coupling(&self, phi: f64, _q: &[f64]) -> DofVec {
         let me = self.mass * self.eccentricity;
-        let (s, c) = (phi + self.unbalance_angle).sin_cos();
+        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
         [-me * s, me * c, 0.0, 0.0]
     }
 
     fn unbalance_forces(&self, phi: f64, spin_rate: f64, f: &mut DofVec) {
         let me = self.mass * self.eccentricity * spin_rate * spin_rate;
-        let (s, c) = (phi + self.unbalance_angle).sin_cos();
+        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
         f[0] += me * c;
         f[1] += me * s;
     }

@@ -180,7 +180,7 @@ pub fn lean_row(
 
     // As RotatingSystem::new forms it.
     let me = rotor.mass * rotor.eccentricity;
-    let (s, c) = rotor.unbalance_angle.sin_cos();
+    let (s, c) = autobal::model::trig::sin_cos(rotor.unbalance_angle);
     let unbalance_force = (me * omega * omega * c, me * omega * omega * s);
 
     let contact = scene
@@ -359,7 +359,7 @@ mod tests {
         let (mut a11, mut a12, mut a22) = (m_total, 0.0, m_total);
         let mut trig = vec![(0.0, 0.0); n];
         for j in 0..n {
-            let (s, co) = psi[j].sin_cos();
+            let (s, co) = autobal::model::trig::sin_cos(psi[j]);
             trig[j] = (s, co);
             let ml = r.mass[j] * r.track_radius[j];
             let rt = w + rate[j];
