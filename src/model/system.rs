@@ -75,6 +75,10 @@ pub struct RotorSystem {
     spin_inertia: f64,
     /// The rotor's static unbalance, cached for the effects (constant).
     rotor_unbalance: (f64, f64),
+    /// (sin, cos) of each cargo's absolute angle φ + ψ_j, evaluated once per
+    /// call for the elimination and reused by the back-substitution. A field,
+    /// not a local, so that a call allocates nothing.
+    trig: std::cell::RefCell<Vec<(f64, f64)>>,
 }
 
 impl RotorSystem {
@@ -106,6 +110,7 @@ impl RotorSystem {
         };
         RotorSystem {
             inertia: cargo.iter().map(Cargo::inertia).collect(),
+            trig: std::cell::RefCell::new(vec![(0.0, 0.0); cargo.len()]),
             rotor_unbalance: rotor.static_unbalance(),
             rotor,
             cargo,
@@ -270,8 +275,10 @@ impl OdeSystem for RotorSystem {
         //   I_j ψ̈_j + c_j·z = Q_j,  c_j = (w_j, I_j − J_j),
         // and contributes e_j·ψ̈_j to the head rows, e_j = (w_j, −J_j), with
         // w_j = m l (−sin φ_j G_u + cos φ_j G_v) and J_j the rolling coupling.
+        let mut trig = self.trig.borrow_mut();
         for (j, c) in self.cargo.iter().enumerate() {
             let (s, co) = super::trig::sin_cos(phi + psi[j]);
+            trig[j] = (s, co);
             let ml = c.mass * c.track_radius;
             let [gu, gv] = &self.plane_maps[c.plane];
             let rate = spin_rate + psi_rate[j];
@@ -340,7 +347,7 @@ impl OdeSystem for RotorSystem {
         z_rotor[..k].copy_from_slice(&z[..k]);
         let z_spin = if lay.spin_free { z[k] } else { 0.0 };
         for (j, c) in self.cargo.iter().enumerate() {
-            let (s, co) = super::trig::sin_cos(phi + psi[j]);
+            let (s, co) = trig[j];
             let ml = c.mass * c.track_radius;
             let [gu, gv] = &self.plane_maps[c.plane];
             let mut wz = 0.0;
