@@ -22,9 +22,9 @@ use serde::{Deserialize, Serialize};
 pub struct SolverSettings {
     /// Formulation: analytic, rotating, full, or auto (rotating when exact for the scene).
     pub fidelity: Fidelity,
-    /// Integration method: `auto` (dp5 in the inertial frame, radau5 in the
-    /// rotating frame, whose fixed point only an A-stable method can step
-    /// across in large steps), or `dp5`, `dop853`, `radau5`.
+    /// Integration method: `auto` (dp5, or dop853 below rtol 1e-7, handing
+    /// over to radau5 where the run turns stiff; radau5 from the start with
+    /// a stiff effect such as rolling resistance), or `dp5`, `dop853`, `radau5`.
     pub method: MethodChoice,
     /// Relative tolerance.
     pub rtol: f64,
@@ -160,7 +160,7 @@ impl MethodChoice {
     /// below the tolerance in steps of 1/(ω + ω_n), while Radau5 steps across
     /// it: 11× fewer RHS calls over 10 000 revolutions. With early stop the
     /// run ends 50 revolutions after settling, the transient dominates, and
-    /// the explicit start is the cheaper: 0.60× Radau5's time per run on the
+    /// the explicit start is the cheaper: 0.65× Radau5's time per run on the
     /// main job at rtol 1e-6 (docs/benchmarks.md).
     pub fn resolve(self, rtol: f64, implicit_from_start: bool) -> Method {
         match self {
