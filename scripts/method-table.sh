@@ -14,15 +14,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 rounds=${1:-2}
 samples=${2:-50}
-python=$root/bench/lean/.venv/bin/python
-if [ ! -x "$python" ]; then
-    python3 -m venv "$root/bench/lean/.venv"
-    "$python" -m pip install --quiet --disable-pip-version-check -r "$root/bench/lean/requirements.txt"
-fi
-(cd "$root" && cargo build --quiet --bin study)
-study=${CARGO_TARGET_DIR:-$root/target}/debug/study
-out=$(mktemp -d "${TMPDIR:-/tmp}/autobal-methods.XXXXXX")
-echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg))" >&2
+# shellcheck source=bench-setup.sh
+source "$root/scripts/bench-setup.sh" methods
 
 cases=()
 for rtol in 1e-6 1e-8 1e-9; do

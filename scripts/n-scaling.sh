@@ -16,15 +16,8 @@ samples=${1:-5}
 shift || true
 ns=("$@")
 [ ${#ns[@]} -gt 0 ] || ns=(2 4 8 16 32)
-python=$root/bench/lean/.venv/bin/python
-if [ ! -x "$python" ]; then
-    python3 -m venv "$root/bench/lean/.venv"
-    "$python" -m pip install --quiet --disable-pip-version-check -r "$root/bench/lean/requirements.txt"
-fi
-(cd "$root" && cargo build --quiet --bin study)
-study=${CARGO_TARGET_DIR:-$root/target}/debug/study
-out=$(mktemp -d "${TMPDIR:-/tmp}/autobal-n.XXXXXX")
-echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg))" >&2
+# shellcheck source=bench-setup.sh
+source "$root/scripts/bench-setup.sh" n
 
 for n in "${ns[@]}"; do
     sed -e "s/^samples = [0-9]*/samples = $samples/" \
