@@ -453,6 +453,17 @@ pub fn run_study(
     let already = done.iter().filter(|d| **d).count() as u64;
     progress.begin(total, already);
 
+    // One pool for the runs and the summary's comparisons, so that
+    // `--threads` bounds both.
+    let pool = match options.threads {
+        Some(t) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .map_err(|e| RunError::Pool(e.to_string()))?,
+        ),
+        None => None,
+    };
     let mut executed = 0;
     let mut adaptive = None;
     let batches = batches(plan);
@@ -462,7 +473,15 @@ pub fn run_study(
             .filter(in_slice)
             .filter(|&id| !done[id as usize])
             .collect();
-        let saved = execute(plan, &pending, options, &chunks, &provenance, progress)?;
+        let saved = execute(
+            plan,
+            &pending,
+            options,
+            pool.as_ref(),
+            &chunks,
+            &provenance,
+            progress,
+        )?;
         if options
             .cancel
             .as_ref()
@@ -501,7 +520,11 @@ pub fn run_study(
     let written = write_runs(&pieces, total_ids, &runs_path, &provenance)?;
     drop(pieces);
     let summary = if options.shard.is_none() {
-        let mut summary = summarize_table(plan, &read_summary_columns(&runs_path)?)?;
+        let table = read_summary_columns(&runs_path)?;
+        let mut summary = match &pool {
+            Some(p) => p.install(|| summarize_table(plan, &table))?,
+            None => summarize_table(plan, &table)?,
+        };
         write_parquet(&summary_path, &mut summary, &provenance)?;
         Some(summary)
     } else {
@@ -530,19 +553,11 @@ fn execute(
     plan: &StudyPlan,
     pending: &[u64],
     options: &RunOptions,
+    pool: Option<&rayon::ThreadPool>,
     chunks: &Path,
     provenance: &Provenance,
     progress: &dyn Progress,
 ) -> Result<u64, RunError> {
-    let pool = match options.threads {
-        Some(t) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .map_err(|e| RunError::Pool(e.to_string()))?,
-        ),
-        None => None,
-    };
     let cancelled = || {
         options
             .cancel
@@ -569,7 +584,7 @@ fn execute(
                     });
                 }
             };
-            match &pool {
+            match pool {
                 Some(p) => p.install(work),
                 None => work(),
             }

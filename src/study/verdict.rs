@@ -12,6 +12,7 @@ use crate::stats::paired::{
 };
 use crate::stats::survival::{KaplanMeier, LogRank, Observation, log_rank};
 use polars::prelude::*;
+use rayon::prelude::*;
 
 /// Level of every interval the comparisons report.
 pub const LEVEL: f64 = 0.95;
@@ -265,8 +266,10 @@ pub fn best_versus_rest(
     })?;
     let paired =
         common_random_numbers && designs.iter().all(|d| pairing_refusal(best, d).is_none());
+    // In parallel: each comparison draws from its own stream, and collect
+    // keeps the order, so the result does not depend on the thread count.
     let comparisons: Vec<Comparison> = designs
-        .iter()
+        .par_iter()
         .filter(|d| d.design_id != best.design_id)
         .map(|d| compare(best, d, paired, seed))
         .collect();
