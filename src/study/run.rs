@@ -500,7 +500,11 @@ pub fn run_study(
             pieces.extend(chunk_pieces(&chunks)?);
             let so_far = read_pieces_summary_columns(&pieces)?;
             let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
-            let reached = precision(plan, stop, &so_far.filter(&mask)?)?;
+            let judged = so_far.filter(&mask)?;
+            let reached = match &pool {
+                Some(p) => p.install(|| precision(plan, stop, &judged))?,
+                None => precision(plan, stop, &judged)?,
+            };
             let stop_here = reached.reached || k + 1 == batches.len();
             adaptive = Some(AdaptiveOutcome {
                 batches: k + 1,
