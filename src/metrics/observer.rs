@@ -184,7 +184,11 @@ impl<'a> SettlingObserver<'a> {
             return Flow::Stop;
         }
         self.ring[self.ring_pos] = r * r;
-        self.ring_pos = (self.ring_pos + 1) % self.ring.len();
+        // A compare, not `%`: an integer division per sample is measurable.
+        self.ring_pos += 1;
+        if self.ring_pos == self.ring.len() {
+            self.ring_pos = 0;
+        }
         self.ring_filled = (self.ring_filled + 1).min(self.ring.len());
         self.r_hold
             .update(t, operating && r <= self.band, self.window);
