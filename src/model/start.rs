@@ -110,13 +110,28 @@ pub fn locked_response(system: &RotorSystem, psi0: &[f64], omega: f64) -> [f64; 
 
 /// Total unbalance (kg·m) of rotor and cargoes at φ = 0 as (U_x, U_y).
 pub fn total_unbalance(system: &RotorSystem, psi: &[f64]) -> (f64, f64) {
+    let cargo = system.cargo().iter().map(|c| c.unbalance());
+    add_cargo_unbalance(rotor_unbalance(system), cargo.zip(psi.iter().copied()))
+}
+
+/// The rotor's own unbalance (kg·m) at φ = 0 as (U_x, U_y).
+pub(crate) fn rotor_unbalance(system: &RotorSystem) -> (f64, f64) {
     let (me, angle) = system.rotor().static_unbalance();
     let (sa, ca) = super::trig::sin_cos(angle);
-    let (mut ux, mut uy) = (me * ca, me * sa);
-    for (c, &p) in system.cargo().iter().zip(psi) {
+    (me * ca, me * sa)
+}
+
+/// `start` plus each cargo's unbalance m l e^{iψ}, given as (m l, ψ) pairs,
+/// added in order (so that every caller gets the same bits).
+pub(crate) fn add_cargo_unbalance(
+    start: (f64, f64),
+    cargo: impl Iterator<Item = (f64, f64)>,
+) -> (f64, f64) {
+    let (mut ux, mut uy) = start;
+    for (u, p) in cargo {
         let (s, co) = super::trig::sin_cos(p);
-        ux += c.unbalance() * co;
-        uy += c.unbalance() * s;
+        ux += u * co;
+        uy += u * s;
     }
     (ux, uy)
 }

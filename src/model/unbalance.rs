@@ -4,7 +4,7 @@
 //! to tell a balanced fixed point from an unbalanced one.
 
 use crate::model::forced::unbalance_forcing;
-use crate::model::start::is_plane_translation;
+use crate::model::start::{add_cargo_unbalance, is_plane_translation, rotor_unbalance};
 use crate::model::system::RotorSystem;
 
 /// Reference unbalance U: the size of the rotor's own unbalance (M e for the
@@ -45,11 +45,7 @@ pub struct BalancingGauge {
 impl BalancingGauge {
     /// A gauge for `system`, relative to `unbalance_ref`.
     pub fn new(system: &RotorSystem, unbalance_ref: f64) -> Self {
-        let plane = is_plane_translation(system).then(|| {
-            let (me, angle) = system.rotor().static_unbalance();
-            let (s, c) = super::trig::sin_cos(angle);
-            (me * c, me * s)
-        });
+        let plane = is_plane_translation(system).then(|| rotor_unbalance(system));
         BalancingGauge {
             plane,
             cargo_unbalance: system.cargo().iter().map(|c| c.unbalance()).collect(),
@@ -59,14 +55,15 @@ impl BalancingGauge {
 
     /// ε at cargo angles ψ, as [`balancing_error`] computes it.
     pub fn error(&self, system: &RotorSystem, psi: &[f64]) -> f64 {
-        let Some((mut ux, mut uy)) = self.plane else {
+        let Some(rotor) = self.plane else {
             return balancing_error(system, psi, self.unbalance_ref);
         };
-        for (u, &p) in self.cargo_unbalance.iter().zip(psi) {
-            let (s, c) = super::trig::sin_cos(p);
-            ux += u * c;
-            uy += u * s;
-        }
+        let cargo = self
+            .cargo_unbalance
+            .iter()
+            .copied()
+            .zip(psi.iter().copied());
+        let (ux, uy) = add_cargo_unbalance(rotor, cargo);
         planar_norm(ux, uy) / self.unbalance_ref
     }
 }
