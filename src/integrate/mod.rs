@@ -17,7 +17,7 @@ pub mod controller;
 pub mod dop853;
 pub mod dp5;
 mod driver;
-mod lu;
+pub(crate) mod lu;
 mod newton_matrices;
 pub mod norm;
 pub mod radau5;

@@ -28,6 +28,7 @@
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
 //! the ramp's final speed or the motor's synchronous speed).
 
+pub mod certify;
 pub mod observer;
 pub mod reference;
 
@@ -52,6 +53,10 @@ pub struct MetricOptions {
     pub stop_when_settled: bool,
     /// r beyond this multiple of A_ref counts as divergence.
     pub divergence_factor: f64,
+    /// End a settled run's hold window early once the linearised flow,
+    /// checked against the run, bounds the rest of it (rotating frame with
+    /// early stop; docs/metrics.md, "Certified hold").
+    pub certified_hold: bool,
 }
 
 impl Default for MetricOptions {
@@ -63,6 +68,7 @@ impl Default for MetricOptions {
             samples_per_rev: 32,
             stop_when_settled: true,
             divergence_factor: 1e4,
+            certified_hold: false,
         }
     }
 }
@@ -118,6 +124,10 @@ pub struct RunMetrics {
     pub settling_time_eps: Option<f64>,
     /// True when the band held for the whole window W (false: only until the end of the run).
     pub hold_complete: bool,
+    /// True when a certified hold ended the run before the window's end
+    /// (`metrics.certified_hold`): the rest of the window is bounded on the
+    /// linearised flow, and the final state is the one at that earlier end.
+    pub hold_certified: bool,
     /// RMS of r over the last W revolutions.
     pub residual_abs: f64,
     /// residual_abs / A_ref.
@@ -181,6 +191,7 @@ impl RunMetrics {
             settling_time_err: 0.0,
             settling_time_eps: None,
             hold_complete: false,
+            hold_certified: false,
             residual_abs: 0.0,
             residual_rel: 0.0,
             a_ref,

@@ -1,10 +1,11 @@
 //! The step observer that measures a run: samples r and ε on dense output,
 //! detects settling, watches for divergence, and optionally records a series.
 
+use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, RESIDUAL_SHARE, Tracked};
 use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
-use crate::integrate::{Failure, Flow, SolveReport, Status, Step, StepObserver};
+use crate::integrate::{Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
 use crate::model::gap::GapGauge;
 use crate::model::system::RotorSystem;
 use crate::model::unbalance::BalancingGauge;
@@ -25,6 +26,78 @@ pub struct Series {
     pub eps: Vec<f64>,
     /// Cargo angles relative to the rotor, one vector per cargo (rad).
     pub psi: Vec<Vec<f64>>,
+}
+
+/// r² of the last hold window's samples, for the residual (an RMS).
+#[derive(Debug, Clone)]
+struct SquareRing {
+    values: Vec<f64>,
+    pos: usize,
+    filled: usize,
+}
+
+impl SquareRing {
+    fn new(len: usize) -> Self {
+        SquareRing {
+            values: vec![0.0; len],
+            pos: 0,
+            filled: 0,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    fn push(&mut self, r2: f64) {
+        self.values[self.pos] = r2;
+        // A compare, not `%`: an integer division per sample is measurable.
+        self.pos += 1;
+        if self.pos == self.values.len() {
+            self.pos = 0;
+        }
+        self.filled = (self.filled + 1).min(self.values.len());
+    }
+
+    /// Σ of the `count` most recent values (all there are, if fewer).
+    fn latest_sum(&self, count: usize) -> f64 {
+        let (older, newer) = self.latest(count);
+        older.iter().chain(newer).sum()
+    }
+
+    /// The `count` most recent values (all there are, if fewer), as the
+    /// older and the newer part of the storage.
+    fn latest(&self, count: usize) -> (&[f64], &[f64]) {
+        let count = count.min(self.filled);
+        let newer = &self.values[self.pos.saturating_sub(count)..self.pos];
+        let older_len = count - newer.len();
+        let older = &self.values[self.values.len() - older_len..];
+        (older, newer)
+    }
+
+    /// The largest of the `count` most recent values (0 when empty).
+    fn latest_max(&self, count: usize) -> f64 {
+        let (older, newer) = self.latest(count);
+        older.iter().chain(newer).fold(0.0, |m, &v| f64::max(m, v))
+    }
+
+    /// sqrt of the mean, 0 when empty; sums in storage order, as always.
+    fn rms(&self) -> f64 {
+        if self.filled == 0 {
+            return 0.0;
+        }
+        let sum: f64 = if self.filled == self.values.len() {
+            self.values.iter().sum()
+        } else {
+            self.values[..self.filled].iter().sum()
+        };
+        (sum / self.filled as f64).sqrt()
+    }
+}
+
+/// x ≤ limit, false for NaN: a prediction that is not a number bounds nothing.
+fn inside(x: f64, limit: f64) -> bool {
+    x <= limit
 }
 
 /// Tracks one "holds continuously" rule (r ≤ band or ε ≤ band).
@@ -71,14 +144,16 @@ pub struct SettlingObserver<'a> {
     t0: f64,
     next_index: u64,
     scratch: Vec<f64>,
-    ring: Vec<f64>,
-    ring_pos: usize,
-    ring_filled: usize,
+    ring: SquareRing,
     r_hold: Hold,
+    /// Σ r² over the current stretch inside the band (for the certifier).
+    stretch_sum: f64,
     eps_hold: Hold,
     peak_r: f64,
     gap: Option<GapGauge>,
     min_gap: f64,
+    /// The closest two weights come at the latest sample (rad).
+    gap_now: f64,
     /// When the speed reaches its operating value, if known in advance.
     t_op: Option<f64>,
     /// The first sample at the operating speed (settling is judged from here).
@@ -87,13 +162,65 @@ pub struct SettlingObserver<'a> {
     diverged: Option<String>,
     series: Option<Series>,
     frame: Option<f64>,
+    certifier: Option<HoldCertifier<'a>>,
+    /// The sample (t, state) at which a certified hold ended the run.
+    certified: Option<(f64, Vec<f64>)>,
+    /// The rest of the window as the tracked flow predicts it.
+    plan: Option<TailPlan>,
 }
+
+/// The samples first..=last of a hold window predicted on a tracked flow:
+/// reused, from a later sample on, while the same flow keeps tracking.
+#[derive(Debug)]
+struct TailPlan {
+    check: u32,
+    first: u64,
+    last: u64,
+    r: Vec<f64>,
+    /// The smallest gap between weights on the checked samples (rad).
+    closest: f64,
+}
+
+/// After a prediction that fails (ε or the gaps), the next try comes this
+/// many revolutions later.
+const REPLAN_REVS: f64 = 3.0;
+
+/// On the affine flow, ε and the gaps are checked on every this many samples
+/// (they move slowly next to r, which is checked on every sample).
+const TAIL_CHECK_STRIDE: usize = 4;
+
+/// Tracking starts once r has stayed below this fraction of the band for a
+/// revolution: deep enough inside for the linearisation to hold.
+const READY_FRACTION: f64 = 0.2;
 
 impl<'a> SettlingObserver<'a> {
     /// The state holds rotor-frame (u, v) turning at `omega`: r and ε are the
     /// same, the recorded (x, y) are turned back to the inertial frame.
     pub fn in_rotating_frame(mut self, omega: f64) -> Self {
         self.frame = Some(omega);
+        self
+    }
+
+    /// End the hold window early when the affine flow of `ode` (autonomous,
+    /// the system's state layout) bounds its rest; see [`super::certify`].
+    pub fn certify_with(mut self, ode: &'a dyn OdeSystem) -> Self {
+        let lay = self.system.layout();
+        let positions: Vec<f64> = (0..lay.nq())
+            .map(|i| if i < lay.rotor_dof { self.a_ref } else { 1.0 })
+            .collect();
+        let scale = positions
+            .iter()
+            .copied()
+            .chain(positions.iter().map(|s| s * self.omega))
+            .collect();
+        let rev = 2.0 * PI / self.omega;
+        self.certifier = Some(HoldCertifier::new(
+            ode,
+            scale,
+            rev,
+            self.dt,
+            self.options.delta,
+        ));
         self
     }
 
@@ -114,14 +241,14 @@ impl<'a> SettlingObserver<'a> {
             t0: 0.0,
             next_index: 0,
             scratch: vec![0.0; crate::integrate::OdeSystem::dim(system)],
-            ring: vec![0.0; ring_len],
-            ring_pos: 0,
-            ring_filled: 0,
+            ring: SquareRing::new(ring_len),
             r_hold: Hold::default(),
+            stretch_sum: 0.0,
             eps_hold: Hold::default(),
             peak_r: 0.0,
             gap: GapGauge::new(system.cargo()),
             min_gap: f64::INFINITY,
+            gap_now: f64::INFINITY,
             t_op: system.speed().operating_time(),
             operating_since: None,
             omega,
@@ -131,6 +258,9 @@ impl<'a> SettlingObserver<'a> {
                 ..Series::default()
             }),
             frame: None,
+            certifier: None,
+            certified: None,
+            plan: None,
             options,
         }
     }
@@ -174,7 +304,8 @@ impl<'a> SettlingObserver<'a> {
         }
         self.peak_r = self.peak_r.max(r);
         if let Some(gauge) = &self.gap {
-            self.min_gap = self.min_gap.min(gauge.min_gap(psi));
+            self.gap_now = gauge.min_gap(psi);
+            self.min_gap = self.min_gap.min(self.gap_now);
         }
         if r > self.options.divergence_factor * self.a_ref {
             self.diverged = Some(format!(
@@ -183,13 +314,7 @@ impl<'a> SettlingObserver<'a> {
             ));
             return Flow::Stop;
         }
-        self.ring[self.ring_pos] = r * r;
-        // A compare, not `%`: an integer division per sample is measurable.
-        self.ring_pos += 1;
-        if self.ring_pos == self.ring.len() {
-            self.ring_pos = 0;
-        }
-        self.ring_filled = (self.ring_filled + 1).min(self.ring.len());
+        self.ring.push(r * r);
         self.r_hold
             .update(t, operating && r <= self.band, self.window);
         self.eps_hold
@@ -213,26 +338,192 @@ impl<'a> SettlingObserver<'a> {
             }
         }
         if self.options.stop_when_settled && self.r_hold.met_at.is_some() {
-            Flow::Stop
-        } else {
-            Flow::Continue
+            return Flow::Stop;
         }
+        if self.certifier.is_none() {
+            return Flow::Continue;
+        }
+        let Some(start) = self.r_hold.stretch_start else {
+            self.stretch_sum = 0.0;
+            return Flow::Continue;
+        };
+        self.stretch_sum += r * r;
+        // Linearising costs a Newton solve: only once the rest of the window
+        // is about to be negligible next to the stretch so far, and never
+        // with weights at rest in contact (the kink of the penalty, where
+        // no linearisation holds).
+        let wants = self
+            .certifier
+            .as_ref()
+            .is_some_and(|c| c.wants_to_start(t, start));
+        let ready = wants && self.gap_now > 0.0 && self.recent_peak() <= READY_FRACTION * self.band;
+        if let Some(certifier) = &mut self.certifier
+            && let Some(tracked) =
+                certifier.observe(t, &self.scratch, r / self.a_ref, Some(start), ready)
+        {
+            return self.end_on_flow(&tracked);
+        }
+        Flow::Continue
+    }
+
+    /// The largest r over the last revolution of samples.
+    fn recent_peak(&self) -> f64 {
+        let per_rev = self.options.samples_per_rev.max(32) as usize;
+        self.ring.latest_max(per_rev).sqrt()
+    }
+
+    /// Time of sample k.
+    fn sample_time(&self, k: u64) -> f64 {
+        self.t0 + k as f64 * self.dt
+    }
+
+    /// The run has tracked a flow up to this sample: if the flow bounds the
+    /// rest of the hold window (see [`super::certify`]), take its samples
+    /// for the rest and stop; otherwise go on integrating, and tell the
+    /// certifier when the bound is likely to hold.
+    fn end_on_flow(&mut self, tracked: &Tracked) -> Flow {
+        let (Some(start), Some(_)) = (self.r_hold.stretch_start, self.operating_since) else {
+            return Flow::Continue;
+        };
+        // ε inside its band now, so that its stretch (or hold) stands; no
+        // weights at rest in contact (the kink of the penalty, where no
+        // linearisation holds).
+        let eps_inside = self.eps_hold.met_at.is_some() || self.eps_hold.stretch_start.is_some();
+        if !eps_inside || self.gap_now <= 0.0 {
+            return Flow::Continue;
+        }
+        let first = self.next_index;
+        let mut last = first;
+        // The same test as `Hold::update`, on the same sample times.
+        while self.sample_time(last) - start < self.window {
+            last += 1;
+        }
+        let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
+        if self.sample_time(last) > self.t0 + self.options.t_end_revs * rev {
+            return Flow::Continue;
+        }
+        let reusable = self
+            .plan
+            .as_ref()
+            .is_some_and(|p| p.check == tracked.check && p.first <= first && p.last == last);
+        if !reusable {
+            self.plan = self.plan_tail(tracked, first, last);
+        }
+        let Some(plan) = &self.plan else {
+            let t = self.sample_time(first) + REPLAN_REVS * rev;
+            if let Some(c) = &mut self.certifier {
+                c.defer(t);
+            }
+            return Flow::Continue;
+        };
+        let r = &plan.r[(first - plan.first) as usize..];
+        // The samples of now that the window's last ring will still hold.
+        let known = self
+            .ring
+            .latest_sum(self.ring.len().saturating_sub(r.len()));
+        let limit = (1.0 - MARGIN) * self.band;
+        let floor = ERROR_GROWTH * tracked.error * self.a_ref;
+        // How far the bound lets r² exceed the prediction, sample by sample.
+        let excess = |r: f64| {
+            let bound = (1.0 + BOUND_SLACK) * r + floor;
+            bound * bound - r * r
+        };
+        let max_r = r.iter().copied().fold(0.0, f64::max);
+        if !inside((1.0 + BOUND_SLACK) * max_r + floor, limit) {
+            self.plan = None;
+            return Flow::Continue;
+        }
+        let total_excess: f64 = r.iter().map(|&r| excess(r)).sum();
+        if !inside(total_excess, RESIDUAL_SHARE * known) {
+            // On the prediction, the first later sample where it would hold.
+            let (mut known_then, mut excess_then) = (known, total_excess);
+            let mut wait = r.len();
+            for (k, &rk) in r.iter().enumerate() {
+                known_then += rk * rk;
+                excess_then -= excess(rk);
+                if excess_then <= RESIDUAL_SHARE * known_then {
+                    wait = k + 1;
+                    break;
+                }
+            }
+            let t = self.sample_time(first - 1) + wait as f64 * self.dt;
+            if let Some(c) = &mut self.certifier {
+                c.defer(t);
+            }
+            return Flow::Continue;
+        }
+        let Some(plan) = self.plan.take() else {
+            unreachable!("checked above")
+        };
+        for (k, &rk) in plan.r[(first - plan.first) as usize..].iter().enumerate() {
+            let t = self.sample_time(first + k as u64);
+            self.ring.push(rk * rk);
+            self.peak_r = self.peak_r.max(rk);
+            self.r_hold.update(t, true, self.window);
+            self.eps_hold.update(t, true, self.window);
+        }
+        self.min_gap = self.min_gap.min(plan.closest);
+        self.next_index = last + 1;
+        // The run ends here: its final state is the integrated one, not
+        // the prediction at the window's end.
+        self.certified = Some((self.sample_time(first - 1), self.scratch.clone()));
+        Flow::Stop
+    }
+
+    /// r on the tracked flow from the current state for samples first..=last,
+    /// or None if ε would leave its band or two weights would touch.
+    fn plan_tail(&self, tracked: &Tracked, first: u64, last: u64) -> Option<TailPlan> {
+        let flow = &tracked.flow;
+        let system = self.system;
+        let lay = system.layout();
+        let psi = lay.head()..lay.nq();
+        let dim = self.scratch.len();
+        let eps_limit = (1.0 - MARGIN) * self.options.delta;
+        let count = (last - first + 1) as usize;
+        let mut x = vec![0.0; dim + 1];
+        let mut tmp = vec![0.0; dim + 1];
+        let mut state = vec![0.0; dim];
+        let mut r = Vec::with_capacity(count);
+        let mut closest = f64::INFINITY;
+        flow.lift(&self.scratch, &mut x);
+        for k in 0..count {
+            flow.advance(&mut x, &mut tmp);
+            flow.lower(&x, &mut state);
+            r.push(vibration(system, &state));
+            if k % TAIL_CHECK_STRIDE == 0 || k + 1 == count {
+                let angles = &state[psi.clone()];
+                if !inside(self.balancing.error(system, angles), eps_limit) {
+                    return None;
+                }
+                // Contact would change the flow: the weights must stay apart.
+                if let Some(g) = &self.gap {
+                    let gap = g.min_gap(angles);
+                    if gap.is_nan() || gap <= 0.0 {
+                        return None;
+                    }
+                    closest = closest.min(gap);
+                }
+            }
+        }
+        Some(TailPlan {
+            check: tracked.check,
+            first,
+            last,
+            r,
+            closest,
+        })
     }
 
     /// Turn the observations and the solver's report into the run's metrics.
     pub fn finish(self, report: &SolveReport) -> (RunMetrics, Option<Series>) {
         let lay = self.system.layout();
-        let psi = &report.y[lay.head()..lay.nq()];
-        let rms = if self.ring_filled == 0 {
-            0.0
-        } else {
-            let sum: f64 = if self.ring_filled == self.ring.len() {
-                self.ring.iter().sum()
-            } else {
-                self.ring[..self.ring_filled].iter().sum()
-            };
-            (sum / self.ring_filled as f64).sqrt()
+        // A certified hold ends the run at the sample that certified it.
+        let (t_final, y_final) = match &self.certified {
+            Some((t, y)) => (*t, y.as_slice()),
+            None => (report.t, report.y.as_slice()),
         };
+        let psi = &y_final[lay.head()..lay.nq()];
+        let rms = self.ring.rms();
         let (t_s, hold_complete) = self.r_hold.settling_time();
         let (t_eps, _) = self.eps_hold.settling_time();
         let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
@@ -268,7 +559,7 @@ impl<'a> SettlingObserver<'a> {
                     match self.operating_since {
                         Some(_) => format!(
                             "censored: r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
-                            vibration(self.system, &report.y) / self.a_ref,
+                            vibration(self.system, y_final) / self.a_ref,
                             self.options.delta,
                             rms / self.a_ref
                         ),
@@ -289,6 +580,7 @@ impl<'a> SettlingObserver<'a> {
             settling_time_err: self.dt,
             settling_time_eps: t_eps,
             hold_complete: settled && hold_complete,
+            hold_certified: self.certified.is_some(),
             residual_abs: rms,
             residual_rel: rms / self.a_ref,
             a_ref: self.a_ref,
@@ -301,19 +593,19 @@ impl<'a> SettlingObserver<'a> {
             p_final: position_parameter(psi),
             outcome,
             reason,
-            t_final: report.t,
+            t_final,
             steps: report.stats.steps,
-            rhs_calls: report.stats.rhs_calls,
+            rhs_calls: report.stats.rhs_calls + self.certifier.as_ref().map_or(0, |c| c.rhs_calls),
             method: String::new(),
             fidelity: String::new(),
             min_gap_rad: self.gap.as_ref().map(|_| self.min_gap),
             censoring_revs: (outcome == Outcome::Censored).then(|| {
-                let t_op = self.operating_since.unwrap_or(report.t);
-                ((report.t - self.window).max(t_op) - self.t0) / rev
+                let t_op = self.operating_since.unwrap_or(t_final);
+                ((t_final - self.window).max(t_op) - self.t0) / rev
             }),
             final_min_gap_rad: self.gap.as_ref().map(|g| g.min_gap(psi)),
             operating_time: self.operating_since,
-            final_spin_rate: Some(self.system.spin(report.t, &report.y).1),
+            final_spin_rate: Some(self.system.spin(t_final, y_final).1),
             balance_angle_error_deg: None,
         };
         (metrics, self.series)
@@ -337,7 +629,12 @@ impl StepObserver for SettlingObserver<'_> {
             }
             // Samples read only positions, except a free rotor's spin rate
             // until it reaches its operating speed.
-            let needed = if self.t_op.is_none() && self.operating_since.is_none() {
+            // The certifier linearises at full states inside the band.
+            let certifying = match (&self.certifier, self.r_hold.stretch_start) {
+                (Some(c), Some(since)) => c.needs_full_state(t, since),
+                _ => false,
+            };
+            let needed = if certifying || (self.t_op.is_none() && self.operating_since.is_none()) {
                 self.scratch.len()
             } else {
                 self.system.layout().nq()

@@ -25,6 +25,7 @@ impl Simulation {
                     settling_time: Some(t),
                     settling_revs: Some(t / rev),
                     hold_complete: true,
+                    hold_certified: false,
                     outcome: Outcome::Settled,
                     reason: format!(
                         "linear estimate ln((r0/A_ref)/δ)/σ with σ = {:.4e} 1/s ({} neutral directions set aside)",
@@ -66,6 +67,7 @@ impl Simulation {
                     settling_time: Some(t),
                     settling_revs: Some(t / rev),
                     hold_complete: true,
+                    hold_certified: false,
                     p_final: mode.p,
                     outcome: Outcome::Settled,
                     reason: format!(

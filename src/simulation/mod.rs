@@ -92,10 +92,10 @@ impl Simulation {
 
     /// Integrate `ode` (whose state has the layout of `system`), switching to
     /// Radau5 when an explicit method stalls; `frame` is ω for the rotating frame.
-    fn integrate<S: OdeSystem>(
+    fn integrate<'a, S: OdeSystem>(
         &self,
-        ode: &S,
-        system: &RotorSystem,
+        ode: &'a S,
+        system: &'a RotorSystem,
         y0: &[f64],
         frame: Option<f64>,
         record: bool,
@@ -110,6 +110,10 @@ impl Simulation {
         let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);
         if let Some(w) = frame {
             observer = observer.in_rotating_frame(w);
+            // A recorded series keeps every integrated sample.
+            if self.metrics.certified_hold && self.metrics.stop_when_settled && !record {
+                observer = observer.certify_with(ode);
+            }
         }
         let options = SolverOptions {
             rtol: self.solver.rtol,

@@ -134,6 +134,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             .settling_time_eps),
         col!("censoring_revs", |r: &RunRecord| r.metrics.censoring_revs),
         col!("hold_complete", |r: &RunRecord| r.metrics.hold_complete),
+        col!("hold_certified", |r: &RunRecord| r.metrics.hold_certified),
         col!("residual_abs", |r: &RunRecord| r.metrics.residual_abs),
         col!("residual_rel", |r: &RunRecord| r.metrics.residual_rel),
         col!("a_ref", |r: &RunRecord| r.metrics.a_ref),
@@ -298,6 +299,11 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let (steps, rhs, wall) = (u64s("steps")?, u64s("rhs_calls")?, req("wall_time_s")?);
     let fidelity = strs("fidelity")?;
     let contact = bools("contact")?;
+    // Absent from tables written before the certified hold existed.
+    let certified = match df.column("hold_certified") {
+        Ok(_) => bools("hold_certified")?,
+        Err(_) => vec![false; df.height()],
+    };
     let (min_gap, final_gap) = (f64s("min_gap_rad")?, f64s("final_min_gap_rad")?);
     let censoring = f64s("censoring_revs")?;
     let weights: Option<Vec<SampledWeights>> = if df.column(WEIGHT_COLUMNS[0]).is_ok() {
@@ -358,6 +364,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 settling_time_err: te[i],
                 settling_time_eps: teps[i],
                 hold_complete: hold[i],
+                hold_certified: certified[i],
                 residual_abs: ra[i],
                 residual_rel: rr[i],
                 a_ref: aref[i],

@@ -74,10 +74,19 @@ pub fn shipped_plan(
     samples: u32,
     edit: impl FnOnce(&mut autobal::simulation::SolverSettings),
 ) -> autobal::study::config::StudyPlan {
+    shipped_plan_edited(path, samples, |file| edit(&mut file.solver))
+}
+
+/// A shipped study at `samples` per design, any part of its file edited.
+pub fn shipped_plan_edited(
+    path: &std::path::Path,
+    samples: u32,
+    edit: impl FnOnce(&mut autobal::study::config::StudyFile),
+) -> autobal::study::config::StudyPlan {
     let text = std::fs::read_to_string(path).unwrap();
     let shown = path.display().to_string();
     let mut file = autobal::study::config::StudyFile::parse(&text, &shown).unwrap();
     file.sampling.samples = samples;
-    edit(&mut file.solver);
+    edit(&mut file);
     file.plan(&text, &shown).unwrap()
 }

@@ -4,6 +4,7 @@ mod adaptive;
 mod auto_method;
 mod bad_input;
 mod bench;
+mod certified_hold;
 mod check;
 mod claims;
 mod cli_design;

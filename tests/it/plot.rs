@@ -262,6 +262,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     settling_time_err: 0.001,
                     settling_time_eps: None,
                     hold_complete: settled,
+                    hold_certified: false,
                     residual_abs: 1e-6,
                     residual_rel: 0.01,
                     a_ref: 1e-4,

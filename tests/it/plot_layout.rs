@@ -211,6 +211,7 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         settling_time_err: 0.001,
         settling_time_eps: settled.then_some(revs * 0.025),
         hold_complete: settled,
+        hold_certified: false,
         residual_abs: 1e-6,
         residual_rel: 0.01,
         a_ref: 1e-4,

@@ -56,6 +56,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             settling_time_err: 0.001,
             settling_time_eps: None,
             hold_complete: revs.is_some(),
+            hold_certified: false,
             residual_abs: residual_rel * 1e-4,
             residual_rel,
             a_ref: 1e-4,
