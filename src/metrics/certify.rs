@@ -71,7 +71,7 @@ const NORMAL_RIDGE: f64 = 1e-12;
 const TAYLOR_DEGREE: u32 = 12;
 
 /// Relative step of the central differences (≈ ε^(1/3) for their error balance).
-const FD_STEP: f64 = 6e-6;
+const FD_STEP: f64 = 1e-9;
 
 /// The affine flow over one sample interval, on the scaled state.
 #[derive(Debug, Clone)]
@@ -240,8 +240,13 @@ impl<'a> HoldCertifier<'a> {
                 if next.is_nan() {
                     *next = since + FIRST_CHECK_REVS * self.rev;
                 }
-                if ready && t + on_grid >= *next {
-                    self.start_tracking(t, z, r_rel);
+                if t + on_grid >= *next {
+                    if ready {
+                        self.start_tracking(t, z, r_rel);
+                    } else {
+                        // Not yet: look again a revolution later.
+                        *next = t + self.rev;
+                    }
                 }
                 None
             }

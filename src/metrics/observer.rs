@@ -152,8 +152,6 @@ pub struct SettlingObserver<'a> {
     peak_r: f64,
     gap: Option<GapGauge>,
     min_gap: f64,
-    /// The closest two weights come at the latest sample (rad).
-    gap_now: f64,
     /// When the speed reaches its operating value, if known in advance.
     t_op: Option<f64>,
     /// The first sample at the operating speed (settling is judged from here).
@@ -177,9 +175,12 @@ struct TailPlan {
     first: u64,
     last: u64,
     r: Vec<f64>,
-    /// The smallest gap between weights on the checked samples (rad).
-    closest: f64,
 }
+
+/// Every pair of weights must stay this far (rad) from the touching angle,
+/// apart or in contact, for the flow to be linearised: well beyond the
+/// central differences' step in an angle (6e-6 × max(1, |ψ|) ≤ 4e-5 rad).
+const CONTACT_MARGIN: f64 = 2.5e-8;
 
 /// After a prediction that fails (ε or the gaps), the next try comes this
 /// many revolutions later.
@@ -248,7 +249,6 @@ impl<'a> SettlingObserver<'a> {
             peak_r: 0.0,
             gap: GapGauge::new(system.cargo()),
             min_gap: f64::INFINITY,
-            gap_now: f64::INFINITY,
             t_op: system.speed().operating_time(),
             operating_since: None,
             omega,
@@ -304,8 +304,7 @@ impl<'a> SettlingObserver<'a> {
         }
         self.peak_r = self.peak_r.max(r);
         if let Some(gauge) = &self.gap {
-            self.gap_now = gauge.min_gap(psi);
-            self.min_gap = self.min_gap.min(self.gap_now);
+            self.min_gap = self.min_gap.min(gauge.min_gap(psi));
         }
         if r > self.options.divergence_factor * self.a_ref {
             self.diverged = Some(format!(
@@ -356,7 +355,8 @@ impl<'a> SettlingObserver<'a> {
             .certifier
             .as_ref()
             .is_some_and(|c| c.wants_to_start(t, start));
-        let ready = wants && self.gap_now > 0.0 && self.recent_peak() <= READY_FRACTION * self.band;
+        let ready =
+            wants && self.recent_peak() <= READY_FRACTION * self.band && self.contacts_settled();
         if let Some(certifier) = &mut self.certifier
             && let Some(tracked) =
                 certifier.observe(t, &self.scratch, r / self.a_ref, Some(start), ready)
@@ -364,6 +364,15 @@ impl<'a> SettlingObserver<'a> {
             return self.end_on_flow(&tracked);
         }
         Flow::Continue
+    }
+
+    /// Whether no two weights are within [`CONTACT_MARGIN`] of touching (in
+    /// contact or apart) at the latest sample.
+    fn contacts_settled(&self) -> bool {
+        let psi = &self.scratch[self.system.layout().head()..self.system.layout().nq()];
+        self.gap
+            .as_ref()
+            .is_none_or(|g| g.same_contacts(psi, psi, CONTACT_MARGIN))
     }
 
     /// The largest r over the last revolution of samples.
@@ -389,7 +398,7 @@ impl<'a> SettlingObserver<'a> {
         // weights at rest in contact (the kink of the penalty, where no
         // linearisation holds).
         let eps_inside = self.eps_hold.met_at.is_some() || self.eps_hold.stretch_start.is_some();
-        if !eps_inside || self.gap_now <= 0.0 {
+        if !eps_inside || !self.contacts_settled() {
             return Flow::Continue;
         }
         let first = self.next_index;
@@ -462,7 +471,6 @@ impl<'a> SettlingObserver<'a> {
             self.r_hold.update(t, true, self.window);
             self.eps_hold.update(t, true, self.window);
         }
-        self.min_gap = self.min_gap.min(plan.closest);
         self.next_index = last + 1;
         // The run ends here: its final state is the integrated one, not
         // the prediction at the window's end.
@@ -471,7 +479,8 @@ impl<'a> SettlingObserver<'a> {
     }
 
     /// r on the tracked flow from the current state for samples first..=last,
-    /// or None if ε would leave its band or two weights would touch.
+    /// or None if ε would leave its band, a contact open or close, or two
+    /// weights come closer than they have so far.
     fn plan_tail(&self, tracked: &Tracked, first: u64, last: u64) -> Option<TailPlan> {
         let flow = &tracked.flow;
         let system = self.system;
@@ -484,7 +493,6 @@ impl<'a> SettlingObserver<'a> {
         let mut tmp = vec![0.0; dim + 1];
         let mut state = vec![0.0; dim];
         let mut r = Vec::with_capacity(count);
-        let mut closest = f64::INFINITY;
         flow.lift(&self.scratch, &mut x);
         for k in 0..count {
             flow.advance(&mut x, &mut tmp);
@@ -495,13 +503,13 @@ impl<'a> SettlingObserver<'a> {
                 if !inside(self.balancing.error(system, angles), eps_limit) {
                     return None;
                 }
-                // Contact would change the flow: the weights must stay apart.
-                if let Some(g) = &self.gap {
-                    let gap = g.min_gap(angles);
-                    if gap.is_nan() || gap <= 0.0 {
-                        return None;
-                    }
-                    closest = closest.min(gap);
+                // A contact that opens or closes would change the flow, and
+                // the closest approach so far must stay the run's.
+                if let Some(g) = &self.gap
+                    && !(g.same_contacts(&self.scratch[psi.clone()], angles, CONTACT_MARGIN)
+                        && g.min_gap(angles) >= self.min_gap)
+                {
+                    return None;
                 }
             }
         }
@@ -510,7 +518,6 @@ impl<'a> SettlingObserver<'a> {
             first,
             last,
             r,
-            closest,
         })
     }
 

@@ -45,6 +45,29 @@ impl GapGauge {
         smallest
     }
 
+    /// Whether every pair of one plane is as far from touching at `later`
+    /// as at `now` in kind: apart by more than `margin` at both, or
+    /// overlapping (in contact) by more than `margin` at both. A contact
+    /// that opens or closes, or sits within `margin` of it, is a kink in
+    /// the equations of motion, where no linearisation holds.
+    pub fn same_contacts(&self, now: &[f64], later: &[f64], margin: f64) -> bool {
+        for (a, &(j, alpha_j, plane_j)) in self.sized.iter().enumerate() {
+            for &(k, alpha_k, plane_k) in &self.sized[a + 1..] {
+                if plane_k == plane_j {
+                    let touch = alpha_j + alpha_k;
+                    let g0 = wrapped(now[k] - now[j]).abs() - touch;
+                    let g1 = wrapped(later[k] - later[j]).abs() - touch;
+                    let apart = g0 > margin && g1 > margin;
+                    let pressed = g0 < -margin && g1 < -margin;
+                    if !(apart || pressed) {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    }
+
     /// The touching angle 2α of the smallest pair (rad), the scale of a gap.
     pub fn contact_angle(&self) -> f64 {
         let mut smallest = f64::INFINITY;

@@ -39,7 +39,9 @@ fn certified_hold_reports_the_full_holds_settling_and_residual_on_every_shipped_
             // The tail's gaps are the flow's, checked every few samples.
             assert!(
                 gap_off <= 1e-4,
-                "{what}: closest approach moved {gap_off:.2e} rad"
+                "{what}: closest approach {:?} against {:?} of the full hold",
+                b.min_gap_rad,
+                a.min_gap_rad
             );
             worst_gap = worst_gap.max(gap_off);
             assert_eq!(a.peak_r, b.peak_r, "{what}");
