@@ -402,8 +402,13 @@ impl<'a> SettlingObserver<'a> {
             return Flow::Continue;
         }
         let first = self.next_index;
-        let mut last = first;
-        // The same test as `Hold::update`, on the same sample times.
+        // The sample at which `Hold::update` will find the window complete:
+        // estimated, then settled by its own test on the same sample times.
+        let ahead = ((start + self.window - self.sample_time(first)) / self.dt).floor();
+        let mut last = first + ahead.max(0.0) as u64;
+        while last > first && self.sample_time(last - 1) - start >= self.window {
+            last -= 1;
+        }
         while self.sample_time(last) - start < self.window {
             last += 1;
         }
@@ -491,7 +496,8 @@ impl<'a> SettlingObserver<'a> {
         let count = (last - first + 1) as usize;
         let mut x = vec![0.0; dim + 1];
         let mut tmp = vec![0.0; dim + 1];
-        let mut state = vec![0.0; dim];
+        // Positions only: r, ε and the gaps need no more.
+        let mut state = vec![0.0; lay.nq()];
         let mut r = Vec::with_capacity(count);
         flow.lift(&self.scratch, &mut x);
         for k in 0..count {
