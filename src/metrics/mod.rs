@@ -68,7 +68,7 @@ impl Default for MetricOptions {
             samples_per_rev: 32,
             stop_when_settled: true,
             divergence_factor: 1e4,
-            certified_hold: false,
+            certified_hold: true,
         }
     }
 }

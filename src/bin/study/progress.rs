@@ -35,6 +35,8 @@ pub struct RunProgress {
     earlier: AtomicU64,
     done: AtomicU64,
     settled: AtomicU64,
+    /// Runs a certified hold ended early (`metrics.certified_hold`).
+    certified: AtomicU64,
     failures: AtomicU64,
 }
 
@@ -66,6 +68,7 @@ impl RunProgress {
             earlier: AtomicU64::new(0),
             done: AtomicU64::new(0),
             settled: AtomicU64::new(0),
+            certified: AtomicU64::new(0),
             failures: AtomicU64::new(0),
         }
     }
@@ -119,6 +122,9 @@ impl Progress for RunProgress {
         if record.metrics.settled {
             self.settled.fetch_add(1, Ordering::Relaxed);
         }
+        if record.metrics.hold_certified {
+            self.certified.fetch_add(1, Ordering::Relaxed);
+        }
         let failed = matches!(
             record.metrics.outcome,
             Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded
@@ -156,8 +162,17 @@ impl Progress for RunProgress {
                 let elapsed = start.elapsed();
                 let done = self.done.load(Ordering::Relaxed);
                 let settled = self.settled.load(Ordering::Relaxed);
+                let certified = self.certified.load(Ordering::Relaxed);
+                let early = if certified > 0 {
+                    format!(
+                        " ({:.1} % by a certified hold)",
+                        100.0 * certified as f64 / done.max(1) as f64
+                    )
+                } else {
+                    String::new()
+                };
                 eprintln!(
-                    "finished: {} runs in {} ({:.0} runs/s), settled {:.1} %, failures {}",
+                    "finished: {} runs in {} ({:.0} runs/s), settled {:.1} %{early}, failures {}",
                     done,
                     hms(elapsed.as_secs_f64()),
                     done as f64 / elapsed.as_secs_f64().max(1e-9),

@@ -100,15 +100,29 @@ pub struct ThreadScaling {
 
 /// The cut-down [`THREAD_STUDY`] writing under `output`.
 pub fn thread_study(samples: u32, output: &Path) -> StudyPlan {
+    edited_main_job(samples, output, "--thread-scaling", |_| {})
+}
+
+/// The main job with `samples` per design, its output under `output`, and
+/// `edit` applied; the provenance text names the `verb` and the changes,
+/// so the files are not mistaken for the real study's.
+pub fn edited_main_job(
+    samples: u32,
+    output: &Path,
+    verb: &str,
+    edit: impl FnOnce(&mut StudyFile),
+) -> StudyPlan {
     let path = "studies/three_balls.toml";
     let mut file = StudyFile::parse(THREAD_STUDY, path).expect("the bundled study parses");
     file.sampling.samples = samples.max(1);
     file.output = output.display().to_string();
-    // The provenance text says what was changed, so the files are not mistaken for the real study.
-    let text = format!(
-        "{THREAD_STUDY}\n# study bench --thread-scaling: sampling.samples = {}\n",
-        file.sampling.samples
-    );
+    let bundled = file.clone();
+    edit(&mut file);
+    let mut note = format!("sampling.samples = {}", file.sampling.samples);
+    if file.metrics != bundled.metrics {
+        note += &format!(", metrics = {:?}", file.metrics);
+    }
+    let text = format!("{THREAD_STUDY}\n# study bench {verb}: {note}\n");
     file.plan(&text, path).expect("the bundled study is valid")
 }
 
