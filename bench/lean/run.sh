@@ -44,9 +44,13 @@ echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null
 "$study" bench --lean-inputs "$out/runs.csv" --samples "$samples"
 # The same plan for `study run`: the main job with its samples cut down and
 # its output in $out (the draws depend on the seed, design and sample only).
+# Twice: by default (certified hold) and holding every window to its end,
+# the lean program's rule (`metrics.certified_hold = false`).
 sed -e "s/^samples = [0-9]*/samples = $samples/" \
     -e "s|^seed = \(.*\)\$|seed = \1\noutput = \"$out/study\"|" \
     "$root/studies/three_balls.toml" >"$out/three_balls.toml"
+sed -e "s/^hold_revs = \(.*\)/hold_revs = \1\ncertified_hold = false/" \
+    "$out/three_balls.toml" >"$out/full_hold.toml"
 
 run_autobal() {
     local t0 t1
@@ -54,7 +58,9 @@ run_autobal() {
     "$study" run "$out/three_balls.toml" --threads 1 --quiet --overwrite >/dev/null
     t1=$(date +%s.%N)
     echo "$t1 - $t0" | bc >>"$out/walls.txt"
-    cp "$out/study/three_balls/runs.parquet" "$out/autobal-$1.parquet"
+    cp "$out/study/three_balls/runs.parquet" "$out/autobal-certified-$1.parquet"
+    "$study" run "$out/full_hold.toml" --threads 1 --quiet --overwrite >/dev/null
+    cp "$out/study/full_hold/runs.parquet" "$out/autobal-full-$1.parquet"
 }
 run_lean() {
     "$lean_matched" "$out/runs.csv" >"$out/lean-matched-$1.txt"

@@ -15,9 +15,9 @@ import pyarrow.parquet as pq
 out = sys.argv[1]
 
 
-def load_autobal():
+def load_autobal(variant):
     best, calls, method, settle = {}, {}, {}, {}
-    for path in sorted(glob.glob(f"{out}/autobal-*.parquet")):
+    for path in sorted(glob.glob(f"{out}/autobal-{variant}-*.parquet")):
         d = pq.read_table(path, columns=["run_id", "wall_time_s", "rhs_calls", "method", "settling_revs"]).to_pydict()
         for i, rid in enumerate(d["run_id"]):
             best[rid] = min(best.get(rid, math.inf), d["wall_time_s"][i])
@@ -39,8 +39,11 @@ def load_lean(profile):
     return best, calls, summary
 
 
-a_time, a_calls, a_method, _ = load_autobal()
-rounds = len(glob.glob(f"{out}/autobal-*.parquet"))
+# "certified": the default (certified hold on); "full": metrics.certified_hold = false,
+# the lean program's own rule (it holds every window to its end).
+autobal = {v: load_autobal(v) for v in ("certified", "full")}
+a_time, a_calls, a_method, _ = autobal["full"]
+rounds = len(glob.glob(f"{out}/autobal-full-*.parquet"))
 lean = {p: load_lean(p) for p in ("matched", "full")}
 runs = sorted(a_time)
 subsets = [
@@ -57,19 +60,27 @@ def stats(times, calls, ids):
 
 
 rows = []
-for label, ids in subsets:
-    if not ids:
+for variant, label_hold in (("full", "full hold"), ("certified", "certified hold (default)")):
+    v_time, v_calls = autobal[variant][0], autobal[variant][1]
+    if not v_time:
         continue
-    a = stats(a_time, a_calls, ids)
-    m = stats(*lean["matched"][:2], ids)
-    f = stats(*lean["full"][:2], ids)
-    rows.append((label, len(ids), a, m, f))
+    for label, ids in subsets:
+        if not ids:
+            continue
+        a = stats(v_time, v_calls, ids)
+        m = stats(*lean["matched"][:2], ids)
+        f = stats(*lean["full"][:2], ids)
+        rows.append((f"{label}, {label_hold}", len(ids), a, m, f))
 
 s = lean["matched"][2][-1]
+certified = autobal["certified"]
+same = sum(1 for r in runs if certified[3].get(r) == autobal["full"][3].get(r))
 print(f"{len(runs)} runs of studies/three_balls.toml ({s['same_settling']}/{s['runs']} settling times identical, "
-      f"RHS calls identical on {s['same_calls_dp5']} runs autobal kept on dp5), {rounds} interleaved rounds, "
+      f"RHS calls identical on {s['same_calls_dp5']} runs autobal kept on dp5; with the certified hold "
+      f"{same}/{len(runs)} settling times as with the full hold), {rounds} interleaved rounds, "
       "fastest round per run, one thread.")
-print("autobal: `study run --threads 1`, dev profile (autobal at opt-level 2, debug assertions on);")
+print("autobal: `study run --threads 1`, dev profile (autobal at opt-level 2, debug assertions on), "
+      "with `metrics.certified_hold = false` (full hold, the lean program's rule) and by default;")
 print("lean: bench/lean built with the same settings (`--release`, see its Cargo.toml) and, last column, at opt-level 3.\n")
 hdr = ["runs", "n", "autobal runs/s", "lean runs/s", "autobal/lean", "lean O3 runs/s",
        "RHS/run autobal", "RHS/run lean", "ns/RHS autobal", "ns/RHS lean", "ns/RHS lean O3"]

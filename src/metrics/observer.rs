@@ -502,9 +502,12 @@ impl<'a> SettlingObserver<'a> {
         flow.lift(&self.scratch, &mut x);
         for k in 0..count {
             flow.advance(&mut x, &mut tmp);
-            flow.lower(&x, &mut state);
+            let checked = k % TAIL_CHECK_STRIDE == 0 || k + 1 == count;
+            // r needs the rotor's coordinates only; the angles, when checked.
+            let needed = if checked { lay.nq() } else { lay.head() };
+            flow.lower(&x, &mut state[..needed]);
             r.push(vibration(system, &state));
-            if k % TAIL_CHECK_STRIDE == 0 || k + 1 == count {
+            if checked {
                 let angles = &state[psi.clone()];
                 if !inside(self.balancing.error(system, angles), eps_limit) {
                     return None;
