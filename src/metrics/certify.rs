@@ -23,7 +23,7 @@
 //!    observer checks these);
 //! 3. **negligible rest**: what the bounds allow beyond the prediction,
 //!    Σ (bound² − predicted r²) over the rest of the window, is at most
-//!    [`RESIDUAL_SHARE`] of the window's Σ r² so far, so the reported
+//!    [`residual_share`] of the window's Σ r² so far, so the reported
 //!    residual, which sums the predicted r² for the rest, is within half of
 //!    that of the full hold's.
 //!
@@ -61,8 +61,17 @@ pub const BOUND_SLACK: f64 = 0.1;
 /// How far the flow's absolute error may grow past what tracking saw.
 pub const ERROR_GROWTH: f64 = 2.0;
 /// The bounds may move Σ r² over the window by at most this fraction (the
-/// residual, an RMS, then by at most half of it).
+/// residual, an RMS, then by at most half of it)...
 pub const RESIDUAL_SHARE: f64 = 0.01;
+/// ... or by this many times the integration's rtol, if less: at rtol 1e-6
+/// (the default) the full share, as much as the integration's own error in
+/// the residual there; a tighter tolerance asks for a residual as accurate.
+pub const RESIDUAL_SHARE_PER_RTOL: f64 = 1e4;
+
+/// The share of Σ r² the bounds may move for an integration at `rtol`.
+pub fn residual_share(rtol: f64) -> f64 {
+    (RESIDUAL_SHARE_PER_RTOL * rtol).min(RESIDUAL_SHARE)
+}
 
 /// Newton steps towards the fixed point at most.
 const NEWTON_STEPS: usize = 6;

@@ -1,7 +1,7 @@
 //! The step observer that measures a run: samples r and ε on dense output,
 //! detects settling, watches for divergence, and optionally records a series.
 
-use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, RESIDUAL_SHARE, Tracked};
+use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, Tracked, residual_share};
 use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
@@ -161,6 +161,8 @@ pub struct SettlingObserver<'a> {
     series: Option<Series>,
     frame: Option<f64>,
     certifier: Option<HoldCertifier<'a>>,
+    /// How much the certified hold may move Σ r² over the window.
+    residual_share: f64,
     /// The sample (t, state) at which a certified hold ended the run.
     certified: Option<(f64, Vec<f64>)>,
     /// The rest of the window as the tracked flow predicts it.
@@ -203,8 +205,10 @@ impl<'a> SettlingObserver<'a> {
     }
 
     /// End the hold window early when the affine flow of `ode` (autonomous,
-    /// the system's state layout) bounds its rest; see [`super::certify`].
-    pub fn certify_with(mut self, ode: &'a dyn OdeSystem) -> Self {
+    /// the system's state layout), integrated at `rtol`, bounds its rest;
+    /// see [`super::certify`].
+    pub fn certify_with(mut self, ode: &'a dyn OdeSystem, rtol: f64) -> Self {
+        self.residual_share = residual_share(rtol);
         let lay = self.system.layout();
         let positions: Vec<f64> = (0..lay.nq())
             .map(|i| if i < lay.rotor_dof { self.a_ref } else { 1.0 })
@@ -259,6 +263,7 @@ impl<'a> SettlingObserver<'a> {
             }),
             frame: None,
             certifier: None,
+            residual_share: 0.0,
             certified: None,
             plan: None,
             options,
@@ -448,14 +453,14 @@ impl<'a> SettlingObserver<'a> {
             return Flow::Continue;
         }
         let total_excess: f64 = r.iter().map(|&r| excess(r)).sum();
-        if !inside(total_excess, RESIDUAL_SHARE * known) {
+        if !inside(total_excess, self.residual_share * known) {
             // On the prediction, the first later sample where it would hold.
             let (mut known_then, mut excess_then) = (known, total_excess);
             let mut wait = r.len();
             for (k, &rk) in r.iter().enumerate() {
                 known_then += rk * rk;
                 excess_then -= excess(rk);
-                if excess_then <= RESIDUAL_SHARE * known_then {
+                if excess_then <= self.residual_share * known_then {
                     wait = k + 1;
                     break;
                 }

@@ -112,7 +112,7 @@ impl Simulation {
             observer = observer.in_rotating_frame(w);
             // A recorded series keeps every integrated sample.
             if self.metrics.certified_hold && self.metrics.stop_when_settled && !record {
-                observer = observer.certify_with(ode);
+                observer = observer.certify_with(ode, self.solver.rtol);
             }
         }
         let options = SolverOptions {

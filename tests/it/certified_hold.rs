@@ -77,3 +77,27 @@ fn certified_hold_reports_the_full_holds_settling_and_residual_on_every_shipped_
         "only {certified} of {runs} runs certified"
     );
 }
+
+/// A tighter tolerance asks for a residual as accurate: at rtol 1e-9 the
+/// certified hold may move Σ r² by 1e4·rtol = 1e-5 of itself at most, so the
+/// residual by 5e-6 (`certify::residual_share`).
+#[test]
+fn a_tight_tolerance_tightens_the_certified_residual() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/three_balls.toml");
+    let tight = |certified: bool| {
+        shipped_plan_edited(&path, 2, |f| {
+            f.solver.rtol = 1e-9;
+            f.metrics.certified_hold = certified;
+        })
+    };
+    let (full, early) = (tight(false), tight(true));
+    let mut certified = 0;
+    for id in 0..full.total_runs() {
+        let (a, b) = (run_one(&full, id).metrics, run_one(&early, id).metrics);
+        assert_eq!(a.settling_revs, b.settling_revs, "run {id}");
+        let off = (b.residual_rel / a.residual_rel - 1.0).abs();
+        assert!(off <= 5e-6, "run {id}: residual moved {off:.1e}");
+        certified += usize::from(b.hold_certified);
+    }
+    assert!(certified > 0, "no run certified at rtol 1e-9");
+}
