@@ -563,10 +563,19 @@ impl<'a> SettlingObserver<'a> {
             (None, _) => match t_s {
                 Some(t) if hold_complete => (
                     Outcome::Settled,
-                    format!(
-                        "r ≤ {} A_ref held for {} revolutions from t = {t:.4}",
-                        self.options.delta, self.options.hold_revs
-                    ),
+                    match self.certified {
+                        // Say which part of the window was integrated.
+                        Some((t_end, _)) => format!(
+                            "r ≤ {} A_ref held for {} revolutions from t = {t:.4} (certified: integrated to t = {t_end:.4}, the last {:.1} revolutions bounded on the linearised flow)",
+                            self.options.delta,
+                            self.options.hold_revs,
+                            (t + self.window - t_end.min(t + self.window)) / rev
+                        ),
+                        None => format!(
+                            "r ≤ {} A_ref held for {} revolutions from t = {t:.4}",
+                            self.options.delta, self.options.hold_revs
+                        ),
+                    },
                 ),
                 Some(t) => (
                     Outcome::Censored,
