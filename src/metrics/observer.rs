@@ -8,7 +8,7 @@ use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
 use crate::model::gap::GapGauge;
 use crate::model::system::RotorSystem;
-use crate::model::unbalance::BalancingGauge;
+use crate::model::unbalance::{BalancingGauge, BandCheck, BandDecider};
 use std::f64::consts::PI;
 
 /// A sampled time history: t, x, y, r, ε and every ψ_j.
@@ -138,6 +138,8 @@ pub struct SettlingObserver<'a> {
     a_ref: f64,
     u_ref: f64,
     balancing: BalancingGauge,
+    /// Decides ε ≤ δ without computing ε where a bound settles it.
+    eps_band: BandDecider,
     band: f64,
     window: f64,
     dt: f64,
@@ -235,11 +237,13 @@ impl<'a> SettlingObserver<'a> {
         let samples = options.samples_per_rev.max(32);
         let ring_len = ((options.hold_revs * f64::from(samples)).ceil() as usize).max(1);
         let a = a_ref(system, omega);
+        let balancing = BalancingGauge::new(system, reference_unbalance(system));
         SettlingObserver {
             system,
             a_ref: a,
             u_ref: reference_unbalance(system),
-            balancing: BalancingGauge::new(system, reference_unbalance(system)),
+            eps_band: BandDecider::new(&balancing),
+            balancing,
             band: options.delta * a,
             window: options.hold_revs * rev,
             dt: rev / f64::from(samples),
@@ -302,8 +306,18 @@ impl<'a> SettlingObserver<'a> {
         let y = &self.scratch;
         let r = vibration(self.system, y);
         let psi = &y[lay.head()..lay.nq()];
-        let eps = self.balancing.error(self.system, psi);
-        if !r.is_finite() || !eps.is_finite() {
+        // A recorded series keeps every ε; otherwise only ε ≤ δ matters.
+        let check = if self.series.is_some() {
+            BandCheck::Computed(self.balancing.error(self.system, psi))
+        } else {
+            self.eps_band
+                .check(&self.balancing, self.system, psi, self.options.delta)
+        };
+        let (eps_inside, eps) = match check {
+            BandCheck::Decided(inside) => (inside, None),
+            BandCheck::Computed(eps) => (eps <= self.options.delta, Some(eps)),
+        };
+        if !r.is_finite() || eps.is_some_and(|e| !e.is_finite()) {
             self.diverged = Some(format!("non-finite state at t = {t}"));
             return Flow::Stop;
         }
@@ -322,7 +336,7 @@ impl<'a> SettlingObserver<'a> {
         self.r_hold
             .update(t, operating && r <= self.band, self.window);
         self.eps_hold
-            .update(t, operating && eps <= self.options.delta, self.window);
+            .update(t, operating && eps_inside, self.window);
         if let Some(series) = &mut self.series {
             series.t.push(t);
             // The rotating frame integrates (u, v): report inertial (x, y).
@@ -336,7 +350,7 @@ impl<'a> SettlingObserver<'a> {
             series.x.push(x);
             series.y.push(yy);
             series.r.push(r);
-            series.eps.push(eps);
+            series.eps.push(eps.unwrap_or(f64::NAN));
             for (j, p) in psi.iter().enumerate() {
                 series.psi[j].push(*p);
             }

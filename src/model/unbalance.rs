@@ -68,6 +68,76 @@ impl BalancingGauge {
     }
 }
 
+/// Decides ε ≤ δ sample after sample, computing ε (and its trig) only when
+/// a bound cannot: for the plane rotor |ε(ψ) − ε(ψ₀)| ≤ Σ_j (m_j l_j / U)
+/// |ψ_j − ψ₀_j|, because |e^{ia} − e^{ib}| ≤ |a − b|, so from the last ε
+/// computed (at ψ₀) the answer is often already certain. The decisions are
+/// those of computing ε every time: the bound is widened by far more than
+/// the rounding of either side.
+#[derive(Debug, Clone)]
+pub struct BandDecider {
+    /// m_j l_j / U per cargo; None where the bound is not derived (rotors
+    /// with several coordinates): there ε is always computed.
+    weights: Option<Vec<f64>>,
+    /// The last ε computed, and the angles it was computed at.
+    anchor: Option<(f64, Vec<f64>)>,
+}
+
+/// What [`BandDecider::check`] found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BandCheck {
+    /// The bound settled it: whether ε ≤ δ.
+    Decided(bool),
+    /// ε had to be computed (it may be non-finite).
+    Computed(f64),
+}
+
+impl BandDecider {
+    /// A decider for the system `gauge` measures.
+    pub fn new(gauge: &BalancingGauge) -> Self {
+        BandDecider {
+            weights: gauge.plane.map(|_| {
+                gauge
+                    .cargo_unbalance
+                    .iter()
+                    .map(|u| u / gauge.unbalance_ref)
+                    .collect()
+            }),
+            anchor: None,
+        }
+    }
+
+    /// Whether ε(ψ) ≤ δ, by the bound if it settles it, else by computing ε.
+    pub fn check(
+        &mut self,
+        gauge: &BalancingGauge,
+        system: &RotorSystem,
+        psi: &[f64],
+        delta: f64,
+    ) -> BandCheck {
+        if let (Some(weights), Some((eps0, psi0))) = (&self.weights, &self.anchor) {
+            let reach: f64 = weights
+                .iter()
+                .zip(psi.iter().zip(psi0))
+                .map(|(w, (p, p0))| w * (p - p0).abs())
+                .sum();
+            // Far wider than rounding: ε and the sum err by ~1e-15.
+            let reach = reach * (1.0 + 1e-9) + 1e-12 * delta;
+            if eps0 + reach < delta {
+                return BandCheck::Decided(true);
+            }
+            if eps0 - reach > delta {
+                return BandCheck::Decided(false);
+            }
+        }
+        let eps = gauge.error(system, psi);
+        if self.weights.is_some() {
+            self.anchor = eps.is_finite().then(|| (eps, psi.to_vec()));
+        }
+        BandCheck::Computed(eps)
+    }
+}
+
 /// |(x, y)| for the observer's per-sample sizes (r and ε): sqrt(x² + y²),
 /// which costs a third of `hypot` (its scaling against overflow and
 /// underflow was 6 % of a study's time); `hypot` only where x² + y² would

@@ -16,6 +16,7 @@ mod convergence;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;
+mod eps_band;
 mod extremes;
 mod fixtures;
 mod fuzz_input;

@@ -1,0 +1,53 @@
+//! `BandDecider` decides ε ≤ δ without computing ε where a Lipschitz bound
+//! settles it; its decisions must be those of computing ε every time.
+
+use autobal::model::cargo::Cargo;
+use autobal::model::effect::Effects;
+use autobal::model::rotor::PlaneRotor;
+use autobal::model::scene::Scene;
+use autobal::model::speed::SpeedLaw;
+use autobal::model::unbalance::{BalancingGauge, BandCheck, BandDecider, reference_unbalance};
+use rand::{RngExt, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+#[test]
+fn band_decisions_are_those_of_computing_the_balancing_error_every_time() {
+    // Three weights of capacity 3 M e on the dimensionless rotor: ε ranges
+    // from 0 (balanced) to about 4.
+    let scene = Scene {
+        rotor: PlaneRotor::isotropic(1.0, 0.01, 1.0, 0.1).into(),
+        balancer: None,
+        balancers: Vec::new(),
+        cargo: vec![Cargo::point(0.01, 1.0, 0.01, 1.4); 3],
+        speed: SpeedLaw::Constant { omega: 4.0 },
+        effects: Effects::default(),
+    };
+    let system = scene.build().unwrap();
+    let gauge = BalancingGauge::new(&system, reference_unbalance(&system));
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
+    let (mut decided, mut computed) = (0u32, 0u32);
+    for delta in [0.05, 0.5, 2.0] {
+        let mut decider = BandDecider::new(&gauge);
+        // A random walk with steps from tiny to large, through balance.
+        let mut psi = vec![0.3, 2.4, 4.5];
+        for _ in 0..20_000 {
+            let size = 10f64.powf(rng.random_range(-6.0..-0.5));
+            for p in &mut psi {
+                *p += size * rng.random_range(-1.0..1.0);
+            }
+            let exact = gauge.error(&system, &psi) <= delta;
+            match decider.check(&gauge, &system, &psi, delta) {
+                BandCheck::Decided(inside) => {
+                    assert_eq!(inside, exact, "ψ = {psi:?}, δ = {delta}");
+                    decided += 1;
+                }
+                BandCheck::Computed(eps) => {
+                    assert_eq!(eps <= delta, exact);
+                    computed += 1;
+                }
+            }
+        }
+    }
+    // Not vacuous: most samples of a slow walk need no trig.
+    assert!(decided > computed, "decided {decided}, computed {computed}");
+}
