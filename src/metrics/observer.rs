@@ -6,7 +6,7 @@ use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
-use crate::model::gap::GapGauge;
+use crate::model::gap::{ClosestApproach, GapGauge};
 use crate::model::system::RotorSystem;
 use crate::model::unbalance::{BalancingGauge, BandCheck, BandDecider};
 use std::f64::consts::PI;
@@ -153,7 +153,8 @@ pub struct SettlingObserver<'a> {
     eps_hold: Hold,
     peak_r: f64,
     gap: Option<GapGauge>,
-    min_gap: f64,
+    /// The smallest gap between weights over the samples.
+    closest: ClosestApproach,
     /// When the speed reaches its operating value, if known in advance.
     t_op: Option<f64>,
     /// The first sample at the operating speed (settling is judged from here).
@@ -256,7 +257,7 @@ impl<'a> SettlingObserver<'a> {
             eps_hold: Hold::default(),
             peak_r: 0.0,
             gap: GapGauge::new(system.cargo()),
-            min_gap: f64::INFINITY,
+            closest: ClosestApproach::default(),
             t_op: system.speed().operating_time(),
             operating_since: None,
             omega,
@@ -323,7 +324,7 @@ impl<'a> SettlingObserver<'a> {
         }
         self.peak_r = self.peak_r.max(r);
         if let Some(gauge) = &self.gap {
-            self.min_gap = self.min_gap.min(gauge.min_gap(psi));
+            self.closest.sample(gauge, psi);
         }
         if r > self.options.divergence_factor * self.a_ref {
             self.diverged = Some(format!(
@@ -535,7 +536,7 @@ impl<'a> SettlingObserver<'a> {
                 // the closest approach so far must stay the run's.
                 if let Some(g) = &self.gap
                     && !(g.same_contacts(&self.scratch[psi.clone()], angles, CONTACT_MARGIN)
-                        && g.min_gap(angles) >= self.min_gap)
+                        && g.min_gap(angles) >= self.closest.smallest())
                 {
                     return None;
                 }
@@ -642,7 +643,7 @@ impl<'a> SettlingObserver<'a> {
             rhs_calls: report.stats.rhs_calls + self.certifier.as_ref().map_or(0, |c| c.rhs_calls),
             method: String::new(),
             fidelity: String::new(),
-            min_gap_rad: self.gap.as_ref().map(|_| self.min_gap),
+            min_gap_rad: self.gap.as_ref().map(|_| self.closest.smallest()),
             censoring_revs: (outcome == Outcome::Censored).then(|| {
                 let t_op = self.operating_since.unwrap_or(t_final);
                 ((t_final - self.window).max(t_op) - self.t0) / rev

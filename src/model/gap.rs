@@ -82,6 +82,63 @@ impl GapGauge {
     }
 }
 
+/// The smallest gap over a run's samples, computing the gaps only where
+/// they could undercut it: each pair's gap is 1-Lipschitz in either angle
+/// (|wrapped(x)| is the distance of x to 2πℤ), so
+/// min_gap(ψ) ≥ min_gap(ψ₀) − 2 max_j |ψ_j − ψ₀_j| from the last sample
+/// measured, ψ₀. The result is the minimum over every sample, bit for bit.
+#[derive(Debug, Clone)]
+pub struct ClosestApproach {
+    smallest: f64,
+    /// The gap measured at the anchor angles, and those angles.
+    anchor: Option<(f64, Vec<f64>)>,
+}
+
+impl Default for ClosestApproach {
+    fn default() -> Self {
+        ClosestApproach {
+            smallest: f64::INFINITY,
+            anchor: None,
+        }
+    }
+}
+
+/// Slack on the bound (rad): far beyond the rounding of angle differences
+/// even for angles of thousands of radians.
+const BOUND_SLACK: f64 = 1e-9;
+
+impl ClosestApproach {
+    /// Take the sample at angles ψ into the minimum.
+    pub fn sample(&mut self, gauge: &GapGauge, psi: &[f64]) {
+        if let Some((gap0, psi0)) = &self.anchor {
+            let moved = psi
+                .iter()
+                .zip(psi0)
+                .map(|(p, p0)| (p - p0).abs())
+                .fold(0.0, f64::max);
+            // NaN fails the test and is measured below.
+            if gap0 - 2.0 * moved - BOUND_SLACK > self.smallest {
+                return;
+            }
+        }
+        let gap = gauge.min_gap(psi);
+        self.smallest = self.smallest.min(gap);
+        // Reuse the anchor's storage: a sample allocates nothing.
+        match &mut self.anchor {
+            Some((gap0, psi0)) if psi0.len() == psi.len() => {
+                *gap0 = gap;
+                psi0.copy_from_slice(psi);
+            }
+            anchor => *anchor = Some((gap, psi.to_vec())),
+        }
+    }
+
+    /// The smallest gap so far (∞ before any sample).
+    pub fn smallest(&self) -> f64 {
+        self.smallest
+    }
+}
+
 /// Two weights of one plane that start closer than they may: their indices
 /// (from 0), their centre angle and the angle at which they touch (rad).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -132,7 +132,15 @@ impl BandDecider {
         }
         let eps = gauge.error(system, psi);
         if self.weights.is_some() {
-            self.anchor = eps.is_finite().then(|| (eps, psi.to_vec()));
+            // Reuse the anchor's storage: a sample allocates nothing.
+            match &mut self.anchor {
+                _ if !eps.is_finite() => self.anchor = None,
+                Some((eps0, psi0)) if psi0.len() == psi.len() => {
+                    *eps0 = eps;
+                    psi0.copy_from_slice(psi);
+                }
+                anchor => *anchor = Some((eps, psi.to_vec())),
+            }
         }
         BandCheck::Computed(eps)
     }

@@ -1,8 +1,11 @@
-//! `BandDecider` decides ε ≤ δ without computing ε where a Lipschitz bound
-//! settles it; its decisions must be those of computing ε every time.
+//! The observer's per-sample shortcuts give the exact answers: `BandDecider`
+//! decides ε ≤ δ and `ClosestApproach` keeps the smallest gap without
+//! computing them where a Lipschitz bound settles it; their results must be
+//! those of computing every sample.
 
 use autobal::model::cargo::Cargo;
 use autobal::model::effect::Effects;
+use autobal::model::gap::{ClosestApproach, GapGauge};
 use autobal::model::rotor::PlaneRotor;
 use autobal::model::scene::Scene;
 use autobal::model::speed::SpeedLaw;
@@ -50,4 +53,38 @@ fn band_decisions_are_those_of_computing_the_balancing_error_every_time() {
     }
     // Not vacuous: most samples of a slow walk need no trig.
     assert!(decided > computed, "decided {decided}, computed {computed}");
+}
+
+#[test]
+fn the_closest_approach_is_the_minimum_over_every_sample() {
+    // Four balls of half-angle 0.2 rad each (sized weights have gaps).
+    let ball = Cargo {
+        radius: 0.2_f64.sin(),
+        ..Cargo::point(0.01, 1.0, 0.01, 1.4)
+    };
+    let alpha = ball.contact_half_angle();
+    assert!(alpha > 0.0);
+    let gauge = GapGauge::new(&vec![ball; 4]).unwrap();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    let mut psi = vec![0.0, 1.6, 3.2, 4.8];
+    let (mut closest, mut exact) = (ClosestApproach::default(), f64::INFINITY);
+    for step in 0..20_000 {
+        // Drift together now and then, so that the minimum keeps moving.
+        let size = 10f64.powf(rng.random_range(-6.0..-1.0));
+        for (j, p) in psi.iter_mut().enumerate() {
+            let pull = if step % 5000 < 2500 {
+                -(j as f64) * 1e-4
+            } else {
+                0.0
+            };
+            *p += size * rng.random_range(-1.0..1.0) + pull;
+        }
+        closest.sample(&gauge, &psi);
+        exact = exact.min(gauge.min_gap(&psi));
+        assert_eq!(closest.smallest().to_bits(), exact.to_bits(), "step {step}");
+    }
+    assert!(
+        exact < 1.6 - 2.0 * alpha,
+        "the weights never came closer than at the start"
+    );
 }
