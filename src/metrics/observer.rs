@@ -7,8 +7,9 @@ use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
 use crate::model::gap::{ClosestApproach, GapGauge};
+use crate::model::start::is_plane_translation;
 use crate::model::system::RotorSystem;
-use crate::model::unbalance::{BalancingGauge, BandCheck, BandDecider};
+use crate::model::unbalance::{BalancingGauge, BandCheck, BandDecider, planar_norm};
 use std::f64::consts::PI;
 
 /// A sampled time history: t, x, y, r, ε and every ψ_j.
@@ -153,6 +154,8 @@ pub struct SettlingObserver<'a> {
     eps_hold: Hold,
     peak_r: f64,
     gap: Option<GapGauge>,
+    /// Whether r is the plane rotor's |(x, y)| (decided once, not per sample).
+    plane: bool,
     /// The smallest gap between weights over the samples.
     closest: ClosestApproach,
     /// When the speed reaches its operating value, if known in advance.
@@ -258,6 +261,7 @@ impl<'a> SettlingObserver<'a> {
             peak_r: 0.0,
             gap: GapGauge::new(system.cargo()),
             closest: ClosestApproach::default(),
+            plane: is_plane_translation(system),
             t_op: system.speed().operating_time(),
             operating_since: None,
             omega,
@@ -305,7 +309,7 @@ impl<'a> SettlingObserver<'a> {
         let operating = self.at_operating_speed(t);
         let lay = self.system.layout();
         let y = &self.scratch;
-        let r = vibration(self.system, y);
+        let r = self.whirl(y);
         let psi = &y[lay.head()..lay.nq()];
         // A recorded series keeps every ε; otherwise only ε ≤ δ matters.
         let check = if self.series.is_some() {
@@ -399,6 +403,15 @@ impl<'a> SettlingObserver<'a> {
     fn recent_peak(&self) -> f64 {
         let per_rev = self.options.samples_per_rev.max(32) as usize;
         self.ring.latest_max(per_rev).sqrt()
+    }
+
+    /// r at positions q, as [`vibration`] computes it.
+    fn whirl(&self, q: &[f64]) -> f64 {
+        if self.plane {
+            planar_norm(q[0], q[1])
+        } else {
+            vibration(self.system, q)
+        }
     }
 
     /// Time of sample k.
@@ -526,7 +539,7 @@ impl<'a> SettlingObserver<'a> {
             // r needs the rotor's coordinates only; the angles, when checked.
             let needed = if checked { lay.nq() } else { lay.head() };
             flow.lower(&x, &mut state[..needed]);
-            r.push(vibration(system, &state));
+            r.push(self.whirl(&state));
             if checked {
                 let angles = &state[psi.clone()];
                 if !inside(self.balancing.error(system, angles), eps_limit) {
