@@ -149,8 +149,6 @@ pub struct SettlingObserver<'a> {
     scratch: Vec<f64>,
     ring: SquareRing,
     r_hold: Hold,
-    /// Σ r² over the current stretch inside the band (for the certifier).
-    stretch_sum: f64,
     eps_hold: Hold,
     peak_r: f64,
     gap: Option<GapGauge>,
@@ -186,8 +184,9 @@ struct TailPlan {
 }
 
 /// Every pair of weights must stay this far (rad) from the touching angle,
-/// apart or in contact, for the flow to be linearised: well beyond the
-/// central differences' step in an angle (6e-6 × max(1, |ψ|) ≤ 4e-5 rad).
+/// apart or in contact, for the flow to be linearised: beyond the central
+/// differences' step in an angle, 1e-9 × max(1, |ψ|) (≤ 6.3e-9 within a
+/// turn; for angles far beyond, the tracking check still guards).
 const CONTACT_MARGIN: f64 = 2.5e-8;
 
 /// After a prediction that fails (ε or the gaps), the next try comes this
@@ -256,7 +255,6 @@ impl<'a> SettlingObserver<'a> {
             scratch: vec![0.0; crate::integrate::OdeSystem::dim(system)],
             ring: SquareRing::new(ring_len),
             r_hold: Hold::default(),
-            stretch_sum: 0.0,
             eps_hold: Hold::default(),
             peak_r: 0.0,
             gap: GapGauge::new(system.cargo()),
@@ -367,14 +365,11 @@ impl<'a> SettlingObserver<'a> {
             return Flow::Continue;
         }
         let Some(start) = self.r_hold.stretch_start else {
-            self.stretch_sum = 0.0;
             return Flow::Continue;
         };
-        self.stretch_sum += r * r;
-        // Linearising costs a Newton solve: only once the rest of the window
-        // is about to be negligible next to the stretch so far, and never
-        // with weights at rest in contact (the kink of the penalty, where
-        // no linearisation holds).
+        // Linearising costs a Newton solve: only once r is deep inside the
+        // band, and never with two weights within CONTACT_MARGIN of touching
+        // (the kink of the contact law, where no linearisation holds).
         let wants = self
             .certifier
             .as_ref()
@@ -428,8 +423,7 @@ impl<'a> SettlingObserver<'a> {
             return Flow::Continue;
         };
         // ε inside its band now, so that its stretch (or hold) stands; no
-        // weights at rest in contact (the kink of the penalty, where no
-        // linearisation holds).
+        // two weights within CONTACT_MARGIN of touching.
         let eps_inside = self.eps_hold.met_at.is_some() || self.eps_hold.stretch_start.is_some();
         if !eps_inside || !self.contacts_settled() {
             return Flow::Continue;
