@@ -20,6 +20,7 @@
 use super::controller::PiController;
 use super::norm::{atol_of, explicit_start};
 use super::stepper::{Stepper, Trial};
+use super::stiffness::{PowerProbe, indicator};
 use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
 const C2: f64 = 0.526_001_519_587_677_318_785_587_544_488e-1;
@@ -207,8 +208,6 @@ fn dot(w: &[f64; 12], k: &[f64; 12]) -> f64 {
 const SAFE: f64 = 0.9;
 const FAC_MIN: f64 = 1.0 / 3.0;
 const FAC_MAX: f64 = 6.0;
-/// Hairer's bound on h·|λ| for the stability region of DOP853.
-const STIFF_BOUND: f64 = 6.1;
 
 /// The 7th-order continuous extension over one step: Hairer's eight `rcont`
 /// vectors, evaluated in nested form.
@@ -473,10 +472,13 @@ pub struct Dop853 {
     y1: Vec<f64>,
     ys: Vec<f64>,
     dense: Dense,
+    probe: PowerProbe,
 }
 
 impl Stepper for Dop853 {
     const METHOD: Method = Method::Dop853;
+    /// Hairer's bound on h·|λ| for the stability region of DOP853.
+    const STIFF_BOUND: f64 = 6.1;
 
     fn new(dim: usize, options: &SolverOptions) -> Self {
         let zeros = || vec![0.0; dim];
@@ -493,6 +495,7 @@ impl Stepper for Dop853 {
                 h: 1.0,
                 r: std::array::from_fn(|_| zeros()),
             },
+            probe: PowerProbe::new(dim),
         }
     }
 
@@ -552,15 +555,23 @@ impl Stepper for Dop853 {
         }
     }
 
-    fn looks_stiff(&self, h: f64) -> bool {
+    fn stiffness_indicator(&self, h: f64) -> f64 {
         // h·|λ| from stage 12 and the new point, which both sit at t + h.
-        let (k12, k13) = (&self.st.k[11], &self.st.k[12]);
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..k12.len() {
-            num += (k13[i] - k12[i]).powi(2);
-            den += (self.y1[i] - self.ys[i]).powi(2);
-        }
-        den > 0.0 && h * (num / den).sqrt() > STIFF_BOUND
+        indicator(h, &self.st.k[12], &self.st.k[11], &self.y1, &self.ys)
+    }
+
+    fn power_check<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t_new: f64,
+        h: f64,
+        enough: f64,
+        stats: &mut Stats,
+    ) -> f64 {
+        let tol = (self.options.rtol, self.options.atol.as_slice());
+        let (y1, fy, y_other) = (&self.y1, &self.st.k[12], &self.ys);
+        self.probe
+            .h_rho(system, t_new, y1, fy, y_other, h, tol, enough, stats)
     }
 
     fn accept<S: OdeSystem + ?Sized>(

@@ -4,6 +4,7 @@
 use super::controller::PiController;
 use super::norm::{error_norm, explicit_start};
 use super::stepper::{Stepper, Trial};
+use super::stiffness::{PowerProbe, indicator};
 use super::{DenseOutput, Failure, Method, OdeSystem, SolverOptions, Stats};
 
 const C2: f64 = 1.0 / 5.0;
@@ -48,8 +49,6 @@ const SAFE: f64 = 0.9;
 const FAC_MIN: f64 = 0.2;
 const FAC_MAX: f64 = 10.0;
 const BETA: f64 = 0.04;
-/// Hairer's bound on h·|λ| for the stability region of DOPRI5.
-const STIFF_BOUND: f64 = 3.25;
 
 /// The continuous extension over one step: Hairer's five `rcont` vectors.
 struct Dense {
@@ -79,10 +78,13 @@ pub struct Dp5 {
     ystage: Vec<f64>,
     err: Vec<f64>,
     dense: Dense,
+    probe: PowerProbe,
 }
 
 impl Stepper for Dp5 {
     const METHOD: Method = Method::Dp5;
+    /// Hairer's bound on h·|λ| for the stability region of DOPRI5.
+    const STIFF_BOUND: f64 = 3.25;
 
     fn new(dim: usize, options: &SolverOptions) -> Self {
         let zeros = || vec![0.0; dim];
@@ -98,6 +100,7 @@ impl Stepper for Dp5 {
                 h: 1.0,
                 r: std::array::from_fn(|_| zeros()),
             },
+            probe: PowerProbe::new(dim),
         }
     }
 
@@ -184,15 +187,24 @@ impl Stepper for Dp5 {
         }
     }
 
-    fn looks_stiff(&self, h: f64) -> bool {
+    fn stiffness_indicator(&self, h: f64) -> f64 {
         // h·|λ| from the last two stages, which both sit at t + h.
         let [.., k6, k7] = &self.k;
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..k6.len() {
-            num += (k7[i] - k6[i]).powi(2);
-            den += (self.y1[i] - self.ystage[i]).powi(2);
-        }
-        den > 0.0 && h * (num / den).sqrt() > STIFF_BOUND
+        indicator(h, k7, k6, &self.y1, &self.ystage)
+    }
+
+    fn power_check<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t_new: f64,
+        h: f64,
+        enough: f64,
+        stats: &mut Stats,
+    ) -> f64 {
+        let tol = (self.options.rtol, self.options.atol.as_slice());
+        let (y1, fy, y_other) = (&self.y1, &self.k[6], &self.ystage);
+        self.probe
+            .h_rho(system, t_new, y1, fy, y_other, h, tol, enough, stats)
     }
 
     fn accept<S: OdeSystem + ?Sized>(

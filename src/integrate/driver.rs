@@ -5,18 +5,13 @@
 
 use super::norm::check_step;
 use super::stepper::{Stepper, Trial};
+use super::stiffness::{StiffnessWatch, Verdict};
 use super::{
     Failure, Flow, OdeSystem, SolveReport, SolverOptions, Stats, Status, Step, StepObserver,
 };
 
 /// Attempts between two looks at the wall clock.
 const WALL_CHECK_EVERY: u64 = 256;
-
-/// Hairer's stiffness counting (DOPRI5, DOP853): this many accepted steps
-/// held by stability in a row mean the problem is stiff ...
-const STIFF_STEPS: u32 = 15;
-/// ... unless this many steps held by accuracy come in between.
-const NON_STIFF_STEPS: u32 = 6;
 
 /// Run `St` from (t0, y0) towards t_end until it finishes, the observer
 /// stops it or it fails. The observer's `start` is the caller's business, so
@@ -54,7 +49,7 @@ where
     };
     let mut t = t0;
     let mut last_rejected = false;
-    let (mut stiff_count, mut non_stiff_count) = (0u32, 0u32);
+    let mut watch = StiffnessWatch::new(St::STIFF_BOUND);
 
     loop {
         if let Err(f) = check_step(t, h, &stats, options) {
@@ -85,18 +80,14 @@ where
         };
         stats.steps += 1;
         if watch_stiffness {
-            if stepper.looks_stiff(h) {
-                non_stiff_count = 0;
-                stiff_count += 1;
-                if stiff_count == STIFF_STEPS {
-                    let f = Failure::StiffnessDetected { t };
-                    return report(Status::Failed(f), t, y, stats);
-                }
-            } else {
-                non_stiff_count += 1;
-                if non_stiff_count == NON_STIFF_STEPS {
-                    stiff_count = 0;
-                }
+            let mut verdict = watch.observe(stepper.stiffness_indicator(h));
+            if verdict == Verdict::Check {
+                let enough = watch.confirm_level();
+                verdict = watch.checked(stepper.power_check(system, t + h, h, enough, &mut stats));
+            }
+            if verdict == Verdict::Stiff {
+                let f = Failure::StiffnessDetected { t };
+                return report(Status::Failed(f), t, y, stats);
             }
         }
         let t_prev = t;

@@ -22,6 +22,7 @@ mod newton_matrices;
 pub mod norm;
 pub mod radau5;
 pub mod stepper;
+mod stiffness;
 
 pub use stepper::{Stepper, Trial};
 

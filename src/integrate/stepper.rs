@@ -1,7 +1,7 @@
 //! What a single-step method must provide so that the one driver
 //! ([`super::driver`]) can run it: a trial step with its error estimate and
 //! step-size proposal, the commit of an accepted step with its dense output,
-//! and (for explicit methods) Hairer's stiffness indicator.
+//! and (for explicit methods) the stiffness indicator and check.
 //!
 //! A stepper owns no loop, no budget, no observer and no end-of-interval
 //! logic: those are the driver's, written once for every method.
@@ -69,11 +69,29 @@ pub trait Stepper: Sized {
         stats: &mut Stats,
     ) -> Trial;
 
-    /// After an accepted trial of size `h`: does Hairer's test say that the
-    /// step size was held by stability rather than accuracy? Implicit
-    /// methods, which have no such limit, say no.
-    fn looks_stiff(&self, _h: f64) -> bool {
-        false
+    /// Hairer's bound on [`Stepper::stiffness_indicator`]: where the
+    /// method's stability region ends on the negative real axis.
+    const STIFF_BOUND: f64 = f64::INFINITY;
+
+    /// After an accepted trial of size `h`: Hairer's indicator h·|λ|, which
+    /// says whether the step size was held by stability rather than
+    /// accuracy. Implicit methods, which have no such limit, say 0.
+    fn stiffness_indicator(&self, _h: f64) -> f64 {
+        0.0
+    }
+
+    /// After an accepted trial of size `h` ending at `t_new`: an estimate
+    /// of h·ρ(J) there by power iteration ([`super::stiffness::PowerProbe`]),
+    /// which may stop once it exceeds `enough`. Implicit methods say 0.
+    fn power_check<S: OdeSystem + ?Sized>(
+        &mut self,
+        _system: &S,
+        _t_new: f64,
+        _h: f64,
+        _enough: f64,
+        _stats: &mut Stats,
+    ) -> f64 {
+        0.0
     }
 
     /// Commit the accepted trial from (t, y) of size `h`: overwrite `y` with
