@@ -134,7 +134,7 @@ pub const ALL_PAIRS_UP_TO: usize = 8;
 
 /// Largest weight count the neighbour search sorts on the stack (the study
 /// limit on weights per balancer); beyond it every pair is checked.
-const NEIGHBOUR_BUFFER: usize = 256;
+pub const NEIGHBOUR_BUFFER: usize = 256;
 
 impl Contact {
     /// The contact torque between cargoes j and k, if they overlap.
