@@ -7,6 +7,9 @@ use super::cargo::Cargo;
 use super::effect::contact::{ALL_PAIRS_UP_TO, NEIGHBOUR_BUFFER, wrapped};
 use std::f64::consts::TAU;
 
+/// Two weights (cargo indices j < k) and the gap between them (rad).
+pub type PairGap = (u32, u32, f64);
+
 /// The weights that have a size, with their touching half-angles and planes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GapGauge {
@@ -49,15 +52,29 @@ impl GapGauge {
     /// at least for rounding. Deeper overlaps (no solid weight gets near
     /// them) fall back to all pairs.
     pub fn min_gap(&self, psi: &[f64]) -> f64 {
+        self.visit_min_gap(psi, &mut |_, _, _| {})
+    }
+
+    /// [`GapGauge::min_gap`], keeping the pairs it measured (cargo indices
+    /// j < k and their gap) in `pairs`: each pair's gap at these angles
+    /// bounds it nearby ([`ClosestApproach`]). After an all-pairs fallback
+    /// the neighbours are listed twice, which changes no bound.
+    pub fn min_gap_of_pairs(&self, psi: &[f64], pairs: &mut Vec<PairGap>) -> f64 {
+        pairs.clear();
+        self.visit_min_gap(psi, &mut |j, k, gap| pairs.push((j as u32, k as u32, gap)))
+    }
+
+    /// The minimum, calling `visit` on every pair measured.
+    fn visit_min_gap(&self, psi: &[f64], visit: &mut impl FnMut(usize, usize, f64)) -> f64 {
         let n = self.sized.len();
         if n <= ALL_PAIRS_UP_TO || n > NEIGHBOUR_BUFFER {
-            return self.all_pairs_min_gap(psi);
+            return self.all_pairs_min_gap(psi, visit);
         }
-        let neighbours = self.neighbour_min_gap(psi);
+        let neighbours = self.neighbour_min_gap(psi, visit);
         if neighbours >= -self.smallest_half_angle {
             neighbours
         } else {
-            self.all_pairs_min_gap(psi)
+            self.all_pairs_min_gap(psi, visit)
         }
     }
 
@@ -71,12 +88,14 @@ impl GapGauge {
     }
 
     /// Every pair of one plane: O(n²).
-    fn all_pairs_min_gap(&self, psi: &[f64]) -> f64 {
+    fn all_pairs_min_gap(&self, psi: &[f64], visit: &mut impl FnMut(usize, usize, f64)) -> f64 {
         let mut smallest = f64::INFINITY;
         for (a, &(_, _, plane_j)) in self.sized.iter().enumerate() {
             for (b, &(_, _, plane_k)) in self.sized.iter().enumerate().skip(a + 1) {
                 if plane_k == plane_j {
-                    smallest = smallest.min(self.pair_gap(a, b, psi));
+                    let gap = self.pair_gap(a, b, psi);
+                    visit(self.sized[a].0, self.sized[b].0, gap);
+                    smallest = smallest.min(gap);
                 }
             }
         }
@@ -84,7 +103,7 @@ impl GapGauge {
     }
 
     /// Neighbours along the race, plane by plane (the order on the stack).
-    fn neighbour_min_gap(&self, psi: &[f64]) -> f64 {
+    fn neighbour_min_gap(&self, psi: &[f64], visit: &mut impl FnMut(usize, usize, f64)) -> f64 {
         let n = self.sized.len();
         let mut order = [0u16; NEIGHBOUR_BUFFER];
         let mut angle = [0.0f64; NEIGHBOUR_BUFFER];
@@ -110,10 +129,18 @@ impl GapGauge {
             let pairs = if m > 2 { m } else { m.saturating_sub(1) };
             for i in 0..pairs {
                 let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
-                smallest = smallest.min(self.pair_gap(a.min(b), a.max(b), psi));
+                let (a, b) = (a.min(b), a.max(b));
+                let gap = self.pair_gap(a, b, psi);
+                visit(self.sized[a].0, self.sized[b].0, gap);
+                smallest = smallest.min(gap);
             }
         }
         smallest
+    }
+
+    /// The smallest touching half-angle α of a sized weight (rad).
+    pub fn smallest_half_angle(&self) -> f64 {
+        self.smallest_half_angle
     }
 
     /// Whether every pair of one plane is as far from touching at `later`
@@ -154,15 +181,20 @@ impl GapGauge {
 }
 
 /// The smallest gap over a run's samples, computing the gaps only where
-/// they could undercut it: each pair's gap is 1-Lipschitz in either angle
-/// (|wrapped(x)| is the distance of x to 2πℤ), so
-/// min_gap(ψ) ≥ min_gap(ψ₀) − 2 max_j |ψ_j − ψ₀_j| from the last sample
-/// measured, ψ₀. The result is the minimum over every sample, bit for bit.
+/// they could undercut it. Each pair's gap is 1-Lipschitz in the pair's
+/// angle difference (|wrapped(x)| is the distance of x to 2πℤ), so from
+/// the last sample measured, ψ₀, with Δ = ψ − ψ₀, a pair measured there
+/// keeps gap(ψ) ≥ gap(ψ₀) − |Δ_k − Δ_j|. Pairs not measured (not
+/// neighbours at ψ₀) are bounded through the neighbours between them, as
+/// in [`GapGauge::min_gap`], while those bounds stay above −α_min. Weights
+/// resting against each other in a pack keep their bounds while free ones
+/// move: a bound on each pair, not on the fastest weight. The result is the
+/// minimum over every sample, bit for bit.
 #[derive(Debug, Clone)]
 pub struct ClosestApproach {
     smallest: f64,
-    /// The gap measured at the anchor angles, and those angles.
-    anchor: Option<(f64, Vec<f64>)>,
+    /// The angles of the last sample measured, and its pairs with their gaps.
+    anchor: Option<(Vec<f64>, Vec<PairGap>)>,
 }
 
 impl Default for ClosestApproach {
@@ -181,27 +213,25 @@ const BOUND_SLACK: f64 = 1e-9;
 impl ClosestApproach {
     /// Take the sample at angles ψ into the minimum.
     pub fn sample(&mut self, gauge: &GapGauge, psi: &[f64]) {
-        if let Some((gap0, psi0)) = &self.anchor {
-            let moved = psi
-                .iter()
-                .zip(psi0)
-                .map(|(p, p0)| (p - p0).abs())
-                .fold(0.0, f64::max);
-            // NaN fails the test and is measured below.
-            if gap0 - 2.0 * moved - BOUND_SLACK > self.smallest {
+        if let Some((psi0, pairs)) = &self.anchor {
+            let mut bound = f64::INFINITY;
+            for &(j, k, gap0) in pairs {
+                let (j, k) = (j as usize, k as usize);
+                let moved = ((psi[k] - psi0[k]) - (psi[j] - psi0[j])).abs();
+                bound = bound.min(gap0 - moved);
+            }
+            // NaN fails both tests and is measured below.
+            if bound - BOUND_SLACK > self.smallest && bound >= -gauge.smallest_half_angle() {
                 return;
             }
         }
-        let gap = gauge.min_gap(psi);
+        // Reuse the anchor's storage: a sample allocates nothing once the
+        // pair list has grown to its size.
+        let (psi0, pairs) = self.anchor.get_or_insert_with(|| (Vec::new(), Vec::new()));
+        let gap = gauge.min_gap_of_pairs(psi, pairs);
         self.smallest = self.smallest.min(gap);
-        // Reuse the anchor's storage: a sample allocates nothing.
-        match &mut self.anchor {
-            Some((gap0, psi0)) if psi0.len() == psi.len() => {
-                *gap0 = gap;
-                psi0.copy_from_slice(psi);
-            }
-            anchor => *anchor = Some((gap, psi.to_vec())),
-        }
+        psi0.clear();
+        psi0.extend_from_slice(psi);
     }
 
     /// The smallest gap so far (∞ before any sample).
@@ -300,10 +330,12 @@ mod tests {
                                 + 40.0 * (uniform(&mut seed) - 0.5).round() * TAU
                         })
                         .collect();
-                    let exact = gauge.all_pairs_min_gap(&psi);
+                    let exact = gauge.all_pairs_min_gap(&psi, &mut |_, _, _| {});
                     let got = gauge.min_gap(&psi);
                     assert_eq!(got.to_bits(), exact.to_bits(), "n = {n}, {squeeze}");
-                    if gauge.neighbour_min_gap(&psi) >= -gauge.smallest_half_angle {
+                    if gauge.neighbour_min_gap(&psi, &mut |_, _, _| {})
+                        >= -gauge.smallest_half_angle
+                    {
                         fast += 1;
                     } else {
                         fallback += 1;

@@ -88,3 +88,57 @@ fn the_closest_approach_is_the_minimum_over_every_sample() {
         "the weights never came closer than at the start"
     );
 }
+
+/// Beyond eight weights the bound runs over the neighbour pairs of the last
+/// sample measured: a pack resting in contact with free weights moving
+/// around it, mixed sizes, weights that pass through each other (the gauge
+/// does not stop them, so the neighbours change) and two planes.
+#[test]
+fn the_closest_approach_of_a_pack_is_that_of_every_sample() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
+    for (n, planes) in [(16_usize, 1_usize), (40, 1), (24, 2)] {
+        let cargo: Vec<Cargo> = (0..n)
+            .map(|j| Cargo {
+                radius: 0.004 + 0.002 * (j % 3) as f64,
+                plane: j % planes,
+                ..Cargo::point(0.03, 0.05, 0.1, 1.4)
+            })
+            .collect();
+        let gauge = GapGauge::new(&cargo).unwrap();
+        let pitch = 2.0 * 0.008 / 0.05;
+        // The first half packed (overlapping a little), the rest spread out.
+        let mut psi: Vec<f64> = (0..n)
+            .map(|j| {
+                let i = (j / planes) as f64;
+                if j < n / 2 {
+                    i * pitch * 0.99
+                } else {
+                    3.0 + 2.9 * (j - n / 2) as f64 / (n / 2) as f64
+                }
+            })
+            .collect();
+        let (mut closest, mut exact) = (ClosestApproach::default(), f64::INFINITY);
+        for step in 0..20_000 {
+            let drift = 1e-4 * rng.random_range(-1.0..1.0);
+            let jostle = 10f64.powf(rng.random_range(-9.0..-5.0));
+            for (j, p) in psi.iter_mut().enumerate() {
+                *p += if j < n / 2 {
+                    // The pack moves together, squeezing now and then (new
+                    // minima) and jostling a little.
+                    let squeeze = if step % 4000 < 1000 { 2e-7 } else { 0.0 };
+                    drift - squeeze * (j as f64) + jostle * rng.random_range(-1.0..1.0)
+                } else {
+                    10f64.powf(rng.random_range(-5.0..-2.5)) * rng.random_range(-1.0..1.0)
+                };
+            }
+            closest.sample(&gauge, &psi);
+            exact = exact.min(gauge.min_gap(&psi));
+            assert_eq!(
+                closest.smallest().to_bits(),
+                exact.to_bits(),
+                "n = {n}, step {step}"
+            );
+        }
+        assert!(exact < 0.0, "n = {n}: the pack must overlap");
+    }
+}
