@@ -70,10 +70,31 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
 
 /// Write `df` to `path` atomically, with provenance in the key-value metadata.
 pub fn write_parquet(path: &Path, df: &mut DataFrame, provenance: &Provenance) -> PolarsResult<()> {
+    write_parquet_compressed(path, df, provenance, ParquetCompression::default())
+}
+
+/// [`write_parquet`] without compression, for a study's chunks: they are read
+/// once, into `runs.parquet`, and deleted, and compressing them is work on
+/// the receiving thread while the runs go on (10 ms of a 1 000-run study).
+pub fn write_chunk_parquet(
+    path: &Path,
+    df: &mut DataFrame,
+    provenance: &Provenance,
+) -> PolarsResult<()> {
+    write_parquet_compressed(path, df, provenance, ParquetCompression::Uncompressed)
+}
+
+fn write_parquet_compressed(
+    path: &Path,
+    df: &mut DataFrame,
+    provenance: &Provenance,
+    compression: ParquetCompression,
+) -> PolarsResult<()> {
     let tmp = temp_path(path);
     let file = File::create(&tmp)?;
     ParquetWriter::new(file)
         .with_key_value_metadata(Some(KeyValueMetadata::from_static(provenance.pairs())))
+        .with_compression(compression)
         .finish(df)?;
     std::fs::rename(&tmp, path)?;
     Ok(())

@@ -9,7 +9,9 @@
 use super::adaptive::{Precision, batch_ids, batches, precision};
 use super::aggregate::summarize_table;
 use super::config::{Design, StudyPlan};
-use super::io::{Provenance, read_parquet, sha256_hex, write_parquet, write_text};
+use super::io::{
+    Provenance, read_parquet, sha256_hex, write_chunk_parquet, write_parquet, write_text,
+};
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
@@ -603,7 +605,7 @@ fn execute(
             }
             buffer.sort_by_key(|r| r.run_id);
             let mut df = to_dataframe(buffer)?;
-            write_parquet(
+            write_chunk_parquet(
                 &chunks.join(format!("chunk-{next_chunk:06}.parquet")),
                 &mut df,
                 provenance,
