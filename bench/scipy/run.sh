@@ -25,17 +25,8 @@ scipy_repeats=${SCIPY_REPEATS:-1}
 revolutions=${REVOLUTIONS:-500}
 scipy_rhs=${SCIPY_RHS:-auto}
 
-venv=$here/.venv
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-fi
-# Reinstall only when the pins change (pip is slow to say "already satisfied").
-stamp=$venv/.requirements
-if ! cmp -s "$here/requirements.txt" "$stamp"; then
-    "$venv/bin/pip" install --quiet --disable-pip-version-check -r "$here/requirements.txt"
-    cp "$here/requirements.txt" "$stamp"
-fi
-py=$venv/bin/python
+# shellcheck source=venv.sh
+source "$here/venv.sh"
 
 (cd "$root" && cargo build --release --quiet --bin study)
 study=${CARGO_TARGET_DIR:-$root/target}/release/study

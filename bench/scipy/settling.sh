@@ -24,16 +24,8 @@ samples=${1:-20}
 stride=${2:-10}
 rounds=${3:-3}
 
-venv=$here/.venv
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-fi
-stamp=$venv/.requirements
-if ! cmp -s "$here/requirements.txt" "$stamp"; then
-    "$venv/bin/pip" install --quiet --disable-pip-version-check -r "$here/requirements.txt"
-    cp "$here/requirements.txt" "$stamp"
-fi
-py=$venv/bin/python
+# shellcheck source=venv.sh
+source "$here/venv.sh"
 
 (cd "$root" && cargo build --quiet --bin study)
 study=${CARGO_TARGET_DIR:-$root/target}/debug/study

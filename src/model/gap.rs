@@ -4,8 +4,8 @@
 //! overlap, which solid weights cannot have (docs/metrics.md).
 
 use super::cargo::Cargo;
-use super::effect::contact::{ALL_PAIRS_UP_TO, NEIGHBOUR_BUFFER, wrapped};
-use std::f64::consts::TAU;
+use super::effect::contact::{ALL_PAIRS_UP_TO, wrapped};
+use super::race_ring::{MAX_RING, for_each_neighbour_pair};
 
 /// Two weights (cargo indices j < k) and the gap between them (rad).
 pub type PairGap = (u32, u32, f64);
@@ -67,7 +67,7 @@ impl GapGauge {
     /// The minimum, calling `visit` on every pair measured.
     fn visit_min_gap(&self, psi: &[f64], visit: &mut impl FnMut(usize, usize, f64)) -> f64 {
         let n = self.sized.len();
-        if n <= ALL_PAIRS_UP_TO || n > NEIGHBOUR_BUFFER {
+        if n <= ALL_PAIRS_UP_TO || n > MAX_RING {
             return self.all_pairs_min_gap(psi, visit);
         }
         let neighbours = self.neighbour_min_gap(psi, visit);
@@ -102,39 +102,20 @@ impl GapGauge {
         smallest
     }
 
-    /// Neighbours along the race, plane by plane (the order on the stack).
+    /// Neighbours along the race, plane by plane ([`crate::model::race_ring`]).
     fn neighbour_min_gap(&self, psi: &[f64], visit: &mut impl FnMut(usize, usize, f64)) -> f64 {
-        let n = self.sized.len();
-        let mut order = [0u16; NEIGHBOUR_BUFFER];
-        let mut angle = [0.0f64; NEIGHBOUR_BUFFER];
-        for (a, &(j, _, _)) in self.sized.iter().enumerate() {
-            angle[a] = psi[j].rem_euclid(TAU);
-        }
         let mut smallest = f64::INFINITY;
-        for first in 0..n {
-            let plane = self.sized[first].2;
-            // Each plane once: at its first weight.
-            if self.sized[..first].iter().any(|s| s.2 == plane) {
-                continue;
-            }
-            let mut m = 0;
-            for a in first..n {
-                if self.sized[a].2 == plane {
-                    order[m] = a as u16;
-                    m += 1;
-                }
-            }
-            let ring = &mut order[..m];
-            ring.sort_unstable_by(|&a, &b| angle[a as usize].total_cmp(&angle[b as usize]));
-            let pairs = if m > 2 { m } else { m.saturating_sub(1) };
-            for i in 0..pairs {
-                let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
-                let (a, b) = (a.min(b), a.max(b));
+        for_each_neighbour_pair(
+            self.sized.len(),
+            |a| self.sized[a].2,
+            |_| true,
+            |a| psi[self.sized[a].0],
+            |a, b| {
                 let gap = self.pair_gap(a, b, psi);
                 visit(self.sized[a].0, self.sized[b].0, gap);
                 smallest = smallest.min(gap);
-            }
-        }
+            },
+        );
         smallest
     }
 
@@ -288,14 +269,8 @@ pub fn start_clash(cargo: &[Cargo], angles: &[f64]) -> Option<StartClash> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Deterministic pseudo-random numbers in [0, 1) (no RNG crate needed).
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::model::race_ring::uniform;
+    use std::f64::consts::TAU;
 
     /// Beyond eight weights the gauge measures neighbours only; on packed
     /// states (overlapping, touching, apart), mixed sizes, one or two

@@ -23,6 +23,7 @@ pub mod gap;
 pub mod invariants;
 pub mod linear;
 pub mod quasi_static;
+pub mod race_ring;
 pub mod rotor;
 pub mod scene;
 pub mod sommerfeld;

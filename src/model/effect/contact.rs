@@ -14,6 +14,7 @@
 
 use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
+use crate::model::race_ring::{MAX_RING, for_each_neighbour_pair};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
@@ -132,10 +133,6 @@ pub fn wrapped(d: f64) -> f64 {
 /// keep their exact arithmetic.
 pub const ALL_PAIRS_UP_TO: usize = 8;
 
-/// Largest weight count the neighbour search sorts on the stack (the study
-/// limit on weights per balancer); beyond it every pair is checked.
-pub const NEIGHBOUR_BUFFER: usize = 256;
-
 impl Contact {
     /// The contact torque between cargoes j and k, if they overlap.
     #[inline]
@@ -171,36 +168,15 @@ impl Contact {
         }
     }
 
-    /// Neighbours along the race only, plane by plane (no allocation: the
-    /// order lives on the stack).
+    /// Neighbours along the race only, plane by plane ([`crate::model::race_ring`]).
     fn neighbours(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
-        let n = ctx.psi.len();
-        let mut order = [0u16; NEIGHBOUR_BUFFER];
-        let mut angle = [0.0f64; NEIGHBOUR_BUFFER];
-        for j in 0..n {
-            angle[j] = ctx.psi[j].rem_euclid(TAU);
-        }
-        for first in 0..n {
-            let plane = self.plane[first];
-            // Each plane once: at its first cargo.
-            if self.plane[..first].contains(&plane) {
-                continue;
-            }
-            let mut m = 0;
-            for j in first..n {
-                if self.plane[j] == plane && self.half_angle[j] > 0.0 {
-                    order[m] = j as u16;
-                    m += 1;
-                }
-            }
-            let ring = &mut order[..m];
-            ring.sort_unstable_by(|&a, &b| angle[a as usize].total_cmp(&angle[b as usize]));
-            let pairs = if m > 2 { m } else { m.saturating_sub(1) };
-            for i in 0..pairs {
-                let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
-                self.pair(a.min(b), a.max(b), ctx, forces);
-            }
-        }
+        for_each_neighbour_pair(
+            ctx.psi.len(),
+            |j| self.plane[j],
+            |j| self.half_angle[j] > 0.0,
+            |j| ctx.psi[j],
+            |j, k| self.pair(j, k, ctx, forces),
+        );
     }
 }
 
@@ -211,7 +187,7 @@ impl Effect for Contact {
 
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
         let n = ctx.psi.len();
-        if n <= ALL_PAIRS_UP_TO || n > NEIGHBOUR_BUFFER {
+        if n <= ALL_PAIRS_UP_TO || n > MAX_RING {
             self.all_pairs(ctx, forces);
         } else {
             self.neighbours(ctx, forces);
@@ -246,14 +222,7 @@ mod wrap_tests {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Deterministic pseudo-random numbers in [0, 1) (no RNG crate needed).
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::model::race_ring::uniform;
 
     /// For many weights, the neighbour search finds exactly the forces of the
     /// exhaustive one, on packed states where many pairs overlap, in one

@@ -1,0 +1,62 @@
+//! Neighbours along a race: per plane, the weights sorted by angle, each
+//! with the next (and the last with the first). Two weights can only touch
+//! if no third sits between them, so contact and the gap gauge need only
+//! these pairs: O(n log n) per call instead of O(n²).
+
+use std::f64::consts::TAU;
+
+/// Most weights a ring sorts on the stack (the study limit on weights per
+/// balancer); callers check every pair beyond it.
+pub const MAX_RING: usize = 256;
+
+/// Call `visit(a, b)` with a < b for every pair of neighbours among the
+/// items 0..n (n ≤ [`MAX_RING`]) for which `in_ring` holds, ring by ring:
+/// items of one `plane`, ordered by `angle` (any real, taken modulo 2π).
+/// Planes come in the order of their first item, pairs in ring order, so
+/// that a caller summing forces gets the same bits every time. No
+/// allocation: the order lives on the stack.
+pub fn for_each_neighbour_pair(
+    n: usize,
+    plane: impl Fn(usize) -> usize,
+    in_ring: impl Fn(usize) -> bool,
+    angle: impl Fn(usize) -> f64,
+    mut visit: impl FnMut(usize, usize),
+) {
+    assert!(n <= MAX_RING, "{n} weights in a ring, at most {MAX_RING}");
+    let mut order = [0u16; MAX_RING];
+    let mut wrapped = [0.0f64; MAX_RING];
+    for (i, w) in wrapped.iter_mut().enumerate().take(n) {
+        *w = angle(i).rem_euclid(TAU);
+    }
+    for first in 0..n {
+        let p = plane(first);
+        // Each plane once: at its first item.
+        if (0..first).any(|i| plane(i) == p) {
+            continue;
+        }
+        let mut m = 0;
+        for i in first..n {
+            if plane(i) == p && in_ring(i) {
+                order[m] = i as u16;
+                m += 1;
+            }
+        }
+        let ring = &mut order[..m];
+        ring.sort_unstable_by(|&a, &b| wrapped[a as usize].total_cmp(&wrapped[b as usize]));
+        let pairs = if m > 2 { m } else { m.saturating_sub(1) };
+        for i in 0..pairs {
+            let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
+            visit(a.min(b), a.max(b));
+        }
+    }
+}
+
+/// Deterministic pseudo-random numbers in [0, 1) for the tests of the
+/// neighbour searches (no RNG crate needed).
+#[cfg(test)]
+pub(crate) fn uniform(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6_364_136_223_846_793_005)
+        .wrapping_add(1_442_695_040_888_963_407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
+}
