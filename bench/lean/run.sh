@@ -18,15 +18,8 @@ root=$(cd "$here/../.." && pwd)
 rounds=${1:-3}
 samples=${2:-20}
 
-venv=$here/.venv
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-fi
-stamp=$venv/.requirements
-if ! cmp -s "$here/requirements.txt" "$stamp"; then
-    "$venv/bin/pip" install --quiet --disable-pip-version-check -r "$here/requirements.txt"
-    cp "$here/requirements.txt" "$stamp"
-fi
+# shellcheck source=../venv.sh
+source "$here/../venv.sh"
 
 # Its own target folder: CARGO_TARGET_DIR is the main crate's.
 (cd "$here" && export CARGO_TARGET_DIR="$here/target" &&

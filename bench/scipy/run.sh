@@ -25,8 +25,8 @@ scipy_repeats=${SCIPY_REPEATS:-1}
 revolutions=${REVOLUTIONS:-500}
 scipy_rhs=${SCIPY_RHS:-auto}
 
-# shellcheck source=venv.sh
-source "$here/venv.sh"
+# shellcheck source=../venv.sh
+source "$here/../venv.sh"
 
 (cd "$root" && cargo build --release --quiet --bin study)
 study=${CARGO_TARGET_DIR:-$root/target}/release/study

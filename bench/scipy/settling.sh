@@ -24,8 +24,8 @@ samples=${1:-20}
 stride=${2:-10}
 rounds=${3:-3}
 
-# shellcheck source=venv.sh
-source "$here/venv.sh"
+# shellcheck source=../venv.sh
+source "$here/../venv.sh"
 
 (cd "$root" && cargo build --quiet --bin study)
 study=${CARGO_TARGET_DIR:-$root/target}/debug/study

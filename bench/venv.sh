@@ -1,5 +1,6 @@
-# Sourced by run.sh and settling.sh (not run on its own): makes the virtual
-# environment bench/scipy/.venv (git-ignored) with the pinned requirements
+# Sourced by bench/lean/run.sh, bench/scipy/run.sh and settling.sh (not run
+# on its own) with `here` set to their folder: makes the virtual
+# environment $here/.venv (git-ignored) with the pinned $here/requirements.txt
 # if missing or out of date, and sets `py` to its python.
 venv=$here/.venv
 if [ ! -x "$venv/bin/python" ]; then
