@@ -9,17 +9,18 @@
 //! mix never reaches the bound and the run crawls at 300 steps per
 //! revolution. The check here follows the indicator's direction a few
 //! Jacobian–vector products further (finite differences, one right-hand side
-//! each), which pulls it towards the dominant eigenvalue: a lower bound of
-//! ρ(J) that can confirm the stability limit without a Jacobian matrix.
+//! each), which pulls it towards the dominant eigenvalue: an estimate of
+//! ρ(J) (from below where the dominant mode leads, as in a chain) that can
+//! confirm the stability limit without a Jacobian matrix.
 
 use super::norm::atol_of;
 use super::{OdeSystem, Stats};
 
 /// Hairer's stiffness counting (DOPRI5, DOP853): this many accepted steps
 /// held by stability in a row mean the problem is stiff ...
-pub(super) const STIFF_STEPS: u32 = 15;
+const STIFF_STEPS: u32 = 15;
 /// ... unless this many steps held by accuracy come in between.
-pub(super) const NON_STIFF_STEPS: u32 = 6;
+const NON_STIFF_STEPS: u32 = 6;
 
 /// An indicator above this fraction of the method's bound, as persistently
 /// as Hairer's counting asks, calls for the power-iteration check.
@@ -124,14 +125,20 @@ impl StiffnessWatch {
         Verdict::Explicit
     }
 
-    /// The power check gave h·ρ ≥ `h_rho`: stiff, or wait longer for the next check.
+    /// The power check estimated h·ρ(J) = `h_rho`: stiff, or wait longer
+    /// for the next check.
     pub(super) fn checked(&mut self, h_rho: f64) -> Verdict {
-        if h_rho > CONFIRM_FRACTION * self.bound {
+        if h_rho > self.confirm_level() {
             return Verdict::Stiff;
         }
         self.hint = 0;
         self.hint_needed = self.hint_needed.saturating_mul(2);
         Verdict::Explicit
+    }
+
+    /// The h·ρ above which [`StiffnessWatch::checked`] confirms.
+    pub(super) fn confirm_level(&self) -> f64 {
+        CONFIRM_FRACTION * self.bound
     }
 }
 
@@ -156,7 +163,7 @@ impl PowerProbe {
     /// iteration from the direction `y − y_other`, in the error norm's
     /// scaled variables (D⁻¹JD has J's eigenvalues, and the scaling keeps
     /// positions and velocities comparable); stops early once it exceeds
-    /// `enough`.
+    /// `enough`, or falls below [`ABANDON_FRACTION`] of it.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn h_rho<S: OdeSystem + ?Sized>(
         &mut self,
@@ -220,13 +227,6 @@ impl PowerProbe {
             previous = ratio;
         }
         estimate
-    }
-}
-
-impl StiffnessWatch {
-    /// The h·ρ above which [`StiffnessWatch::checked`] confirms.
-    pub(super) fn confirm_level(&self) -> f64 {
-        CONFIRM_FRACTION * self.bound
     }
 }
 
