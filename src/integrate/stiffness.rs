@@ -370,4 +370,47 @@ mod tests {
         assert!(small < 0.5 * 1.001, "h·ρ estimated {small}, exact 0.5");
         assert_eq!(stats.rhs_calls, MIN_POWER_STEPS as u64 + 1);
     }
+
+    /// Each explicit stepper hands the check the right vectors: after a
+    /// step on the chain near its stability limit, its own `power_check`
+    /// finds h·ρ(J) as the probe does.
+    #[test]
+    fn each_explicit_stepper_checks_at_its_new_point() {
+        use crate::integrate::SolverOptions;
+        use crate::integrate::dop853::Dop853;
+        use crate::integrate::dp5::Dp5;
+        use crate::integrate::stepper::{Stepper, Trial};
+
+        fn check<St: Stepper>(chain: &Chain, fraction: f64) -> (f64, f64) {
+            let dim = chain.dim();
+            let options = SolverOptions {
+                rtol: 1e-6,
+                atol: vec![1.0],
+                ..SolverOptions::default()
+            };
+            let mut stepper = St::new(dim, &options);
+            let mut stats = Stats::default();
+            // Far below atol: accuracy cannot hold the step, only stability.
+            let y: Vec<f64> = (0..dim).map(|i| 1e-3 * (0.3 * i as f64).sin()).collect();
+            stepper.start(chain, 0.0, &y, 1.0, &mut stats).unwrap();
+            let rho = chain.spectral_radius();
+            let h = fraction * St::STIFF_BOUND / rho;
+            let trial = stepper.attempt(chain, 0.0, &y, h, &mut stats);
+            assert!(matches!(trial, Trial::Accepted { .. }), "{trial:?}");
+            let h_rho = stepper.power_check(chain, h, h, f64::INFINITY, &mut stats);
+            (h_rho, h * rho)
+        }
+        let w = 6000.0;
+        let chain = Chain {
+            n: 16,
+            k: w * w,
+            c: 4.0 * w,
+        };
+        for (h_rho, exact) in [check::<Dp5>(&chain, 0.9), check::<Dop853>(&chain, 0.9)] {
+            assert!(
+                (h_rho / exact - 1.0).abs() < 0.1,
+                "h·ρ estimated {h_rho}, exact {exact}"
+            );
+        }
+    }
 }
