@@ -9,9 +9,7 @@
 use super::adaptive::{Precision, batch_ids, batches, precision};
 use super::aggregate::summarize_table;
 use super::config::{Design, StudyPlan};
-use super::io::{
-    Provenance, read_parquet, sha256_hex, write_chunk_parquet, write_parquet, write_text,
-};
+use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet, write_text};
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
@@ -475,15 +473,7 @@ pub fn run_study(
             .filter(in_slice)
             .filter(|&id| !done[id as usize])
             .collect();
-        let saved = execute(
-            plan,
-            &pending,
-            options,
-            pool.as_ref(),
-            &chunks,
-            &provenance,
-            progress,
-        )?;
+        let saved = execute(plan, &pending, options, pool.as_ref(), &chunks, progress)?;
         if options
             .cancel
             .as_ref()
@@ -561,7 +551,6 @@ fn execute(
     options: &RunOptions,
     pool: Option<&rayon::ThreadPool>,
     chunks: &Path,
-    provenance: &Provenance,
     progress: &dyn Progress,
 ) -> Result<u64, RunError> {
     let cancelled = || {
@@ -605,10 +594,9 @@ fn execute(
             }
             buffer.sort_by_key(|r| r.run_id);
             let mut df = to_dataframe(buffer)?;
-            write_chunk_parquet(
-                &chunks.join(format!("chunk-{next_chunk:06}.parquet")),
+            write_chunk(
+                &chunks.join(format!("chunk-{next_chunk:06}.arrow")),
                 &mut df,
-                provenance,
             )?;
             next_chunk += 1;
             saved += buffer.len() as u64;
@@ -675,7 +663,7 @@ fn chunk_pieces(dir: &Path) -> Result<Vec<Piece>, RunError> {
             .unwrap_or_default();
         if name.contains(".tmp-") {
             std::fs::remove_file(&path)?;
-        } else if name.ends_with(".parquet") {
+        } else if name.ends_with(".arrow") {
             out.push(Piece::open(&path)?);
         }
     }
@@ -686,10 +674,10 @@ fn next_chunk_index(dir: &Path) -> Result<u64, RunError> {
     let mut next = 0;
     for entry in std::fs::read_dir(dir)? {
         let name = entry?.file_name().to_string_lossy().to_string();
-        if let Some(num) = name
-            .strip_prefix("chunk-")
-            .and_then(|s| s.strip_suffix(".parquet"))
-            && let Ok(i) = num.parse::<u64>()
+        if let Some(num) = name.strip_prefix("chunk-").and_then(|s| {
+            s.strip_suffix(".arrow")
+                .or_else(|| s.strip_suffix(".parquet"))
+        }) && let Ok(i) = num.parse::<u64>()
         {
             next = next.max(i + 1);
         }

@@ -29,11 +29,31 @@ pub const SUMMARY_COLUMNS: [&str; 11] = [
     "final_spin_rate",
 ];
 
-/// One Parquet file of runs, with its run ids (ascending).
+/// One file of runs, with its run ids (ascending): Parquet (a finished
+/// table, a shard) or Arrow IPC (a study's chunk, `.arrow`).
 #[derive(Debug)]
 pub struct Piece {
     path: PathBuf,
     ids: Vec<u64>,
+}
+
+/// Whether `path` is an Arrow IPC file (a chunk) rather than Parquet.
+fn is_ipc(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "arrow")
+}
+
+/// The file's rows, all columns or the projection `columns`.
+fn read_file(path: &Path, columns: Option<&[&str]>) -> PolarsResult<DataFrame> {
+    let columns = columns.map(|c| c.iter().map(|c| c.to_string()).collect::<Vec<_>>());
+    if is_ipc(path) {
+        IpcReader::new(File::open(path)?)
+            .with_columns(columns)
+            .finish()
+    } else {
+        ParquetReader::new(File::open(path)?)
+            .with_columns(columns)
+            .finish()
+    }
 }
 
 impl Piece {
@@ -47,10 +67,14 @@ impl Piece {
                 ids,
             });
         }
-        let df = ParquetReader::new(File::open(path)?).finish()?;
+        let df = read_file(path, None)?;
         let mut sorted = df.sort(["run_id"], SortMultipleOptions::default())?;
         let tmp = temp_path(path);
-        ParquetWriter::new(File::create(&tmp)?).finish(&mut sorted)?;
+        if is_ipc(path) {
+            IpcWriter::new(File::create(&tmp)?).finish(&mut sorted)?;
+        } else {
+            ParquetWriter::new(File::create(&tmp)?).finish(&mut sorted)?;
+        }
         std::fs::rename(&tmp, path)?;
         Ok(Piece {
             path: path.to_path_buf(),
@@ -75,6 +99,10 @@ impl Piece {
         if hi == lo {
             return Ok(None);
         }
+        if is_ipc(&self.path) {
+            // A chunk holds a few thousand runs: read whole, then sliced.
+            return Ok(Some(read_file(&self.path, None)?.slice(lo as i64, hi - lo)));
+        }
         ParquetReader::new(File::open(&self.path)?)
             .with_slice(Some((lo, hi - lo)))
             .finish()
@@ -83,9 +111,7 @@ impl Piece {
 }
 
 fn read_ids(path: &Path) -> PolarsResult<Vec<u64>> {
-    let df = ParquetReader::new(File::open(path)?)
-        .with_columns(Some(vec!["run_id".into()]))
-        .finish()?;
+    let df = read_file(path, Some(&["run_id"]))?;
     Ok(df.column("run_id")?.u64()?.into_no_null_iter().collect())
 }
 
@@ -184,11 +210,7 @@ fn window_rows(pieces: &[Piece], from: u64, to: u64) -> PolarsResult<Option<Data
 
 /// The slim projection of `runs.parquet` the summary needs (about 40 bytes a run).
 pub fn read_summary_columns(path: &Path) -> PolarsResult<DataFrame> {
-    ParquetReader::new(File::open(path)?)
-        .with_columns(Some(
-            SUMMARY_COLUMNS.iter().map(|c| c.to_string()).collect(),
-        ))
-        .finish()
+    read_file(path, Some(&SUMMARY_COLUMNS))
 }
 
 /// The slim projection of several pieces, stacked (for decisions taken
@@ -196,7 +218,7 @@ pub fn read_summary_columns(path: &Path) -> PolarsResult<DataFrame> {
 pub fn read_pieces_summary_columns(pieces: &[Piece]) -> PolarsResult<DataFrame> {
     let mut out: Option<DataFrame> = None;
     for piece in pieces {
-        let df = read_summary_columns(piece.path())?;
+        let df = read_file(piece.path(), Some(&SUMMARY_COLUMNS))?;
         match out.as_mut() {
             Some(all) => {
                 all.vstack_mut(&df)?;

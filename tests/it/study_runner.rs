@@ -136,7 +136,7 @@ fn wait_for_a_chunk(chunks: &Path) {
     let start = std::time::Instant::now();
     while !std::fs::read_dir(chunks).is_ok_and(|d| {
         d.filter_map(Result::ok)
-            .any(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
+            .any(|e| e.file_name().to_string_lossy().ends_with(".arrow"))
     }) {
         assert!(start.elapsed().as_secs() < 60, "no chunk appeared");
         std::thread::sleep(std::time::Duration::from_millis(5));
