@@ -674,10 +674,10 @@ fn next_chunk_index(dir: &Path) -> Result<u64, RunError> {
     let mut next = 0;
     for entry in std::fs::read_dir(dir)? {
         let name = entry?.file_name().to_string_lossy().to_string();
-        if let Some(num) = name.strip_prefix("chunk-").and_then(|s| {
-            s.strip_suffix(".arrow")
-                .or_else(|| s.strip_suffix(".parquet"))
-        }) && let Ok(i) = num.parse::<u64>()
+        if let Some(num) = name
+            .strip_prefix("chunk-")
+            .and_then(|s| s.strip_suffix(".arrow"))
+            && let Ok(i) = num.parse::<u64>()
         {
             next = next.max(i + 1);
         }
