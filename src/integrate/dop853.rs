@@ -568,10 +568,10 @@ impl Stepper for Dop853 {
         enough: f64,
         stats: &mut Stats,
     ) -> f64 {
-        let tol = (self.options.rtol, self.options.atol.as_slice());
         let (y1, fy, y_other) = (&self.y1, &self.st.k[12], &self.ys);
+        let options = &self.options;
         self.probe
-            .h_rho(system, t_new, y1, fy, y_other, h, tol, enough, stats)
+            .h_rho(system, t_new, y1, fy, y_other, h, options, enough, stats)
     }
 
     fn accept<S: OdeSystem + ?Sized>(

@@ -14,7 +14,7 @@
 //! confirm the stability limit without a Jacobian matrix.
 
 use super::norm::atol_of;
-use super::{OdeSystem, Stats};
+use super::{OdeSystem, SolverOptions, Stats};
 
 /// Hairer's stiffness counting (DOPRI5, DOP853): this many accepted steps
 /// held by stability in a row mean the problem is stiff ...
@@ -173,10 +173,11 @@ impl PowerProbe {
         fy: &[f64],
         y_other: &[f64],
         h: f64,
-        (rtol, atol): (f64, &[f64]),
+        options: &SolverOptions,
         enough: f64,
         stats: &mut Stats,
     ) -> f64 {
+        let (rtol, atol) = (options.rtol, options.atol.as_slice());
         let scale = |i: usize| atol_of(atol, i) + rtol * y[i].abs();
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         for (i, v) in self.v.iter_mut().enumerate() {
@@ -350,9 +351,13 @@ mod tests {
         let h = 3.0 / rho;
         let mut probe = PowerProbe::new(dim);
         let mut stats = Stats::default();
-        let tol = (1e-6, &[1e-8][..]);
+        let tol = SolverOptions {
+            rtol: 1e-6,
+            atol: vec![1e-8],
+            ..SolverOptions::default()
+        };
         let est = probe.h_rho(
-            &chain, 0.0, &y, &fy, &other, h, tol,
+            &chain, 0.0, &y, &fy, &other, h, &tol,
             4.0, // never reached, and not abandoned above 2
             &mut stats,
         );
@@ -362,11 +367,21 @@ mod tests {
         assert!(est > 0.9 * 3.0, "h·ρ estimated {est}, exact 3");
         // Stopping early once the estimate is enough.
         let mut stats = Stats::default();
-        let early = probe.h_rho(&chain, 0.0, &y, &fy, &other, h, tol, 2.0, &mut stats);
+        let early = probe.h_rho(&chain, 0.0, &y, &fy, &other, h, &tol, 2.0, &mut stats);
         assert!(early > 2.0 && stats.rhs_calls < POWER_STEPS as u64);
         // An accuracy-limited step (h·ρ = 0.5) is given up after the first products.
         let mut stats = Stats::default();
-        let small = probe.h_rho(&chain, 0.0, &y, &fy, &other, h / 6.0, tol, 2.44, &mut stats);
+        let small = probe.h_rho(
+            &chain,
+            0.0,
+            &y,
+            &fy,
+            &other,
+            h / 6.0,
+            &tol,
+            2.44,
+            &mut stats,
+        );
         assert!(small < 0.5 * 1.001, "h·ρ estimated {small}, exact 0.5");
         assert_eq!(stats.rhs_calls, MIN_POWER_STEPS as u64 + 1);
     }
@@ -376,7 +391,6 @@ mod tests {
     /// finds h·ρ(J) as the probe does.
     #[test]
     fn each_explicit_stepper_checks_at_its_new_point() {
-        use crate::integrate::SolverOptions;
         use crate::integrate::dop853::Dop853;
         use crate::integrate::dp5::Dp5;
         use crate::integrate::stepper::{Stepper, Trial};
