@@ -10,6 +10,8 @@
 //! up to rounding.
 
 use super::lu::{ComplexLu, RealLu};
+use super::structured_newton::StructuredNewton;
+use super::{OdeSystem, SolverOptions, Stats};
 
 /// Factored Newton matrices of one Jacobian and step size.
 pub(crate) enum NewtonMatrices {
@@ -26,6 +28,9 @@ pub(crate) enum NewtonMatrices {
         /// 1/(α + iβ) as (re, −im): α/|·|², β/|·|².
         inv_shift: (f64, f64),
     },
+    /// The reduced matrices as tridiagonal plus low rank, from the system's
+    /// coupling structure ([`super::structured_newton`]).
+    Structured(Box<StructuredNewton>),
 }
 
 impl NewtonMatrices {
@@ -48,10 +53,43 @@ impl NewtonMatrices {
         }
     }
 
-    /// Factor γ·I − J and (α + iβ)·I − J for the row-major Jacobian `jac`;
+    /// The matrices `options` allow for `system` from (t0, y0): structured
+    /// when it has enough ring coordinates, else as [`Self::new`].
+    pub(crate) fn for_system<S: OdeSystem + ?Sized>(
+        system: &S,
+        t0: f64,
+        y0: &[f64],
+        options: &SolverOptions,
+    ) -> Self {
+        let split = system
+            .second_order_split()
+            .filter(|_| options.reduce_second_order);
+        match split {
+            Some(m)
+                if options.structured_newton
+                    && 2 * m == y0.len()
+                    && StructuredNewton::pays(system, t0, y0) =>
+            {
+                NewtonMatrices::Structured(Box::new(StructuredNewton::new(m)))
+            }
+            _ => NewtonMatrices::new(y0.len(), split),
+        }
+    }
+
+    /// Factor γ·I − J and (α + iβ)·I − J for the row-major Jacobian `jac`
+    /// (the structured matrices use their own local Jacobian instead);
     /// false if either is singular or not finite.
-    pub(crate) fn factor(&mut self, gamma: f64, alpha: f64, beta: f64, jac: &[f64]) -> bool {
+    pub(crate) fn factor<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        gamma: f64,
+        alpha: f64,
+        beta: f64,
+        jac: &[f64],
+        stats: &mut Stats,
+    ) -> bool {
         match self {
+            NewtonMatrices::Structured(s) => s.factor(system, gamma, alpha, beta, stats),
             NewtonMatrices::Full { real, complex } => {
                 real.factor_shifted(gamma, jac) && complex.factor_shifted(alpha, beta, jac)
             }
@@ -109,8 +147,18 @@ impl NewtonMatrices {
     }
 
     /// Overwrite b with the solution of (γ·I − J)·x = b.
-    pub(crate) fn solve_real(&self, b: &mut [f64]) {
-        match self {
+    pub(crate) fn solve_real<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        b: &mut [f64],
+        stats: &mut Stats,
+    ) {
+        let dense = match self {
+            NewtonMatrices::Structured(s) => return s.solve_real(system, b, stats),
+            dense => &*dense,
+        };
+        match dense {
+            NewtonMatrices::Structured(_) => unreachable!("returned above"),
             NewtonMatrices::Full { real, .. } => real.solve(b),
             NewtonMatrices::Reduced {
                 m,
@@ -136,8 +184,19 @@ impl NewtonMatrices {
     }
 
     /// Overwrite (br, bi) with the solution of ((α + iβ)·I − J)·x = br + i·bi.
-    pub(crate) fn solve_complex(&self, br: &mut [f64], bi: &mut [f64]) {
-        match self {
+    pub(crate) fn solve_complex<S: OdeSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        br: &mut [f64],
+        bi: &mut [f64],
+        stats: &mut Stats,
+    ) {
+        let dense = match self {
+            NewtonMatrices::Structured(s) => return s.solve_complex(system, br, bi, stats),
+            dense => &*dense,
+        };
+        match dense {
+            NewtonMatrices::Structured(_) => unreachable!("returned above"),
             NewtonMatrices::Full { complex, .. } => complex.solve(br, bi),
             NewtonMatrices::Reduced {
                 m,
@@ -186,6 +245,18 @@ impl NewtonMatrices {
 mod tests {
     use super::*;
 
+    /// The dense matrices never call the system.
+    struct NoSystem;
+
+    impl OdeSystem for NoSystem {
+        fn dim(&self) -> usize {
+            0
+        }
+        fn rhs(&self, _t: f64, _y: &[f64], _dydt: &mut [f64]) {
+            unreachable!("dense Newton matrices evaluate nothing")
+        }
+    }
+
     /// A second-order 6×6 Jacobian [[0, I], [A, B]] whose reduced matrices
     /// need pivoting.
     fn jacobian() -> Vec<f64> {
@@ -209,12 +280,12 @@ mod tests {
         let mut full = NewtonMatrices::new(6, None);
         let mut reduced = NewtonMatrices::new(6, Some(3));
         assert!(matches!(reduced, NewtonMatrices::Reduced { .. }));
-        assert!(full.factor(gamma, alpha, beta, &jac));
-        assert!(reduced.factor(gamma, alpha, beta, &jac));
+        assert!(full.factor(&NoSystem, gamma, alpha, beta, &jac, &mut Stats::default()));
+        assert!(reduced.factor(&NoSystem, gamma, alpha, beta, &jac, &mut Stats::default()));
         let b = [1.0, -2.0, 0.5, 3.0, 0.25, -1.0];
         let (mut x_full, mut x_red) = (b, b);
-        full.solve_real(&mut x_full);
-        reduced.solve_real(&mut x_red);
+        full.solve_real(&NoSystem, &mut x_full, &mut Stats::default());
+        reduced.solve_real(&NoSystem, &mut x_red, &mut Stats::default());
         for (p, q) in x_full.iter().zip(&x_red) {
             assert!((p - q).abs() < 1e-13, "{x_full:?} {x_red:?}");
         }
@@ -226,8 +297,8 @@ mod tests {
         let bi = [0.5, 0.0, -1.0, 2.0, 1.5, -0.75];
         let (mut fr, mut fi) = (b, bi);
         let (mut rr, mut ri) = (b, bi);
-        full.solve_complex(&mut fr, &mut fi);
-        reduced.solve_complex(&mut rr, &mut ri);
+        full.solve_complex(&NoSystem, &mut fr, &mut fi, &mut Stats::default());
+        reduced.solve_complex(&NoSystem, &mut rr, &mut ri, &mut Stats::default());
         for k in 0..6 {
             assert!((fr[k] - rr[k]).abs() < 1e-13 && (fi[k] - ri[k]).abs() < 1e-13);
         }
@@ -249,8 +320,8 @@ mod tests {
     fn a_singular_or_non_finite_reduced_matrix_is_refused() {
         let mut reduced = NewtonMatrices::new(6, Some(3));
         let mut jac = jacobian();
-        assert!(!reduced.factor(0.0, 1.0, 1.0, &jac));
+        assert!(!reduced.factor(&NoSystem, 0.0, 1.0, 1.0, &jac, &mut Stats::default()));
         jac[30] = f64::NAN;
-        assert!(!reduced.factor(3.6, 2.7, -1.9, &jac));
+        assert!(!reduced.factor(&NoSystem, 3.6, 2.7, -1.9, &jac, &mut Stats::default()));
     }
 }

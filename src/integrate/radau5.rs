@@ -214,20 +214,35 @@ impl Radau5 {
         let n = y.len();
         if self.need_jac {
             stats.jacobians += 1;
-            if !(self.analytic && system.jacobian(t, y, &mut self.jac)) {
-                self.analytic = false;
-                self.y_perturbed.copy_from_slice(y);
-                for j in 0..n {
-                    let ysafe = y[j];
-                    let delt = (UROUND * ysafe.abs().max(1e-5)).sqrt();
-                    self.y_perturbed[j] = ysafe + delt;
-                    system.rhs(t, &self.y_perturbed, &mut self.tmp);
-                    for i in 0..n {
-                        self.jac[i * n + j] = (self.tmp[i] - self.fy[i]) / delt;
+            let structured = match &mut self.matrices {
+                NewtonMatrices::Structured(s) => {
+                    let ok = s.evaluate(system, t, y, &self.fy, stats);
+                    if !ok {
+                        // No usable structure here: dense matrices from now on.
+                        self.matrices = NewtonMatrices::new(n, Some(n / 2));
                     }
-                    self.y_perturbed[j] = ysafe;
+                    ok
                 }
-                stats.rhs_calls += n as u64;
+                _ => false,
+            };
+            // A structured Jacobian lives in the matrices; a dense one here.
+            if !structured {
+                self.jac.resize(n * n, 0.0);
+                if !(self.analytic && system.jacobian(t, y, &mut self.jac)) {
+                    self.analytic = false;
+                    self.y_perturbed.copy_from_slice(y);
+                    for j in 0..n {
+                        let ysafe = y[j];
+                        let delt = (UROUND * ysafe.abs().max(1e-5)).sqrt();
+                        self.y_perturbed[j] = ysafe + delt;
+                        system.rhs(t, &self.y_perturbed, &mut self.tmp);
+                        for i in 0..n {
+                            self.jac[i * n + j] = (self.tmp[i] - self.fy[i]) / delt;
+                        }
+                        self.y_perturbed[j] = ysafe;
+                    }
+                    stats.rhs_calls += n as u64;
+                }
             }
             self.fresh_jac = true;
             self.need_jac = false;
@@ -240,7 +255,7 @@ impl Radau5 {
             stats.factorizations += 1;
             let singular = !self
                 .matrices
-                .factor(self.fac1, self.alphn, self.betan, &self.jac);
+                .factor(system, self.fac1, self.alphn, self.betan, &self.jac, stats);
             self.need_lu = singular;
             return !singular;
         }
@@ -314,8 +329,8 @@ impl Radau5 {
                 z2[i] = w2 - f2[i] * alphn + f3[i] * betan;
                 z3[i] = w3 - f3[i] * alphn - f2[i] * betan;
             }
-            self.matrices.solve_real(z1);
-            self.matrices.solve_complex(z2, z3);
+            self.matrices.solve_real(system, z1, stats);
+            self.matrices.solve_complex(system, z2, z3, stats);
             newt += 1;
             let dyno = {
                 let s: f64 = (0..n)
@@ -419,7 +434,8 @@ impl Stepper for Radau5 {
             y_perturbed: zeros(),
             z: [zeros(), zeros(), zeros()],
             f: [zeros(), zeros(), zeros()],
-            jac: vec![0.0; n * n],
+            // Sized when a dense Jacobian is first needed.
+            jac: Vec::new(),
             // Sized in `start`, which sees the system.
             matrices: NewtonMatrices::new(0, None),
             dense,
@@ -451,10 +467,7 @@ impl Stepper for Radau5 {
         h_max: f64,
         stats: &mut Stats,
     ) -> Result<f64, Failure> {
-        let split = system
-            .second_order_split()
-            .filter(|_| self.options.reduce_second_order);
-        self.matrices = NewtonMatrices::new(y0.len(), split);
+        self.matrices = NewtonMatrices::for_system(system, t0, y0, &self.options);
         self.set_scal(y0);
         system.rhs(t0, y0, &mut self.fy);
         stats.rhs_calls += 1;
@@ -521,7 +534,7 @@ impl Stepper for Radau5 {
             f2[i] = d1 * z1[i] + d2 * z2[i] + d3 * z3[i];
             tmp[i] = f2[i] + self.fy[i];
         }
-        self.matrices.solve_real(tmp);
+        self.matrices.solve_real(system, tmp, stats);
         let mut err = rms(tmp, &self.scal);
         if err >= 1.0 && err.is_finite() && (self.first || self.reject) {
             for i in 0..n {
@@ -532,7 +545,7 @@ impl Stepper for Radau5 {
             for i in 0..n {
                 tmp[i] = f1[i] + f2[i];
             }
-            self.matrices.solve_real(tmp);
+            self.matrices.solve_real(system, tmp, stats);
             err = rms(tmp, &self.scal);
         }
         if !err.is_finite() {

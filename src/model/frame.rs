@@ -20,7 +20,7 @@ use super::rotor::PlaneRotor;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
-use crate::integrate::OdeSystem;
+use crate::integrate::{CouplingStructure, OdeSystem};
 use std::cell::RefCell;
 
 /// Why a scene cannot use the rotating frame.
@@ -135,6 +135,19 @@ impl OdeSystem for RotatingSystem {
     fn second_order_split(&self) -> Option<usize> {
         // `rhs` copies (u̇, v̇, ψ̇) into the first half as it is.
         Some(2 + self.cargo.len())
+    }
+
+    fn coupling_structure(&self, _t: f64, y: &[f64], out: &mut CouplingStructure) -> bool {
+        let n = self.cargo.len();
+        let psi = &y[2..2 + n];
+        out.head = 2;
+        out.coupling.clear();
+        // ψ̈_j = (Q_j − m l (cos ψ_j · v̈ − sin ψ_j · ü))/I_j, as `rhs` back-substitutes.
+        for ((&p, &ml), &inertia) in psi.iter().zip(&self.mass_track).zip(&self.inertia) {
+            let (s, co) = super::trig::sin_cos(p);
+            out.coupling.extend([ml * s / inertia, -ml * co / inertia]);
+        }
+        super::coupling::cargo_rings(&self.cargo, psi, 2, out)
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {

@@ -16,6 +16,7 @@
 
 pub mod balancer;
 pub mod cargo;
+pub mod coupling;
 pub mod effect;
 pub mod forced;
 pub mod frame;

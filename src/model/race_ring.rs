@@ -22,6 +22,27 @@ pub fn for_each_neighbour_pair(
     angle: impl Fn(usize) -> f64,
     mut visit: impl FnMut(usize, usize),
 ) {
+    for_each_ring(n, plane, in_ring, angle, |ring| {
+        let m = ring.len();
+        let pairs = if m > 2 { m } else { m.saturating_sub(1) };
+        for i in 0..pairs {
+            let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
+            visit(a.min(b), a.max(b));
+        }
+    });
+}
+
+/// Call `visit(ring)` for each plane's ring: the items 0..n (n ≤
+/// [`MAX_RING`]) of that plane for which `in_ring` holds, sorted by `angle`
+/// modulo 2π, planes in the order of their first item (a plane without such
+/// items gives an empty ring). No allocation.
+pub fn for_each_ring(
+    n: usize,
+    plane: impl Fn(usize) -> usize,
+    in_ring: impl Fn(usize) -> bool,
+    angle: impl Fn(usize) -> f64,
+    mut visit: impl FnMut(&[u16]),
+) {
     assert!(n <= MAX_RING, "{n} weights in a ring, at most {MAX_RING}");
     let mut order = [0u16; MAX_RING];
     let mut wrapped = [0.0f64; MAX_RING];
@@ -43,11 +64,7 @@ pub fn for_each_neighbour_pair(
         }
         let ring = &mut order[..m];
         ring.sort_unstable_by(|&a, &b| wrapped[a as usize].total_cmp(&wrapped[b as usize]));
-        let pairs = if m > 2 { m } else { m.saturating_sub(1) };
-        for i in 0..pairs {
-            let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
-            visit(a.min(b), a.max(b));
-        }
+        visit(ring);
     }
 }
 

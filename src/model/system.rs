@@ -17,7 +17,7 @@ use super::effect::{Effect, EffectContext, Forces};
 use super::rotor::{DofVec, MAX_DOF, Rotor};
 use super::speed::SpeedLaw;
 use super::tilt_inertia::TiltTerms;
-use crate::integrate::OdeSystem;
+use crate::integrate::{CouplingStructure, OdeSystem};
 
 /// Largest head block: rotor coordinates plus the spin angle.
 const MAX_HEAD: usize = MAX_DOF + 1;
@@ -210,6 +210,38 @@ impl OdeSystem for RotorSystem {
     fn second_order_split(&self) -> Option<usize> {
         // `rhs` copies q̇ into the first half as it is.
         Some(self.layout.nq())
+    }
+
+    fn coupling_structure(&self, t: f64, y: &[f64], out: &mut CouplingStructure) -> bool {
+        let lay = self.layout;
+        let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
+        let (q, qd) = y.split_at(nq);
+        let (phi, spin_rate) = self.spin(t, y);
+        out.head = head;
+        out.coupling.clear();
+        // ψ̈_j = (Q_j − w_j·z_rotor − (I_j − J_j) φ̈)/I_j, as `rhs` back-substitutes.
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = super::trig::sin_cos(phi + q[head + j]);
+            let ml = c.mass * c.track_radius;
+            let [gu, gv] = &self.plane_maps[c.plane];
+            let inv = 1.0 / self.inertia[j];
+            let mut w: DofVec = [0.0; MAX_DOF];
+            for i in 0..k {
+                w[i] = ml * (co * gv[i] - s * gu[i]);
+            }
+            let rate = spin_rate + qd[head + j];
+            if let Some(t) = self.tilt_terms(c, (s, co), rate, &q[..k], &qd[..k]) {
+                for i in 0..k {
+                    w[i] += t.coupling[i];
+                }
+            }
+            out.coupling.extend(w[..k].iter().map(|wi| -wi * inv));
+            if lay.spin_free {
+                out.coupling
+                    .push(-(self.inertia[j] - c.rolling_coupling) * inv);
+            }
+        }
+        super::coupling::cargo_rings(&self.cargo, &q[head..], head, out)
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {

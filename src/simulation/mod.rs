@@ -125,6 +125,7 @@ impl Simulation {
                 self.solver.max_wall_seconds,
             )),
             reduce_second_order: !self.solver.full_newton,
+            structured_newton: !self.solver.dense_newton,
             stiffness: if explicit && self.solver.implicit_fallback {
                 Stiffness::SwitchToImplicit
             } else {

@@ -48,6 +48,11 @@ pub struct SolverSettings {
     /// file key).
     #[serde(skip)]
     pub full_newton: bool,
+    /// Radau5 keeps dense reduced Newton matrices for a system with many
+    /// weights instead of the structured ones (the reference for their
+    /// test; not a file key).
+    #[serde(skip)]
+    pub dense_newton: bool,
 }
 
 impl Default for SolverSettings {
@@ -61,6 +66,7 @@ impl Default for SolverSettings {
             max_wall_seconds: 600.0,
             implicit_fallback: true,
             full_newton: false,
+            dense_newton: false,
         }
     }
 }

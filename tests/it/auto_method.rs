@@ -90,8 +90,15 @@ const MEASURED_RHS_PER_RUN: f64 = 3726.0;
 /// Sixteen balls at half-race fill, started packed (sample 0 of the n = 16
 /// study of `scripts/n-scaling.sh`), in `method`.
 fn packed_chain(method: &str) -> String {
-    let angles: Vec<String> = (0..16)
-        .map(|j| format!("{}", 81.794_013_880_081_96 + 11.25 * j as f64))
+    packed_chain_of(16, method)
+}
+
+/// `n` balls at half-race fill started packed as in [`packed_chain`]: each
+/// touching the next, 180°/n apart.
+pub(crate) fn packed_chain_of(n: usize, method: &str) -> String {
+    let spacing = 180.0 / n as f64;
+    let angles: Vec<String> = (0..n)
+        .map(|j| format!("{}", 81.794_013_880_081_96 + spacing * j as f64))
         .collect();
     format!(
         r#"
@@ -106,7 +113,7 @@ unbalance_angle = 0.05381263
 
 [balancer]
 kind = "ball"
-n = 16
+n = {n}
 rho = "half_race"
 race_radius = 0.05
 density = 7850.0

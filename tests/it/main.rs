@@ -37,6 +37,7 @@ mod rolling_resistance;
 mod sample_bounds;
 mod schema;
 mod sommerfeld;
+mod structured_newton;
 mod study_input;
 mod study_runner;
 mod study_summary;
