@@ -35,12 +35,13 @@ from collections import Counter
 import pyarrow.parquet as pq
 
 out, ns = sys.argv[1], sys.argv[2:]
-print("| n | ms per run | RHS calls per run | steps per run | settled | method |")
-print("| ---: | ---: | ---: | ---: | ---: | --- |")
+print("| n | ms per run | RHS calls per run | steps per run | µs per step and weight | settled | method |")
+print("| ---: | ---: | ---: | ---: | ---: | ---: | --- |")
 for n in ns:
     t = pq.read_table(f"{out}/n{n}/runs.parquet").to_pydict()
     k = len(t["wall_time_s"])
     methods = ", ".join(f"{m} {c}" for m, c in Counter(t["method"]).most_common())
     print(f"| {n} | {1e3 * sum(t['wall_time_s']) / k:,.2f} | {sum(t['rhs_calls']) / k:,.0f} "
-          f"| {sum(t['steps']) / k:,.0f} | {100 * sum(t['settled']) / k:.0f} % | {methods} |".replace(",", " "))
+          f"| {sum(t['steps']) / k:,.0f} | {1e6 * sum(t['wall_time_s']) / sum(t['steps']) / int(n):.2f} "
+          f"| {100 * sum(t['settled']) / k:.0f} % | {methods} |".replace(",", " "))
 EOF
