@@ -90,6 +90,44 @@ impl RealLu {
     /// Overwrite b with the solution x of (s·I − J)·x = b (or of the matrix
     /// given to [`RealLu::factor_from`]).
     pub(crate) fn solve(&self, b: &mut [f64]) {
+        // The few-weight sizes with the size known to the compiler: loops
+        // unrolled, the same operations in the same order (the same bits).
+        match self.n {
+            3 => self.solve_sized::<3>(b),
+            4 => self.solve_sized::<4>(b),
+            5 => self.solve_sized::<5>(b),
+            6 => self.solve_sized::<6>(b),
+            7 => self.solve_sized::<7>(b),
+            8 => self.solve_sized::<8>(b),
+            _ => self.solve_any(b),
+        }
+    }
+
+    /// [`Self::solve`] for n = N.
+    fn solve_sized<const N: usize>(&self, b: &mut [f64]) {
+        let b: &mut [f64; N] = (&mut b[..N]).try_into().expect("n = N");
+        let a = &self.a[..N * N];
+        for (k, &p) in self.piv[..N].iter().enumerate() {
+            b.swap(k, p);
+        }
+        for i in 0..N {
+            let mut s = b[i];
+            for k in 0..i {
+                s -= a[i * N + k] * b[k];
+            }
+            b[i] = s;
+        }
+        for i in (0..N).rev() {
+            let mut s = b[i];
+            for k in i + 1..N {
+                s -= a[i * N + k] * b[k];
+            }
+            b[i] = s / a[i * N + i];
+        }
+    }
+
+    /// [`Self::solve`] for any n.
+    fn solve_any(&self, b: &mut [f64]) {
         let n = self.n;
         let b = &mut b[..n];
         for (k, &p) in self.piv.iter().enumerate() {
@@ -214,6 +252,53 @@ impl ComplexLu {
     /// Overwrite (br, bi) with the solution of ((α + iβ)·I − J)·x = br + i·bi
     /// (or of the matrix given to [`ComplexLu::factor_from`]).
     pub(crate) fn solve(&self, br: &mut [f64], bi: &mut [f64]) {
+        // As [`RealLu::solve`]: the few-weight sizes known to the compiler.
+        match self.n {
+            3 => self.solve_sized::<3>(br, bi),
+            4 => self.solve_sized::<4>(br, bi),
+            5 => self.solve_sized::<5>(br, bi),
+            6 => self.solve_sized::<6>(br, bi),
+            7 => self.solve_sized::<7>(br, bi),
+            8 => self.solve_sized::<8>(br, bi),
+            _ => self.solve_any(br, bi),
+        }
+    }
+
+    /// [`Self::solve`] for n = N.
+    fn solve_sized<const N: usize>(&self, br: &mut [f64], bi: &mut [f64]) {
+        let br: &mut [f64; N] = (&mut br[..N]).try_into().expect("n = N");
+        let bi: &mut [f64; N] = (&mut bi[..N]).try_into().expect("n = N");
+        let (re, im) = (&self.re[..N * N], &self.im[..N * N]);
+        for (k, &p) in self.piv[..N].iter().enumerate() {
+            br.swap(k, p);
+            bi.swap(k, p);
+        }
+        for i in 0..N {
+            let (mut sr, mut si) = (br[i], bi[i]);
+            for k in 0..i {
+                let (lr, li) = (re[i * N + k], im[i * N + k]);
+                sr -= lr * br[k] - li * bi[k];
+                si -= lr * bi[k] + li * br[k];
+            }
+            br[i] = sr;
+            bi[i] = si;
+        }
+        for i in (0..N).rev() {
+            let (mut sr, mut si) = (br[i], bi[i]);
+            for k in i + 1..N {
+                let (ur, ui) = (re[i * N + k], im[i * N + k]);
+                sr -= ur * br[k] - ui * bi[k];
+                si -= ur * bi[k] + ui * br[k];
+            }
+            let (dr, di) = (re[i * N + i], im[i * N + i]);
+            let den = dr * dr + di * di;
+            br[i] = (sr * dr + si * di) / den;
+            bi[i] = (si * dr - sr * di) / den;
+        }
+    }
+
+    /// [`Self::solve`] for any n.
+    fn solve_any(&self, br: &mut [f64], bi: &mut [f64]) {
         let n = self.n;
         let (br, bi) = (&mut br[..n], &mut bi[..n]);
         for (k, &p) in self.piv.iter().enumerate() {
@@ -298,6 +383,39 @@ mod tests {
         lu.solve(&mut br, &mut bi);
         for i in 0..n {
             assert!((br[i] - xr[i]).abs() < 1e-13 && (bi[i] - xi[i]).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn sized_solves_give_the_bits_of_the_general_ones() {
+        for n in 3..=8 {
+            let jac: Vec<f64> = (0..n * n)
+                .map(|k| ((k * 7919 % 97) as f64 - 48.0) / 13.0)
+                .collect();
+            let b: Vec<f64> = (0..n).map(|k| (k as f64 - 2.5) / 3.0).collect();
+            let bi: Vec<f64> = b.iter().map(|v| v * v - 0.5).collect();
+            let mut real = RealLu::new(n);
+            assert!(real.factor_shifted(0.7, &jac));
+            let (mut x, mut y) = (b.clone(), b.clone());
+            real.solve(&mut x);
+            real.solve_any(&mut y);
+            assert_eq!(
+                x.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                y.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                "real n = {n}"
+            );
+            let mut complex = ComplexLu::new(n);
+            assert!(complex.factor_shifted(0.7, -1.3, &jac));
+            let (mut xr, mut xi, mut yr, mut yi) = (b.clone(), bi.clone(), b.clone(), bi.clone());
+            complex.solve(&mut xr, &mut xi);
+            complex.solve_any(&mut yr, &mut yi);
+            assert!(
+                xr.iter()
+                    .chain(&xi)
+                    .zip(yr.iter().chain(&yi))
+                    .all(|(p, q)| p.to_bits() == q.to_bits()),
+                "complex n = {n}"
+            );
         }
     }
 }
