@@ -3,7 +3,15 @@
 //! answers: the same run, to the accuracy of finite differences.
 
 use crate::auto_method::packed_chain_of;
+use autobal::integrate::{CouplingStructure, OdeSystem};
 use autobal::metrics::RunMetrics;
+use autobal::model::cargo::Cargo;
+use autobal::model::effect::Effect;
+use autobal::model::effect::contact::{Contact, ContactSpec};
+use autobal::model::frame::RotatingSystem;
+use autobal::model::rotor::{Rotor, TwoSupportRotor};
+use autobal::model::speed::SpeedLaw;
+use autobal::model::system::RotorSystem;
 use autobal::scene_file::SceneFile;
 
 /// `n` packed balls on Radau5 throughout, with dense or structured Newton
@@ -41,4 +49,173 @@ fn structured_newton_matrices_follow_a_packed_chain_of_24_balls_as_dense_ones_do
         structured.residual_rel,
         dense.residual_rel
     );
+}
+
+/// The largest violation of the structure `system` declares at `y`, relative
+/// to the row it occurs in: every acceleration of a ring coordinate, less
+/// U·(the head accelerations), must depend only on its own coordinate, its
+/// ring neighbours and the head coordinates (central differences).
+fn structure_violation(system: &dyn OdeSystem, t: f64, y: &[f64]) -> f64 {
+    let dim = y.len();
+    let m = dim / 2;
+    let mut st = CouplingStructure::default();
+    assert!(system.coupling_structure(t, y, &mut st));
+    let h = st.head;
+    let mut jac = vec![0.0; dim * dim];
+    let (mut yp, mut fp, mut fm) = (y.to_vec(), vec![0.0; dim], vec![0.0; dim]);
+    for c in 0..dim {
+        let d = 1e-6 * (1.0 + y[c].abs());
+        yp[c] = y[c] + d;
+        system.rhs(t, &yp, &mut fp);
+        yp[c] = y[c] - d;
+        system.rhs(t, &yp, &mut fm);
+        yp[c] = y[c];
+        for r in 0..dim {
+            jac[r * dim + c] = (fp[r] - fm[r]) / (2.0 * d);
+        }
+    }
+    let mut neighbours = vec![Vec::new(); m];
+    let mut start = 0;
+    for &end in &st.ring_ends {
+        let ring = &st.order[start..end];
+        for (p, &i) in ring.iter().enumerate() {
+            let len = ring.len();
+            neighbours[i] = vec![i, ring[(p + 1) % len], ring[(p + len - 1) % len]];
+        }
+        start = end;
+    }
+    let mut worst = 0.0f64;
+    for i in h..m {
+        let u = &st.coupling[(i - h) * h..(i - h + 1) * h];
+        let local = |c: usize| {
+            jac[(m + i) * dim + c] - (0..h).map(|r| u[r] * jac[(m + r) * dim + c]).sum::<f64>()
+        };
+        let scale = (0..dim)
+            .map(|c| jac[(m + i) * dim + c].abs())
+            .fold(1e-300, f64::max);
+        for c in 0..dim {
+            let coordinate = c % m;
+            if coordinate < h || neighbours[i].contains(&coordinate) {
+                continue;
+            }
+            worst = worst.max(local(c).abs() / scale);
+        }
+    }
+    worst
+}
+
+/// Packed angles (rad) a little less than `spacing_deg` apart, so that
+/// contacts press, dealt to the weights out of race order (weight j sits
+/// at place 7j mod n), so that a ring in weight order would be wrong.
+fn pressed(n: usize, spacing_deg: f64, seed: &mut u64) -> Vec<f64> {
+    (0..n)
+        .map(|j| {
+            let place = (7 * j % n) as f64;
+            *seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let noise = (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            (40.0 + spacing_deg * (0.98 * place + 0.01 * noise)).to_radians()
+        })
+        .collect()
+}
+
+/// A state with the head coordinates at `head` ≥ 1e-4, the given ring angles
+/// and every rate about 1.
+fn state(head: usize, nq: usize, angles: &[f64]) -> Vec<f64> {
+    let mut y = vec![0.0; 2 * nq];
+    for r in 0..head {
+        y[r] = 1e-4 * (1.0 + r as f64);
+        y[nq + r] = 0.3 - 0.1 * r as f64;
+    }
+    for (j, a) in angles.iter().enumerate() {
+        y[nq - angles.len() + j] = *a;
+        y[2 * nq - angles.len() + j] = 0.5 + 0.05 * j as f64;
+    }
+    y
+}
+
+#[test]
+fn every_rotor_system_couples_its_weights_as_it_declares() {
+    let mut seed = 17u64;
+    let n = 24;
+    let text = packed_chain_of(n, "radau5");
+    let scene = SceneFile::parse(&text, "scene.toml")
+        .expect("valid scene")
+        .simulation("scene.toml")
+        .expect("simulation")
+        .scene;
+    let angles = pressed(n, 180.0 / n as f64, &mut seed);
+    // The rotating frame (the default path) and the inertial frame.
+    let rotating = RotatingSystem::new(&scene).expect("rotating frame");
+    let y = state(2, 2 + n, &angles);
+    let rotating_violation = structure_violation(&rotating, 0.3, &y);
+    let inertial = scene.build().expect("system");
+    let inertial_violation = structure_violation(&inertial, 0.3, &y);
+    // A motor: the spin angle is a head coordinate.
+    let mut motor_scene = scene.clone();
+    motor_scene.speed = SpeedLaw::Motor {
+        stall_torque: 20.0,
+        omega_sync: 300.0,
+        omega_start: 250.0,
+    };
+    let motor = motor_scene.build().expect("system");
+    let mut y = state(3, 3 + n, &angles);
+    y[2] = 0.7;
+    y[3 + n + 2] = 240.0;
+    let motor_violation = structure_violation(&motor, 0.3, &y);
+    // Two planes of twelve on a rigid rotor with tilt inertia.
+    let rotor = TwoSupportRotor {
+        mass: 1.0,
+        transverse_inertia: 1.0,
+        polar_inertia: 0.2,
+        k1: 1.0,
+        l1: 2.0,
+        k2: 1.0,
+        l2: 2.0,
+        b1: 0.05,
+        b2: 0.05,
+        planes: vec![-1.0, 1.0],
+        static_unbalance: 0.0,
+        static_angle: 0.0,
+        moment_unbalance: 0.0,
+        moment_angle: 0.0,
+        unbalances: Vec::new(),
+        weights_tilt_inertia: true,
+    };
+    let cargo: Vec<Cargo> = (0..n)
+        .map(|j| Cargo {
+            plane: j % 2,
+            radius: (7.5f64).to_radians().sin(),
+            ..Cargo::point(0.01, 1.0, 0.02, 1.4)
+        })
+        .collect();
+    let effects: Vec<Box<dyn Effect>> = vec![Box::new(
+        Contact::new(&ContactSpec::default(), &cargo, 3.0).expect("sized weights"),
+    )];
+    let head = rotor.dof();
+    let two_planes = RotorSystem::new(
+        Box::new(rotor),
+        cargo,
+        SpeedLaw::Constant { omega: 3.0 },
+        effects,
+    );
+    // Plane by plane 15° apart (the planes interleave in cargo order).
+    let mut plane_angles = vec![0.0; n];
+    for (k, a) in pressed(n / 2, 15.0, &mut seed).into_iter().enumerate() {
+        plane_angles[2 * k] = a;
+        plane_angles[2 * k + 1] = a + 0.01;
+    }
+    let y = state(head, head + n, &plane_angles);
+    let two_plane_violation = structure_violation(&two_planes, 0.3, &y);
+    eprintln!(
+        "largest violation: rotating {rotating_violation:e}, inertial {inertial_violation:e}, \
+         motor {motor_violation:e}, two planes {two_plane_violation:e}"
+    );
+    for v in [
+        rotating_violation,
+        inertial_violation,
+        motor_violation,
+        two_plane_violation,
+    ] {
+        assert!(v < 1e-6, "{v:e}");
+    }
 }
