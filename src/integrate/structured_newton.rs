@@ -177,9 +177,20 @@ impl Local {
     /// other along a ring differ, so that no row sees two columns of a group.
     fn colour_rings(&mut self) -> bool {
         let st = &self.structure;
-        let n = self.m - st.head;
-        if st.head > MAX_HEAD || st.order.len() != n || st.coupling.len() != n * st.head {
+        let (head, m) = (st.head, self.m);
+        let n = m.saturating_sub(head);
+        if head > MAX_HEAD || head > m || st.order.len() != n || st.coupling.len() != n * head {
             return false;
+        }
+        // The order must name every ring coordinate once (`colour` is
+        // scratch for the check).
+        self.colour.clear();
+        self.colour.resize(n, 0);
+        for &i in &st.order {
+            if !(head..m).contains(&i) || self.colour[i - head] != 0 {
+                return false;
+            }
+            self.colour[i - head] = 1;
         }
         self.ring.clear();
         self.colour.clear();
@@ -709,6 +720,11 @@ impl StructuredNewton {
     /// Whether `system` offers a structure at (t, y) with enough ring
     /// coordinates for these matrices to pay.
     pub(crate) fn pays<S: OdeSystem + ?Sized>(system: &S, t: f64, y: &[f64]) -> bool {
+        // Ring coordinates are fewer than the state's half: most systems
+        // need not be asked.
+        if y.len() / 2 < MIN_RING_COORDINATES {
+            return false;
+        }
         let mut structure = CouplingStructure::default();
         system.coupling_structure(t, y, &mut structure)
             && structure.order.len() >= MIN_RING_COORDINATES
@@ -1140,6 +1156,50 @@ mod tests {
                 assert!(r.abs() < 1e-12, "dense n = {n}, row {i}: {r}");
             }
         }
+    }
+
+    /// A system whose declared structure is malformed in the given way.
+    struct Malformed(fn(&mut CouplingStructure));
+
+    impl OdeSystem for Malformed {
+        fn dim(&self) -> usize {
+            8
+        }
+        fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+            dydt.copy_from_slice(y);
+        }
+        fn coupling_structure(&self, _t: f64, _y: &[f64], out: &mut CouplingStructure) -> bool {
+            *out = CouplingStructure {
+                head: 1,
+                coupling: vec![0.0; 3],
+                order: vec![1, 2, 3],
+                ring_ends: vec![3],
+            };
+            (self.0)(out);
+            true
+        }
+    }
+
+    #[test]
+    fn a_malformed_structure_is_refused_not_used() {
+        let cases: [fn(&mut CouplingStructure); 6] = [
+            |s| s.order = vec![1, 2, 2],
+            |s| s.order = vec![1, 2, 4],
+            |s| s.order = vec![0, 1, 2],
+            |s| s.ring_ends = vec![2],
+            |s| s.ring_ends = vec![2, 2, 3],
+            |s| {
+                s.coupling.pop();
+            },
+        ];
+        let y = [0.5; 8];
+        for (k, case) in cases.into_iter().enumerate() {
+            let mut matrices = StructuredNewton::new(4);
+            let ok = matrices.evaluate(&Malformed(case), 0.0, &y, &y, &mut Stats::default());
+            assert!(!ok, "case {k}");
+        }
+        let mut matrices = StructuredNewton::new(4);
+        assert!(matrices.evaluate(&Malformed(|_| ()), 0.0, &y, &y, &mut Stats::default()));
     }
 
     #[test]
