@@ -1,31 +1,30 @@
-//! Reduced Newton matrices ([`super::newton_matrices`]) of a second-order
-//! system with a [`CouplingStructure`]: a weight's acceleration depends on its
-//! ring neighbours directly and on every other weight only through the few
-//! head accelerations z. Then
+//! Newton matrices of a second-order system with a [`CouplingStructure`]: a
+//! weight's acceleration a_i depends on its ring neighbours directly and on
+//! every other weight only through the few head accelerations z. With J_loc
+//! the Jacobian with z held fixed and P = [0; U],
 //!
-//!   ∂a/∂(q, q̇) = L + U·∂z/∂(q, q̇),
+//!   J = J_loc + P·∂z/∂(q, q̇),   c₀·I − J = S − P·∂z/∂(q, q̇),   S = c₀·I − J_loc
 //!
-//! with L tridiagonal along each ring (plus head columns and each ring's
-//! closing corner) and U of `head` columns, and the reduced matrix
+//! for the shifts c₀ = γ (real) and α + iβ (complex), c₁ = 1/c₀. Two
+//! Woodbury identities solve it:
 //!
-//!   E = c₀·I − ∂a/∂q̇ − c₁·∂a/∂q   (c₀ = γ, c₁ = 1/γ; or α + iβ and 1/(α + iβ))
+//! - S reduces as every second-order matrix does ([`super::newton_matrices`])
+//!   to T = c₀·I − L_q̇ − c₁·L_q: tridiagonal along the rings (LAPACK's
+//!   gttrf/gttrs, partial pivoting) plus the head columns and each ring's
+//!   closing corners, whose rows of Qᵀ are unit vectors: exact.
+//! - The outer correction has `head` columns; its rows ∂z/∂(q, q̇) are never
+//!   formed but act on a vector as one directional difference of z (two
+//!   for a complex vector).
 //!
-//! is a tridiagonal T plus a low-rank P·Qᵀ, solved by the Woodbury identity
-//!
-//!   E⁻¹b = T⁻¹b − T⁻¹P·K⁻¹·Qᵀ·T⁻¹b,   K = I + Qᵀ·T⁻¹P.
-//!
-//! Costs, for m coordinates and r = 2·head + 2·(rings of three or more)
-//! low-rank columns, all O(m·r) where the dense path is O(m²) per Jacobian
-//! and O(m³) per factorisation:
-//! - L by forward differences over colour groups (columns no row sees
-//!   twice): 2·(head + at most 5) RHS calls whatever m, against 2m.
-//! - ∂z/∂(q, q̇) is never formed: Qᵀ's head rows W = ∂z/∂q̇ + c₁·∂z/∂q act
-//!   on a vector as one directional difference of z (two for a complex
-//!   vector), so forming K costs r (2r) RHS calls and each solve one (two).
-//! - T by LAPACK's gttrf/gttrs (tridiagonal LU with partial pivoting).
+//! Costs for m coordinates, all O(m) where the dense matrices take O(m²) per
+//! Jacobian and O(m³) per factorisation: a Jacobian (L by forward
+//! differences over colour groups, columns no row sees twice) takes
+//! 2·(head + at most 5) RHS calls whatever m, against 2m; a factorisation
+//! of both matrices 3·head RHS calls; a real solve one and a complex solve
+//! two.
 //!
 //! Written by hand: no Rust crate offers a tridiagonal-plus-low-rank solve,
-//! and the matrix-free W is specific to this structure.
+//! and the matrix-free correction is specific to this structure.
 
 use super::{CouplingStructure, OdeSystem, Stats};
 use num_complex::Complex64;
@@ -101,6 +100,7 @@ impl Scalar for Complex64 {
 /// One half (∂/∂q or ∂/∂q̇) of the local Jacobian L, per ring position.
 #[derive(Default)]
 struct LocalHalf {
+    /// To the position's own coordinate.
     diag: Vec<f64>,
     /// To the ring predecessor (cyclic).
     left: Vec<f64>,
@@ -111,6 +111,7 @@ struct LocalHalf {
 }
 
 impl LocalHalf {
+    /// Zeros for `positions` ring positions and `head` head coordinates.
     fn reset(&mut self, positions: usize, head: usize) {
         for v in [&mut self.diag, &mut self.left, &mut self.right] {
             v.clear();
@@ -156,6 +157,9 @@ impl Local {
         let row = self.structure.order[p] - h;
         &self.structure.coupling[row * h..(row + 1) * h]
     }
+    /// The ring predecessor of position p, if its coupling is held at p's
+    /// left (a pair holds its one coupling once: at the second's left and
+    /// the first's right).
     fn left(&self, p: usize) -> Option<usize> {
         let (s, e) = self.ring[p];
         match e - s {
@@ -164,6 +168,7 @@ impl Local {
             _ => Some(if p == s { e - 1 } else { p - 1 }),
         }
     }
+    /// The ring successor of position p, as [`Self::left`].
     fn right(&self, p: usize) -> Option<usize> {
         let (s, e) = self.ring[p];
         match e - s {
