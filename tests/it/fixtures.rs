@@ -90,3 +90,27 @@ pub fn shipped_plan_edited(
     edit(&mut file);
     file.plan(&text, &shown).unwrap()
 }
+
+/// A long rigid rotor (A > C) on symmetric supports with tilt stiffness well
+/// above the translational one (ω1 = √2, ω2 = √10, well-separated ranges),
+/// balancer planes at `planes`, no unbalance and no tilt inertia of weights.
+pub fn long_rotor(planes: Vec<f64>) -> autobal::model::rotor::TwoSupportRotor {
+    autobal::model::rotor::TwoSupportRotor {
+        mass: 1.0,
+        transverse_inertia: 1.0,
+        polar_inertia: 0.2,
+        k1: 1.0,
+        l1: 2.0,
+        k2: 1.0,
+        l2: 2.0,
+        b1: 0.05,
+        b2: 0.05,
+        planes,
+        static_unbalance: 0.0,
+        static_angle: 0.0,
+        moment_unbalance: 0.0,
+        moment_angle: 0.0,
+        unbalances: Vec::new(),
+        weights_tilt_inertia: false,
+    }
+}

@@ -38,22 +38,8 @@ fn plane_rotor() -> RotorModel {
 
 fn long_rotor(planes: Vec<f64>, unbalances: Vec<PointUnbalance>) -> RotorModel {
     TwoSupportRotor {
-        mass: 1.0,
-        transverse_inertia: 1.0,
-        polar_inertia: 0.2,
-        k1: 1.0,
-        l1: 2.0,
-        k2: 1.0,
-        l2: 2.0,
-        b1: 0.05,
-        b2: 0.05,
-        planes,
-        static_unbalance: 0.0,
-        static_angle: 0.0,
-        moment_unbalance: 0.0,
-        moment_angle: 0.0,
         unbalances,
-        weights_tilt_inertia: false,
+        ..crate::fixtures::long_rotor(planes)
     }
     .into()
 }

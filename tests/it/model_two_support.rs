@@ -19,28 +19,7 @@ use autobal::model::system::RotorSystem;
 use autobal::scene_file::SceneFile;
 use autobal::simulation::{Simulation, SolverSettings};
 
-/// A long rotor (A > C) with symmetric supports and tilt stiffness well above
-/// the translational one: ω1 = √2, ω2 = √10 and well-separated ranges.
-fn long_rotor(planes: Vec<f64>) -> TwoSupportRotor {
-    TwoSupportRotor {
-        mass: 1.0,
-        transverse_inertia: 1.0,
-        polar_inertia: 0.2,
-        k1: 1.0,
-        l1: 2.0,
-        k2: 1.0,
-        l2: 2.0,
-        b1: 0.05,
-        b2: 0.05,
-        planes,
-        static_unbalance: 0.0,
-        static_angle: 0.0,
-        moment_unbalance: 0.0,
-        moment_angle: 0.0,
-        unbalances: Vec::new(),
-        weights_tilt_inertia: false,
-    }
-}
+use crate::fixtures::long_rotor;
 
 fn balls(n: usize, mass: f64, drag: f64, plane: usize) -> Vec<Cargo> {
     (0..n)
