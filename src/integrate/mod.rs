@@ -54,6 +54,34 @@ pub trait OdeSystem {
     fn coupling_structure(&self, _t: f64, _y: &[f64], _out: &mut CouplingStructure) -> bool {
         false
     }
+    /// For a system with a [`CouplingStructure`]: write its head equation
+    /// at (t, y), f(t, y) = `f`, into `out` and return true, or return false
+    /// (the default) to let implicit methods take ∂z/∂(q, q̇) by directional
+    /// differences of the right-hand side, which cost a call per use.
+    fn head_equation(&self, _t: f64, _y: &[f64], _f: &[f64], _out: &mut HeadEquation) -> bool {
+        false
+    }
+}
+
+/// The head rows of a second-order system with a [`CouplingStructure`],
+///
+///   M_h·z + Σ_i e_i·a_i = F_h(q, q̇),
+///
+/// linearised in the ring coordinates: with it, implicit methods form
+/// ∂z/∂(q, q̇) from the local Jacobian (whose differences they take anyway)
+/// instead of taking it by extra right-hand-side calls. M_h, e_i and F_h may
+/// depend on the state, but each ring coordinate's terms in
+/// F_h − M_h·z − Σ e_i·a_i only on that coordinate and the head: forces
+/// between weights reach the head through their accelerations alone.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct HeadEquation {
+    /// M_h at (t, y), row-major, head × head.
+    pub mass: Vec<f64>,
+    /// e_i, `head` entries per coordinate head..m, in coordinate order.
+    pub reaction: Vec<f64>,
+    /// ∂(F_h − M_h·z − Σ e_j·a_j)/∂q_i, then ∂/∂q̇_i, at fixed accelerations
+    /// (z and a): 2·`head` entries per coordinate head..m, in coordinate order.
+    pub own: Vec<f64>,
 }
 
 /// How the m accelerations a = q̈ of a second-order system couple: the first

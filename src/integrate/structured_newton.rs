@@ -12,21 +12,22 @@
 //!   to T = c₀·I − L_q̇ − c₁·L_q: tridiagonal along the rings (LAPACK's
 //!   gttrf/gttrs, partial pivoting) plus the head columns and each ring's
 //!   closing corners, whose rows of Qᵀ are unit vectors: exact.
-//! - The outer correction has `head` columns; its rows ∂z/∂(q, q̇) are never
-//!   formed but act on a vector as one directional difference of z (two
-//!   for a complex vector).
+//! - The outer correction has `head` columns. Its rows ∂z/∂(q, q̇) are
+//!   formed from L when the system states its head equation
+//!   ([`HeadEquation`]); otherwise they act on a vector as one directional
+//!   difference of z (two for a complex vector).
 //!
 //! Costs for m coordinates, all O(m) where the dense matrices take O(m²) per
 //! Jacobian and O(m³) per factorisation: a Jacobian (L by forward
 //! differences over colour groups, columns no row sees twice) takes
-//! 2·(head + 3 or 4) RHS calls whatever m (5 for a ring of five), against 2m; a factorisation
-//! of both matrices 3·head RHS calls; a real solve one and a complex solve
-//! two.
+//! 2·(head + 3 or 4) RHS calls whatever m (5 for a ring of five), against
+//! 2m. Without a head equation a factorisation of both matrices takes
+//! 3·head RHS calls more, a real solve one and a complex solve two.
 //!
 //! Written by hand: no Rust crate offers a tridiagonal-plus-low-rank solve,
 //! and the matrix-free correction is specific to this structure.
 
-use super::{CouplingStructure, OdeSystem, Stats};
+use super::{CouplingStructure, HeadEquation, OdeSystem, Stats};
 use num_complex::Complex64;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -133,6 +134,14 @@ struct Local {
     colours: usize,
     dq: LocalHalf,
     dqd: LocalHalf,
+    /// The system's head equation, when it gives one.
+    head_eq: HeadEquation,
+    /// Whether `head_rows` holds ∂z/∂(q, q̇) in full (from the head
+    /// equation); else only its head columns, and the ring columns act by
+    /// directional differences.
+    explicit: bool,
+    /// ∂z/∂(q, q̇), row-major, `head` rows of 2m in coordinate order.
+    head_rows: Vec<f64>,
 }
 
 impl Local {
@@ -215,6 +224,70 @@ impl Local {
             s = e;
         }
         s == n
+    }
+
+    /// The ring columns of ∂z/∂(q, q̇) from the head equation and L: with
+    /// A = M_h + Σ e_i·U_iᵀ (the head's matrix once the weights are
+    /// eliminated), A·∂z/∂y_j = own_j − Σ_i e_i·L_ij over the rows i that
+    /// see column j. False if the equation is malformed or A singular.
+    fn form_head_rows(&mut self) -> bool {
+        let (m, h, n) = (self.m, self.head(), self.positions());
+        let eq = &self.head_eq;
+        if eq.mass.len() != h * h || eq.reaction.len() != n * h || eq.own.len() != 2 * n * h {
+            return false;
+        }
+        let mut a = [0.0; MAX_HEAD * MAX_HEAD];
+        let a = &mut a[..h * h];
+        a.copy_from_slice(&eq.mass);
+        let u = &self.structure.coupling;
+        for (e, u) in eq.reaction.chunks_exact(h).zip(u.chunks_exact(h)) {
+            for r in 0..h {
+                for c in 0..h {
+                    a[r * h + c] += e[r] * u[c];
+                }
+            }
+        }
+        let mut piv = Vec::with_capacity(h);
+        if !small_lu(a, &mut piv, h) {
+            return false;
+        }
+        let mut rows = std::mem::take(&mut self.head_rows);
+        for (half, l) in [(0, &self.dq), (1, &self.dqd)] {
+            let off = half * m;
+            for i in h..m {
+                for r in 0..h {
+                    rows[r * 2 * m + off + i] = eq.own[(i - h) * 2 * h + half * h + r];
+                }
+            }
+            for p in 0..n {
+                let i = self.structure.order[p];
+                let e = &eq.reaction[(i - h) * h..(i - h + 1) * h];
+                let seen = [
+                    Some((p, l.diag[p])),
+                    self.left(p).map(|q| (q, l.left[p])),
+                    self.right(p).map(|q| (q, l.right[p])),
+                ];
+                for (q, lij) in seen.into_iter().flatten() {
+                    let j = off + self.structure.order[q];
+                    for (r, &er) in e.iter().enumerate() {
+                        rows[r * 2 * m + j] -= er * lij;
+                    }
+                }
+            }
+            let mut col = [0.0; MAX_HEAD];
+            for i in h..m {
+                for r in 0..h {
+                    col[r] = rows[r * 2 * m + off + i];
+                }
+                small_solve(a, &piv, h, &mut col[..h]);
+                for r in 0..h {
+                    rows[r * 2 * m + off + i] = col[r];
+                }
+            }
+        }
+        let finite = rows.iter().all(|v| v.is_finite());
+        self.head_rows = rows;
+        finite
     }
 }
 
@@ -480,11 +553,10 @@ impl<S: Scalar> Shifted<S> {
         self.k_out.resize(h * h, zero);
         for r in 0..h {
             head_derivative(
+                local,
                 probe,
                 system,
                 stats,
-                m,
-                h,
                 &self.z_out[r * 2 * m..(r + 1) * 2 * m],
             );
             for i in 0..h {
@@ -558,7 +630,7 @@ impl<S: Scalar> Shifted<S> {
         let (m, h) = (local.m, local.head());
         let mut x = std::mem::take(&mut self.x);
         self.solve_s(local, &mut x);
-        head_derivative(probe, system, stats, m, h, &x);
+        head_derivative(local, probe, system, stats, &x);
         let mut t = [S::from(0.0); MAX_HEAD];
         for (i, t) in t.iter_mut().enumerate().take(h) {
             *t = read_head(probe, i);
@@ -575,13 +647,26 @@ impl<S: Scalar> Shifted<S> {
 
 /// ∂z/∂y·x into the probe's parts (one real part per [`Scalar::PARTS`]).
 fn head_derivative<S: Scalar, Sys: OdeSystem + ?Sized>(
+    local: &Local,
     probe: &mut Probe,
     system: &Sys,
     stats: &mut Stats,
-    m: usize,
-    h: usize,
     x: &[S],
 ) {
+    let (m, h) = (local.m, local.head());
+    if local.explicit {
+        for k in 0..S::PARTS {
+            let part = &mut probe.parts[k];
+            part.clear();
+            part.extend(local.head_rows.chunks_exact(2 * m).map(|row| {
+                row.iter()
+                    .zip(x)
+                    .map(|(q, &v)| q * S::part(v, k))
+                    .sum::<f64>()
+            }));
+        }
+        return;
+    }
     for k in 0..S::PARTS {
         for (d, &v) in probe.dir.iter_mut().zip(x) {
             *d = S::part(v, k);
@@ -769,6 +854,8 @@ impl StructuredNewton {
         probe.at(t, y, f0);
         local.dq.reset(n, h);
         local.dqd.reset(n, h);
+        local.head_rows.clear();
+        local.head_rows.resize(h * 2 * m, 0.0);
         // Δz of one evaluation (head ≤ a few coordinates).
         let mut dz = [0.0; MAX_HEAD];
         let dz = &mut dz[..h];
@@ -781,6 +868,9 @@ impl StructuredNewton {
                 probe.y[off + c] += delta;
                 probe.eval(system, stats);
                 probe.head_change(m, dz);
+                for (r, d) in dz.iter().enumerate() {
+                    local.head_rows[r * 2 * m + off + c] = d / delta;
+                }
                 for p in 0..n {
                     let v = local_change(local, probe, dz, p) / delta;
                     let target = if half == 0 {
@@ -825,6 +915,8 @@ impl StructuredNewton {
                 }
             }
         }
+        local.explicit =
+            system.head_equation(t, y, f0, &mut local.head_eq) && local.form_head_rows();
         true
     }
 
@@ -924,6 +1016,8 @@ mod tests {
         /// Weight indices, ring after ring, and where each ring ends.
         order: Vec<usize>,
         ends: Vec<usize>,
+        /// Whether it gives its head equation.
+        head_equation: bool,
     }
 
     impl Rings {
@@ -949,6 +1043,9 @@ mod tests {
         }
         fn coupling(&self, psi: f64) -> [f64; 2] {
             [0.3 * psi.sin(), -0.3 * psi.cos()]
+        }
+        fn coupling_slope(&self, psi: f64) -> [f64; 2] {
+            [0.3 * psi.cos(), 0.3 * psi.sin()]
         }
     }
 
@@ -1009,6 +1106,38 @@ mod tests {
             out.ring_ends = self.ends.clone();
             true
         }
+        /// With local_j = a_j − c_j·z the head rows read
+        /// (M + 2Σ c cᵀ)·z − Σ c_j·a_j = g₀ + Σ 0.1 ψ̇_j² (c_j1, c_j0).
+        fn head_equation(&self, _t: f64, y: &[f64], f: &[f64], out: &mut HeadEquation) -> bool {
+            if !self.head_equation {
+                return false;
+            }
+            let m = 2 + self.n();
+            let z = [f[m], f[m + 1]];
+            let mut mass = [5.0, 0.2, 0.2, 4.0];
+            out.reaction.clear();
+            out.own.clear();
+            for j in 0..self.n() {
+                let (psi, rate, accel) = (y[2 + j], y[m + 2 + j], f[m + 2 + j]);
+                let (c, dc) = (self.coupling(psi), self.coupling_slope(psi));
+                for r in 0..2 {
+                    for s in 0..2 {
+                        mass[r * 2 + s] += 2.0 * c[r] * c[s];
+                    }
+                }
+                out.reaction.extend([-c[0], -c[1]]);
+                let (cz, dcz) = (c[0] * z[0] + c[1] * z[1], dc[0] * z[0] + dc[1] * z[1]);
+                for r in 0..2 {
+                    let swapped = 0.1 * rate * rate * dc[1 - r];
+                    out.own
+                        .push(swapped - 2.0 * (dc[r] * cz + c[r] * dcz) + dc[r] * accel);
+                }
+                out.own.extend([0.2 * rate * c[1], 0.2 * rate * c[0]]);
+            }
+            out.mass.clear();
+            out.mass.extend(mass);
+            true
+        }
     }
 
     fn state(n: usize) -> Vec<f64> {
@@ -1063,8 +1192,8 @@ mod tests {
 
     /// The structured matrices at (γ, α, β) solve the real and the complex
     /// Newton systems of the exact Jacobian to `tol`; returns the RHS calls
-    /// of the Jacobian alone.
-    fn solves(system: &Rings, shifts: (f64, f64, f64), tol: f64) -> u64 {
+    /// of the Jacobian, then of the factorisations and solves.
+    fn solves(system: &Rings, shifts: (f64, f64, f64), tol: f64) -> (u64, u64) {
         let y = state(system.n());
         let dim = y.len();
         let mut f0 = vec![0.0; dim];
@@ -1090,7 +1219,7 @@ mod tests {
             real < tol && complex < tol,
             "shifts {shifts:?}: residuals {real:e}, {complex:e} (tolerance {tol:e})"
         );
-        jacobian_calls
+        (jacobian_calls, stats.rhs_calls - jacobian_calls)
     }
 
     /// Shifts (γ, α, β)/h of a step with h·‖J‖ about 0.05 and about 50 (the
@@ -1102,26 +1231,34 @@ mod tests {
     const SHIFTS: [((f64, f64, f64), f64); 2] =
         [((360.0, 270.0, -190.0), 1e-6), ((0.36, 0.27, -0.19), 3e-4)];
 
-    #[test]
-    fn one_ring_in_shuffled_order_solves_the_newton_systems() {
-        let system = Rings {
-            order: vec![3, 0, 7, 5, 1, 9, 2, 8, 4, 6, 10],
-            ends: vec![11],
-        };
-        for (shifts, tol) in SHIFTS {
-            solves(&system, shifts, tol);
+    /// Both ways of applying ∂z/∂(q, q̇) solve the Newton systems of
+    /// `order` and `ends`; with the head equation the factorisations and
+    /// solves call the right-hand side no more (3·2 + 1 + 2 calls without).
+    fn solves_either_way(order: Vec<usize>, ends: Vec<usize>) {
+        for head_equation in [false, true] {
+            let system = Rings {
+                order: order.clone(),
+                ends: ends.clone(),
+                head_equation,
+            };
+            for (shifts, tol) in SHIFTS {
+                let (_, later) = solves(&system, shifts, tol);
+                assert_eq!(later, if head_equation { 0 } else { 9 });
+            }
         }
     }
 
     #[test]
+    fn one_ring_in_shuffled_order_solves_the_newton_systems() {
+        solves_either_way(vec![3, 0, 7, 5, 1, 9, 2, 8, 4, 6, 10], vec![11]);
+    }
+
+    #[test]
     fn two_rings_a_pair_and_single_weights_solve_the_newton_systems() {
-        let system = Rings {
-            order: vec![0, 2, 4, 6, 1, 3, 5, 7, 8, 9, 10, 11],
-            ends: vec![4, 8, 10, 11, 12],
-        };
-        for (shifts, tol) in SHIFTS {
-            solves(&system, shifts, tol);
-        }
+        solves_either_way(
+            vec![0, 2, 4, 6, 1, 3, 5, 7, 8, 9, 10, 11],
+            vec![4, 8, 10, 11, 12],
+        );
     }
 
     #[test]
@@ -1129,13 +1266,14 @@ mod tests {
         let ring = |n: usize| Rings {
             order: (0..n).collect(),
             ends: vec![n],
+            head_equation: false,
         };
         // 2·(head + colours): 2·(2 + 4) for rings of 10 and 200, whose
         // lengths are not multiples of 3, and 2·(2 + 3) for one of 201.
         let (shifts, tol) = SHIFTS[0];
-        assert_eq!(solves(&ring(10), shifts, tol), 12);
-        assert_eq!(solves(&ring(200), shifts, tol), 12);
-        assert_eq!(solves(&ring(201), shifts, tol), 10);
+        assert_eq!(solves(&ring(10), shifts, tol).0, 12);
+        assert_eq!(solves(&ring(200), shifts, tol).0, 12);
+        assert_eq!(solves(&ring(201), shifts, tol).0, 10);
     }
 
     #[test]

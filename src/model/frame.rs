@@ -20,7 +20,7 @@ use super::rotor::PlaneRotor;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
-use crate::integrate::{CouplingStructure, OdeSystem};
+use crate::integrate::{CouplingStructure, HeadEquation, OdeSystem};
 use std::cell::RefCell;
 
 /// Why a scene cannot use the rotating frame.
@@ -148,6 +148,35 @@ impl OdeSystem for RotatingSystem {
             out.coupling.extend([ml * s / inertia, -ml * co / inertia]);
         }
         super::coupling::cargo_rings(&self.cargo, psi, 2, out)
+    }
+
+    fn head_equation(&self, _t: f64, y: &[f64], f: &[f64], out: &mut HeadEquation) -> bool {
+        if self.effects.iter().any(|e| e.rotor_forces_from_weights()) {
+            return false;
+        }
+        let n = self.cargo.len();
+        let nq = 2 + n;
+        // M_Σ·a + Σ w_j ψ̈_j = G, w_j = m l (−sin ψ_j, cos ψ_j); weight j's
+        // own terms in G − Σ w ψ̈: m l (ω + ψ̇_j)² (cos ψ_j, sin ψ_j) − w_j ψ̈_j.
+        out.mass.clear();
+        out.mass.extend([self.m_total, 0.0, 0.0, self.m_total]);
+        out.reaction.clear();
+        out.own.clear();
+        let (psi, psi_rate, psi_accel) = (&y[2..nq], &y[nq + 2..], &f[nq + 2..]);
+        let per_cargo = psi.iter().zip(psi_rate).zip(psi_accel);
+        for (((&p, &p_rate), &accel), &ml) in per_cargo.zip(&self.mass_track) {
+            let (s, co) = super::trig::sin_cos(p);
+            let rate = self.omega + p_rate;
+            let centrifugal = ml * rate * rate;
+            out.reaction.extend([-ml * s, ml * co]);
+            out.own.extend([
+                -centrifugal * s + ml * accel * co,
+                centrifugal * co + ml * accel * s,
+                2.0 * ml * rate * co,
+                2.0 * ml * rate * s,
+            ]);
+        }
+        true
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {

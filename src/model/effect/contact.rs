@@ -193,6 +193,11 @@ impl Effect for Contact {
             self.neighbours(ctx, forces);
         }
     }
+
+    fn rotor_forces_from_weights(&self) -> bool {
+        // Equal and opposite between two weights: nothing on the rotor.
+        false
+    }
 }
 
 #[cfg(test)]

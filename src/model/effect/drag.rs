@@ -47,4 +47,9 @@ impl Effect for Drag {
         }
         *forces.spin = spin;
     }
+
+    fn rotor_forces_from_weights(&self) -> bool {
+        // A torque on the spin and the weights only.
+        false
+    }
 }

@@ -75,4 +75,9 @@ impl Effect for Gravity {
             *forces.spin -= me * g * crate::model::trig::cos(ctx.phi + angle);
         }
     }
+
+    fn rotor_forces_from_weights(&self) -> bool {
+        // On the weights and the spin only.
+        false
+    }
 }

@@ -58,6 +58,14 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn name(&self) -> &'static str;
     /// Add this effect's forces for the given state.
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>);
+    /// Whether the forces it writes on the rotor coordinates depend on the
+    /// weights' states: the rotor's head equation then has weight terms only
+    /// the effect knows, and implicit solvers take them by differences. The
+    /// default, true, is always safe; an effect that writes no such force
+    /// says false and lets them form the head rows exactly.
+    fn rotor_forces_from_weights(&self) -> bool {
+        true
+    }
 }
 
 /// What an effect may need to know of the rest of the scene to accept it.

@@ -133,6 +133,11 @@ impl Effect for RollingTorque {
         }
         *forces.spin = spin;
     }
+
+    fn rotor_forces_from_weights(&self) -> bool {
+        // A torque on the spin and the weights only.
+        false
+    }
 }
 
 #[cfg(test)]
