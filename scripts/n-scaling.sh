@@ -30,18 +30,24 @@ for n in "${ns[@]}"; do
 done
 
 "$python" - "$out" "${ns[@]}" <<'EOF'
+import math
 import sys
 from collections import Counter
 import pyarrow.parquet as pq
 
 out, ns = sys.argv[1], sys.argv[2:]
-print("| n | ms per run | RHS calls per run | steps per run | µs per step and weight | settled | method |")
-print("| ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+print("| n | ms per run | RHS calls per run | steps per run | µs per step and weight "
+      "| revolutions per run | µs per revolution and weight | settled | method |")
+print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
 for n in ns:
     t = pq.read_table(f"{out}/n{n}/runs.parquet").to_pydict()
     k = len(t["wall_time_s"])
+    wall = sum(t["wall_time_s"])
+    # Simulated revolutions (the speed is constant): settled runs stop early.
+    revs = sum(tf * w / (2 * math.pi) for tf, w in zip(t["t_final"], t["final_spin_rate"]))
     methods = ", ".join(f"{m} {c}" for m, c in Counter(t["method"]).most_common())
-    print(f"| {n} | {1e3 * sum(t['wall_time_s']) / k:,.2f} | {sum(t['rhs_calls']) / k:,.0f} "
-          f"| {sum(t['steps']) / k:,.0f} | {1e6 * sum(t['wall_time_s']) / sum(t['steps']) / int(n):.2f} "
+    print(f"| {n} | {1e3 * wall / k:,.2f} | {sum(t['rhs_calls']) / k:,.0f} "
+          f"| {sum(t['steps']) / k:,.0f} | {1e6 * wall / sum(t['steps']) / int(n):.2f} "
+          f"| {revs / k:,.0f} | {1e6 * wall / revs / int(n):.2f} "
           f"| {100 * sum(t['settled']) / k:.0f} % | {methods} |".replace(",", " "))
 EOF
