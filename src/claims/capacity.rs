@@ -60,6 +60,7 @@ pub fn capacity_experiment(base: &StudyPlan, ns: &[u32]) -> Vec<CapacityPoint> {
         .collect();
     points
         .par_iter()
+        .with_max_len(1) // one simulation per job, as runs (study::run)
         .filter_map(|&(kind, n, rho)| {
             let spec = DesignSpec {
                 kind,

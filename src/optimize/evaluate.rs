@@ -154,9 +154,10 @@ impl Evaluator<'_> {
     /// random numbers), and are reduced in index order, so the estimate does
     /// not depend on the thread count.
     fn simulate(&self, design: &Design, objective: Objective) -> (f64, f64) {
-        let metrics: Vec<_> = (0..u64::from(self.samples))
+        let metrics: Vec<_> = (0..self.samples)
             .into_par_iter()
-            .map(|k| run_design_sample(self.plan, design, k, k).metrics)
+            .with_max_len(1) // one simulation per job, as runs (study::run)
+            .map(|k| run_design_sample(self.plan, design, k.into(), k.into()).metrics)
             .collect();
         let n = metrics.len() as f64;
         let mean_se = |v: &[f64]| {

@@ -194,6 +194,7 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
     }
     let results: Vec<_> = cells
         .par_iter()
+        .with_max_len(1) // one search per job, as runs (study::run)
         .map(|&(kind, n)| (kind, n, search::search(&evaluator, kind, n, drag)))
         .collect();
     let mut evaluations = Vec::new();

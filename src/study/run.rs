@@ -571,13 +571,22 @@ fn execute(
                         return;
                     }
                     let order = designs_interleaved(block, plan.file.sampling.samples);
-                    order.par_iter().for_each_with(tx.clone(), |tx, &id| {
-                        if cancelled() {
-                            return;
-                        }
-                        // The receiver only disappears if writing failed; the error is reported there.
-                        let _ = tx.send(run_one(plan, id));
-                    });
+                    // One run per job (and one item per job wherever items
+                    // are simulations): rayon otherwise runs a quarter of the
+                    // block as one sequential piece per thread, and the
+                    // thread that finishes first waits for the other's rest
+                    // (1 000 runs at 2 threads: 1.68× → 1.82×). A run costs
+                    // far more than a job.
+                    order
+                        .par_iter()
+                        .with_max_len(1)
+                        .for_each_with(tx.clone(), |tx, &id| {
+                            if cancelled() {
+                                return;
+                            }
+                            // The receiver only disappears if writing failed; the error is reported there.
+                            let _ = tx.send(run_one(plan, id));
+                        });
                 }
             };
             match pool {

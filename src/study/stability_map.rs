@@ -36,6 +36,7 @@ pub fn stability_map(
         .flat_map(|&u| omegas.iter().map(move |&w| (w, u)))
         .collect();
     grid.par_iter()
+        .with_max_len(1) // one analysis per job, as runs (study::run)
         .map(|&(omega, unbalance)| {
             let mut scene = template.clone();
             scene.speed = SpeedLaw::Constant { omega };

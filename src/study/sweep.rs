@@ -70,6 +70,7 @@ fn closed_form(rotor: &RotorModel, omega: f64) -> Option<bool> {
 pub fn run_sweep(template: &Simulation, speeds: &[f64]) -> Result<Vec<SweepPoint>, SceneError> {
     speeds
         .par_iter()
+        .with_max_len(1) // one simulation per job, as runs (study::run)
         .map(|&omega| {
             let mut sim = template.clone();
             sim.scene.speed = SpeedLaw::Constant { omega };

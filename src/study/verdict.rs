@@ -270,6 +270,7 @@ pub fn best_versus_rest(
     // keeps the order, so the result does not depend on the thread count.
     let comparisons: Vec<Comparison> = designs
         .par_iter()
+        .with_max_len(1) // one comparison per job, as runs (study::run)
         .filter(|d| d.design_id != best.design_id)
         .map(|d| compare(best, d, paired, seed))
         .collect();
