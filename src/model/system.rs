@@ -17,7 +17,7 @@ use super::effect::{Effect, EffectContext, Forces};
 use super::rotor::{DofVec, MAX_DOF, Rotor};
 use super::speed::SpeedLaw;
 use super::tilt_inertia::TiltTerms;
-use crate::integrate::{CouplingStructure, OdeSystem};
+use crate::integrate::{CouplingStructure, HeadEquation, OdeSystem};
 
 /// Largest head block: rotor coordinates plus the spin angle.
 const MAX_HEAD: usize = MAX_DOF + 1;
@@ -242,6 +242,45 @@ impl OdeSystem for RotorSystem {
             }
         }
         super::coupling::cargo_rings(&self.cargo, &q[head..], head, out)
+    }
+
+    fn head_equation(&self, t: f64, y: &[f64], f: &[f64], out: &mut HeadEquation) -> bool {
+        // A free spin and the tilt terms add head terms of their own, and
+        // so does an effect that loads the rotor from the weights: those
+        // scenes keep the directional differences.
+        let lay = self.layout;
+        if lay.spin_free
+            || self.tilt_maps.iter().any(Option::is_some)
+            || self.effects.iter().any(|e| e.rotor_forces_from_weights())
+        {
+            return false;
+        }
+        let (k, nq) = (lay.rotor_dof, lay.nq());
+        let (phi, spin_rate, spin_accel) = self.speed.prescribed(t);
+        // head_mass·z + Σ w_j ψ̈_j = F with w_j = m l (cos φ_j G_v − sin φ_j G_u);
+        // weight j's own terms in F − Σ w ψ̈: m l φ̇_j² (cos φ_j G_u + sin φ_j G_v)
+        // − w_j (φ̈ + ψ̈_j), φ_j = φ + ψ_j.
+        out.mass.clear();
+        for row in &self.head_mass[..k] {
+            out.mass.extend_from_slice(&row[..k]);
+        }
+        out.reaction.clear();
+        out.own.clear();
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = super::trig::sin_cos(phi + y[k + j]);
+            let ml = c.mass * c.track_radius;
+            let [gu, gv] = &self.plane_maps[c.plane];
+            let rate = spin_rate + y[nq + k + j];
+            let accel = spin_accel + f[nq + k + j];
+            out.reaction
+                .extend((0..k).map(|i| ml * (co * gv[i] - s * gu[i])));
+            out.own.extend((0..k).map(|i| {
+                ml * rate * rate * (co * gv[i] - s * gu[i]) + ml * accel * (co * gu[i] + s * gv[i])
+            }));
+            out.own
+                .extend((0..k).map(|i| 2.0 * ml * rate * (co * gu[i] + s * gv[i])));
+        }
+        true
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {

@@ -169,7 +169,7 @@ fn head_equation_violation(system: &dyn OdeSystem, t: f64, y: &[f64]) -> Option<
 }
 
 #[test]
-fn the_rotating_frame_gives_its_head_equation_truly_unless_an_effect_loads_the_rotor() {
+fn rotor_systems_give_their_head_equations_truly_or_not_at_all() {
     let n = 24;
     let text = packed_chain_of(n, "radau5");
     let parse = |text: &str| {
@@ -179,20 +179,81 @@ fn the_rotating_frame_gives_its_head_equation_truly_unless_an_effect_loads_the_r
             .expect("simulation")
             .scene
     };
+    let scene = parse(&text);
     let mut seed = 5u64;
-    let y = state(2, 2 + n, &pressed(n, 180.0 / n as f64, &mut seed));
-    let rotating = RotatingSystem::new(&parse(&text)).expect("rotating frame");
-    let violation = head_equation_violation(&rotating, 0.3, &y).expect("a head equation");
-    eprintln!("largest violation of the head equation: {violation:e}");
-    // Measured 2.2e-6, rounding in the differences (it grows as 1/step
-    // below this step); the weight's acceleration term left out of `own`
-    // gives 7.6e-3, a coefficient 5 % off 1.9e-2.
-    assert!(violation < 1e-4, "{violation:e}");
-    // An off-centre race writes rotor forces from the weights' angles.
+    let angles = pressed(n, 180.0 / n as f64, &mut seed);
+    let y = state(2, 2 + n, &angles);
+    let rotating = RotatingSystem::new(&scene).expect("rotating frame");
+    let inertial = scene.build().expect("system");
+    // Two planes of twelve on a rigid rotor, without and with tilt inertia.
+    let two_planes = |tilt: bool| {
+        let rotor = TwoSupportRotor {
+            weights_tilt_inertia: tilt,
+            ..crate::fixtures::long_rotor(vec![-1.0, 1.0])
+        };
+        let cargo: Vec<Cargo> = (0..n)
+            .map(|j| Cargo {
+                plane: j % 2,
+                radius: (7.5f64).to_radians().sin(),
+                ..Cargo::point(0.01, 1.0, 0.02, 1.4)
+            })
+            .collect();
+        let effects: Vec<Box<dyn Effect>> = vec![Box::new(
+            Contact::new(&ContactSpec::default(), &cargo, 3.0).expect("sized weights"),
+        )];
+        RotorSystem::new(
+            Box::new(rotor),
+            cargo,
+            SpeedLaw::Constant { omega: 3.0 },
+            effects,
+        )
+    };
+    let mut plane_angles = vec![0.0; n];
+    for (k, a) in pressed(n / 2, 15.0, &mut seed).into_iter().enumerate() {
+        plane_angles[2 * k] = a;
+        plane_angles[2 * k + 1] = a + 0.01;
+    }
+    let head = crate::fixtures::long_rotor(vec![-1.0, 1.0]).dof();
+    let y_planes = state(head, head + n, &plane_angles);
+    let violations = [
+        ("rotating", head_equation_violation(&rotating, 0.3, &y)),
+        ("inertial", head_equation_violation(&inertial, 0.3, &y)),
+        (
+            "two planes",
+            head_equation_violation(&two_planes(false), 0.3, &y_planes),
+        ),
+    ];
+    eprintln!("largest violations of the head equations: {violations:?}");
+    for (system, violation) in violations {
+        let violation = violation.expect("a head equation");
+        // Measured 2.2e-6 (rotating), rounding in the differences (it grows
+        // as 1/step below this step); the weight's acceleration term left
+        // out of the rotating frame's `own` gives 7.6e-3, a coefficient 5 %
+        // off 1.9e-2.
+        assert!(violation < 1e-4, "{system}: {violation:e}");
+    }
+    // Head terms the systems leave to directional differences: an
+    // off-centre race (rotor forces from the weights' angles), a free
+    // spin, the weights' tilt inertia.
     let off_centre =
         format!("{text}\n[effects.race_eccentricity]\noffset = 1e-4\nangle_deg = 30\n");
     let rotating = RotatingSystem::new(&parse(&off_centre)).expect("rotating frame");
     assert_eq!(head_equation_violation(&rotating, 0.3, &y), None);
+    let mut motor_scene = scene.clone();
+    motor_scene.speed = SpeedLaw::Motor {
+        stall_torque: 20.0,
+        omega_sync: 300.0,
+        omega_start: 250.0,
+    };
+    let mut y_motor = state(3, 3 + n, &angles);
+    y_motor[2] = 0.7;
+    y_motor[3 + n + 2] = 240.0;
+    let motor = motor_scene.build().expect("system");
+    assert_eq!(head_equation_violation(&motor, 0.3, &y_motor), None);
+    assert_eq!(
+        head_equation_violation(&two_planes(true), 0.3, &y_planes),
+        None
+    );
 }
 
 /// Packed angles (rad) a little less than `spacing_deg` apart, so that
