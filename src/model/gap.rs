@@ -142,10 +142,11 @@ impl GapGauge {
     /// still in the ring's order: each pair's angle along the ring, carried
     /// from `psi0` by the change of its two angles, stays above half the
     /// smallest α. Then the neighbours are the same pairs, so the minimum
-    /// over them is the one [`GapGauge::min_gap_of_ring_pairs`] would give, bit
-    /// for bit, without sorting. The angles along the ring move on to
-    /// `psi` and `pairs` takes the new gaps. None (nothing changed) if the
-    /// order may have changed or an overlap needs every pair.
+    /// over them is the one [`GapGauge::min_gap_of_ring_pairs`] would give,
+    /// bit for bit, without sorting. The angles along the ring move on to
+    /// `psi` and `pairs` takes the new gaps. None if the order may have
+    /// changed or an overlap needs every pair: then `pairs` and `ring` are
+    /// the caller's to measure afresh.
     fn min_gap_in_same_order(
         &self,
         psi0: &[f64],
@@ -158,29 +159,21 @@ impl GapGauge {
             let j = self.sized[a as usize].0;
             psi[j] - psi0[j]
         };
-        let mut still = true;
-        for &(from, to, along) in ring.iter() {
-            // NaN fails the test: a NaN angle goes the full way.
-            still &= along + (moved(to) - moved(from)) > margin;
-        }
-        if !still {
-            return None;
-        }
+        // On None the caller measures afresh, rebuilding `pairs` and `ring`.
         let mut smallest = f64::INFINITY;
-        for &(from, to, _) in ring.iter() {
-            let (a, b) = (from.min(to) as usize, from.max(to) as usize);
-            smallest = smallest.min(self.pair_gap(a, b, psi));
-        }
-        if smallest < -self.smallest_half_angle {
-            return None;
-        }
         for (pair, entry) in pairs.iter_mut().zip(ring.iter_mut()) {
             let (from, to, along) = *entry;
+            let along = along + (moved(to) - moved(from));
+            // A NaN angle goes the full way too.
+            if along <= margin || along.is_nan() {
+                return None;
+            }
+            entry.2 = along;
             let (a, b) = (from.min(to) as usize, from.max(to) as usize);
             pair.2 = self.pair_gap(a, b, psi);
-            entry.2 = along + (moved(to) - moved(from));
+            smallest = smallest.min(pair.2);
         }
-        Some(smallest)
+        (smallest >= -self.smallest_half_angle).then_some(smallest)
     }
 
     /// Every pair of one plane: O(n²).
