@@ -142,6 +142,8 @@ struct Local {
     explicit: bool,
     /// ∂z/∂(q, q̇), row-major, `head` rows of 2m in coordinate order.
     head_rows: Vec<f64>,
+    /// Row interchanges of the head's eliminated matrix (scratch).
+    head_piv: Vec<usize>,
 }
 
 impl Local {
@@ -247,10 +249,13 @@ impl Local {
                 }
             }
         }
-        let mut piv = Vec::with_capacity(h);
-        if !small_lu(a, &mut piv, h) {
+        let mut piv = std::mem::take(&mut self.head_piv);
+        let factored = small_lu(a, &mut piv, h);
+        self.head_piv = piv;
+        if !factored {
             return false;
         }
+        let piv = &self.head_piv;
         let mut rows = std::mem::take(&mut self.head_rows);
         for (half, l) in [(0, &self.dq), (1, &self.dqd)] {
             let off = half * m;
@@ -279,7 +284,7 @@ impl Local {
                 for r in 0..h {
                     col[r] = rows[r * 2 * m + off + i];
                 }
-                small_solve(a, &piv, h, &mut col[..h]);
+                small_solve(a, piv, h, &mut col[..h]);
                 for r in 0..h {
                     rows[r * 2 * m + off + i] = col[r];
                 }
