@@ -377,6 +377,21 @@ mod tests {
     use crate::model::race_ring::uniform;
     use std::f64::consts::TAU;
 
+    /// n balls dealt to `planes` planes, each plane's race (radius 0.05)
+    /// 90 % full at the largest size, the sizes spread over the fraction
+    /// `spread` below it.
+    fn mixed_balls(n: usize, planes: usize, spread: f64) -> Vec<Cargo> {
+        let per_plane = n.div_ceil(planes) as f64;
+        let base = 0.05 * (0.9 * std::f64::consts::PI / per_plane).sin();
+        (0..n)
+            .map(|j| Cargo {
+                radius: base * (1.0 - spread + spread * ((j * 7) % 5) as f64 / 4.0),
+                plane: j % planes,
+                ..Cargo::point(0.01, 0.05, 0.1, 1.4)
+            })
+            .collect()
+    }
+
     /// Beyond eight weights the gauge measures neighbours only; on packed
     /// states (overlapping, touching, apart), mixed sizes, one or two
     /// planes and angles many turns out, it gives the all-pairs minimum bit
@@ -387,15 +402,7 @@ mod tests {
         let (mut fast, mut fallback) = (0, 0);
         for n in [9_usize, 16, 33, 64, 200] {
             for planes in [1, 2] {
-                let per_plane = n.div_ceil(planes) as f64;
-                let base = 0.05 * (0.9 * std::f64::consts::PI / per_plane).sin();
-                let cargo: Vec<Cargo> = (0..n)
-                    .map(|j| Cargo {
-                        radius: base * (0.6 + 0.4 * ((j * 7) % 5) as f64 / 4.0),
-                        plane: j % planes,
-                        ..Cargo::point(0.01, 0.05, 0.1, 1.4)
-                    })
-                    .collect();
+                let cargo = mixed_balls(n, planes, 0.4);
                 let gauge = GapGauge::new(&cargo).unwrap();
                 let largest = cargo
                     .iter()
@@ -440,16 +447,7 @@ mod tests {
         let (mut in_order, mut sorted) = (0, 0);
         for n in [5_usize, 9, 24, 64] {
             for planes in [1, 2] {
-                let per_plane = n.div_ceil(planes) as f64;
-                let base = 0.05 * (0.9 * std::f64::consts::PI / per_plane).sin();
-                let cargo: Vec<Cargo> = (0..n)
-                    .map(|j| Cargo {
-                        radius: base * (0.8 + 0.2 * ((j * 7) % 5) as f64 / 4.0),
-                        plane: j % planes,
-                        ..Cargo::point(0.01, 0.05, 0.1, 1.4)
-                    })
-                    .collect();
-                let gauge = GapGauge::new(&cargo).unwrap();
+                let gauge = GapGauge::new(&mixed_balls(n, planes, 0.2)).unwrap();
                 let pitch = 2.0 * gauge.smallest_half_angle() * 1.1;
                 let phase: Vec<f64> = (0..n).map(|_| TAU * uniform(&mut seed)).collect();
                 let mut closest = ClosestApproach::default();
