@@ -2,10 +2,12 @@
 # Cost per run against the number of weights: the table "Cost per run against
 # the number of weights" in docs/benchmarks.md.
 #
-# Usage: scripts/n-scaling.sh [SAMPLES] [N...]   (default 5 samples, n = 2 4 8 16 32)
+# Usage: [RHO=ρ] scripts/n-scaling.sh [SAMPLES] [N...]   (default 5 samples, n = 2 4 8 16 32)
 #
-# Balls at half-race fill (rho = "half_race": packed weights touch) on the
-# main job's rotor, drag 10 N·s/m, one study per n, `study run --threads 1`;
+# Balls at half-race fill (rho = "half_race": packed weights touch; RHO=0.02
+# for balls too light to balance, whose runs all end in the same
+# quasi-steady whirl) on the main job's rotor, drag 10 N·s/m, one study per
+# n, `study run --threads 1`;
 # per run its own `wall_time_s`. Reads runs.parquet with pyarrow from
 # bench/lean's virtual environment (made by bench/lean/run.sh). Not part of
 # the tests or CI.
@@ -22,7 +24,7 @@ source "$root/scripts/bench-setup.sh" n
 for n in "${ns[@]}"; do
     sed -e "s/^samples = [0-9]*/samples = $samples/" \
         -e "s/^n = .*/n = $n/" \
-        -e "s/^rho = .*/rho = \"half_race\"/" \
+        -e "s/^rho = .*/rho = ${RHO:-\"half_race\"}/" \
         -e "s/^drag = .*/drag = 10.0/" \
         -e "s|^seed = \(.*\)\$|seed = \1\noutput = \"$out\"|" \
         "$root/studies/three_balls.toml" >"$out/n$n.toml"
