@@ -5,7 +5,7 @@
 
 use super::cargo::Cargo;
 use super::effect::contact::{ALL_PAIRS_UP_TO, wrapped};
-use super::race_ring::{MAX_RING, for_each_neighbour_pair, for_each_ring};
+use super::race_ring::{MAX_RING, for_each_neighbour_pair, for_each_ring_pair};
 use std::f64::consts::TAU;
 
 /// Two weights (cargo indices j < k) and the gap between them (rad).
@@ -106,27 +106,22 @@ impl GapGauge {
         }
         let angle = |a: usize| psi[self.sized[a].0].rem_euclid(TAU);
         let mut smallest = f64::INFINITY;
-        for_each_ring(
+        for_each_ring_pair(
             n,
             |a| self.sized[a].2,
             |_| true,
             |a| psi[self.sized[a].0],
-            |order| {
-                let m = order.len();
-                let count = if m > 2 { m } else { m.saturating_sub(1) };
-                for i in 0..count {
-                    let (from, to) = (order[i] as usize, order[(i + 1) % m] as usize);
-                    let (a, b) = (from.min(to), from.max(to));
-                    let gap = self.pair_gap(a, b, psi);
-                    visit(self.sized[a].0, self.sized[b].0, gap);
-                    smallest = smallest.min(gap);
-                    let along = if m == 2 {
-                        f64::INFINITY
-                    } else {
-                        (angle(to) - angle(from)).rem_euclid(TAU)
-                    };
-                    ring.push((from as u32, to as u32, along));
-                }
+            |from, to, len| {
+                let (a, b) = (from.min(to), from.max(to));
+                let gap = self.pair_gap(a, b, psi);
+                visit(self.sized[a].0, self.sized[b].0, gap);
+                smallest = smallest.min(gap);
+                let along = if len == 2 {
+                    f64::INFINITY
+                } else {
+                    (angle(to) - angle(from)).rem_euclid(TAU)
+                };
+                ring.push((from as u32, to as u32, along));
             },
         );
         if smallest >= -self.smallest_half_angle {

@@ -22,12 +22,26 @@ pub fn for_each_neighbour_pair(
     angle: impl Fn(usize) -> f64,
     mut visit: impl FnMut(usize, usize),
 ) {
+    for_each_ring_pair(n, plane, in_ring, angle, |a, b, _| {
+        visit(a.min(b), a.max(b))
+    });
+}
+
+/// [`for_each_neighbour_pair`] with each pair in ring order: `visit(from,
+/// to, ring length)`, `to` the next item along the ring after `from` (a
+/// ring of two gives its one pair once).
+pub fn for_each_ring_pair(
+    n: usize,
+    plane: impl Fn(usize) -> usize,
+    in_ring: impl Fn(usize) -> bool,
+    angle: impl Fn(usize) -> f64,
+    mut visit: impl FnMut(usize, usize, usize),
+) {
     for_each_ring(n, plane, in_ring, angle, |ring| {
         let m = ring.len();
         let pairs = if m > 2 { m } else { m.saturating_sub(1) };
         for i in 0..pairs {
-            let (a, b) = (ring[i] as usize, ring[(i + 1) % m] as usize);
-            visit(a.min(b), a.max(b));
+            visit(ring[i] as usize, ring[(i + 1) % m] as usize, m);
         }
     });
 }
