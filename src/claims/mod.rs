@@ -19,7 +19,7 @@ use crate::model::start::StartMode;
 use crate::study::config::{Distribution, InitialSpec, Scale, StudyPlan, UnbalanceSpec};
 use crate::study::run::{Progress, RunError, RunOptions, run_study};
 use crate::study::runs_file::read_summary_columns;
-use crate::study::verdict::{DesignRuns, design_runs, settling_horizon};
+use crate::study::verdict::{DesignRuns, SettlingClock, design_runs, settling_horizon};
 use normalisation::{Normalisation, design_capacity, rho_for};
 use polars::prelude::*;
 use serde::Serialize;
@@ -146,11 +146,11 @@ fn variant(
     file.sampling.unbalance = match norm {
         Normalisation::Paper => UnbalanceSpec {
             distribution: fractions,
-            relative_to: Scale::Capacity,
+            relative_to: Some(Scale::Capacity),
         },
         _ => UnbalanceSpec {
             distribution: scaled(&fractions, reference),
-            relative_to: Scale::Absolute,
+            relative_to: Some(Scale::Absolute),
         },
     };
     let name = format!("{}/{experiment}_{}", base.name, norm.name());
@@ -195,6 +195,7 @@ fn run_variant(
     let by_design = design_runs(
         &read_summary_columns(&out.dir.join("runs.parquet"))?,
         settling_horizon(plan),
+        SettlingClock::of(plan),
     )?;
     let runs: Vec<u64> = summary
         .column("runs")?
@@ -229,6 +230,7 @@ fn run_variant(
                     sample_ids: Vec::new(),
                     settling: Vec::new(),
                     residual: Vec::new(),
+                    residual_abs: Vec::new(),
                 }),
             seed: plan.file.seed,
         })

@@ -6,9 +6,11 @@ use crate::design::geometry::{rho_half_race, sector_angle};
 use crate::design::optimum::optimal_rho;
 use crate::model::balancer::Kind;
 use crate::model::rotor::{PlaneRotor, RotorModel};
+use crate::stats::holm::holm_adjust;
 use crate::study::config::StudyPlan;
+use crate::study::criterion::Criterion;
 use crate::study::verdict::{
-    Comparison, DesignRuns, Verdict, best_versus_rest, compare, settling_horizon,
+    Comparison, DesignRuns, Verdict, best_versus_rest, compare, holm_across, measure_scale,
 };
 use std::fmt::Write;
 
@@ -78,6 +80,90 @@ fn paired_effect(c: &Comparison, a: &str, b: &str) -> String {
     )
 }
 
+/// Holm-adjusted p-values per measure over the comparisons of one family
+/// (one claim): `result[i][k]` for comparison i and measure k.
+fn holm_per_measure(comparisons: &[&Comparison]) -> Vec<Vec<f64>> {
+    let measures = comparisons.first().map_or(0, |c| c.measures.len());
+    let mut out = vec![vec![1.0; measures]; comparisons.len()];
+    for k in 0..measures {
+        let raw: Vec<f64> = comparisons
+            .iter()
+            .map(|c| c.measures[k].difference.map_or(1.0, |d| d.p_value))
+            .collect();
+        for (i, p) in holm_adjust(&raw).into_iter().enumerate() {
+            out[i][k] = p;
+        }
+    }
+    out
+}
+
+/// Every measure of a comparison, A then B, with A − B, its test and the
+/// Holm-adjusted p-value in `holm` (same order as the measures).
+fn measure_list(c: &Comparison, holm: &[f64], family: &str) -> String {
+    let parts: Vec<String> = c
+        .measures
+        .iter()
+        .zip(holm)
+        .map(|(m, p)| match m.difference {
+            Some(d) => {
+                let scale = if m.criterion.unit() == "%" {
+                    100.0
+                } else {
+                    1.0
+                };
+                let x = |v: f64| {
+                    if v.is_finite() {
+                        format!("{:.1}", scale * v)
+                    } else {
+                        "∞".into()
+                    }
+                };
+                format!(
+                    "{} {} vs {} {} ({} p {})",
+                    m.criterion.label(),
+                    x(d.a),
+                    x(d.b),
+                    m.criterion.unit(),
+                    d.test,
+                    p_text(*p)
+                )
+            }
+            None => format!("{}: no comparison", m.criterion.label()),
+        })
+        .collect();
+    format!("{} [{family}]", parts.join("; "))
+}
+
+/// " But B is significantly better on …": the measures on which the
+/// comparison goes the other way from the ranking criterion's point
+/// estimate (empty when none does).
+fn disagreement(c: &Comparison, holm: &[f64], alpha: f64, a: &str, b: &str) -> String {
+    let Some(first) = c.measures.first().and_then(|m| m.difference) else {
+        return String::new();
+    };
+    let a_ahead = c.measures[0].criterion.a_better(first.difference);
+    let against: Vec<String> = c
+        .measures
+        .iter()
+        .zip(holm)
+        .skip(1)
+        .filter(|(m, p)| {
+            m.difference.is_some_and(|d| {
+                **p <= alpha && d.difference != 0.0 && m.criterion.a_better(d.difference) != a_ahead
+            })
+        })
+        .map(|(m, p)| format!("the {} (Holm p {})", m.criterion.label(), p_text(*p)))
+        .collect();
+    if against.is_empty() {
+        return String::new();
+    }
+    let (ahead, behind) = if a_ahead { (b, a) } else { (a, b) };
+    format!(
+        " The measures disagree: {ahead} are significantly better than {behind} on {}.",
+        against.join(" and ")
+    )
+}
+
 /// One line describing the rotor of the study.
 fn rotor_description(rotor: &RotorModel) -> String {
     match rotor.downcast_ref::<PlaneRotor>() {
@@ -94,7 +180,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
     let mut s = String::new();
     let g = &plan.file.designs;
     let alpha = plan.file.statistics.alpha;
-    let horizon = settling_horizon(plan);
+    let scale = measure_scale(plan);
     let _ = writeln!(
         s,
         "# Seed 000's design claims, put to a virtual experiment\n"
@@ -204,37 +290,81 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         s,
         "## Claim 2: three or more weights re-balance much faster than two after a 90° shift\n"
     );
-    s.push_str("Start: the weights at the position that balanced an unbalance of the same magnitude turned by 90°, the rotor in the locked steady state of the new unbalance (so that settling measures the weights, not the support's start-up transient). Verdicts compare three with two weights on runs that met the same unbalance (sign test at α); \"confirmed\" needs three weights to settle sooner in at least 75 % of the pairs.\n\n");
+    s.push_str("Start: the weights at the position that balanced an unbalance of the same magnitude turned by 90°, the rotor in the locked steady state of the new unbalance (so that settling measures the weights, not the support's start-up transient). Verdicts compare three with two weights on runs that met the same unbalance, on the study's ranking criterion (`[summary] rank_by`, `--rank-by`) with its paired test at α, Holm-adjusted over the normalisations (they answer one claim); \"confirmed\" also needs three weights to settle sooner in at least 75 % of the pairs. Each verdict lists every measure, and says where the median and the tail disagree.\n\n");
+    let criterion = plan.file.summary.rank_by;
+    let mut measures = vec![criterion];
+    measures.extend(Criterion::REPORTED.iter().filter(|&&c| c != criterion));
+    // Every normalisation answers the same claim: one Holm family over them.
+    let mut shift_cases = Vec::new();
     for norm in Normalisation::ALL {
         let rows: Vec<&DesignResult> = out
             .shift
             .iter()
             .filter(|r| r.normalisation == norm)
             .collect();
+        let two = rows.iter().find(|r| r.n == 2);
+        let three = rows.iter().find(|r| r.n == 3);
+        let c = two.zip(three).map(|(two, three)| {
+            compare(
+                &three.runs_by_sample,
+                &two.runs_by_sample,
+                true,
+                &measures,
+                &scale,
+                three.seed,
+            )
+        });
+        shift_cases.push((norm, rows, c));
+    }
+    let shift_holm = holm_per_measure(
+        &shift_cases
+            .iter()
+            .filter_map(|(_, _, c)| c.as_ref())
+            .collect::<Vec<_>>(),
+    );
+    let mut shift_holm = shift_holm.into_iter();
+    let tested = shift_cases.iter().filter(|(_, _, c)| c.is_some()).count();
+    for (norm, rows, c) in &shift_cases {
         if rows.is_empty() {
             continue;
         }
         let _ = writeln!(s, "### {} — {}\n", norm.name(), norm.describe());
-        design_table(&mut s, &rows);
-        let two = rows.iter().find(|r| r.n == 2);
-        let three = rows.iter().find(|r| r.n == 3);
-        if let (Some(two), Some(three)) = (two, three) {
-            let c = compare(&three.runs_by_sample, &two.runs_by_sample, true, three.seed);
-            let p = c.p_value();
-            let clear = p <= alpha;
+        design_table(&mut s, rows);
+        if let Some(c) = c {
+            let holm = shift_holm.next().unwrap_or_default();
+            let p = holm.first().copied().unwrap_or(1.0);
+            let on = c.measures.first().and_then(|m| m.difference);
+            let better = on.is_some_and(|d| criterion.a_better(d.difference));
+            let clear = p <= alpha && on.is_some_and(|d| d.difference != 0.0);
             let share = c.paired.as_ref().map_or(0.5, |x| x.a_sooner_share);
+            let verdict = match (clear, better) {
+                (true, true) if share >= 0.75 => format!(
+                    "Confirmed on the {} under this normalisation, and three weights settle sooner in at least 75 % of the pairs.",
+                    criterion.label()
+                ),
+                (true, true) => format!(
+                    "Three are faster on the {}, but settle sooner in fewer than 75 % of the pairs: not by the wide margin the paper suggests.",
+                    criterion.label()
+                ),
+                (true, false) => format!(
+                    "Contradicted on the {}: two weights are faster here.",
+                    criterion.label()
+                ),
+                (false, _) => format!(
+                    "Not distinguishable on the {} at this sample size.",
+                    criterion.label()
+                ),
+            };
             let _ = writeln!(
                 s,
-                "\n{}; sign test {} (α = {alpha}). {}\n",
-                paired_effect(&c, "three weights", "two"),
-                p_text(p),
-                match (clear, c.a_is_sooner()) {
-                    (true, true) if share >= 0.75 => "Confirmed under this normalisation.",
-                    (true, true) =>
-                        "Three are faster, but not by the wide margin the paper suggests.",
-                    (true, false) => "Contradicted: two weights are faster here.",
-                    (false, _) => "Not distinguishable at this sample size.",
-                }
+                "\n{}. {}. {verdict}{}\n",
+                paired_effect(c, "three weights", "two"),
+                measure_list(
+                    c,
+                    &holm,
+                    &format!("Holm over the {tested} normalisations answering claim 2")
+                ),
+                disagreement(c, &holm, alpha, "three weights", "two")
             );
         }
     }
@@ -245,6 +375,30 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         "## Claim 3: the shortest transients come with 3 balls or 5 rollers\n"
     );
     s.push_str("Start: the locked steady state with the weights pressed together at a random angle; unbalances as in [sampling].\n\n");
+    // Every normalisation and kind answers claim 3: one Holm family over all.
+    let mut cases = Vec::new();
+    for norm in Normalisation::ALL {
+        let rows: Vec<&DesignResult> = out
+            .fastest
+            .iter()
+            .filter(|r| r.normalisation == norm)
+            .collect();
+        for (kind, paper_n) in [(Kind::Ball, 3), (Kind::Roller, 5)] {
+            let of_kind: Vec<&DesignResult> =
+                rows.iter().copied().filter(|r| r.kind == kind).collect();
+            let runs: Vec<DesignRuns> = of_kind.iter().map(|r| r.runs_by_sample.clone()).collect();
+            let seed = of_kind.first().map_or(0, |r| r.seed);
+            if let Some(v) = best_versus_rest(&runs, criterion, &scale, alpha, true, seed) {
+                cases.push((norm, kind, paper_n, of_kind, v));
+            }
+        }
+    }
+    let mut families: Vec<_> = cases.iter().map(|c| c.4.clone()).collect();
+    holm_across(&mut families);
+    let comparisons: usize = families.iter().map(|f| f.others.len()).sum();
+    let family = format!(
+        "α = {alpha}, Holm-adjusted over all {comparisons} comparisons of the fastest design with the others, every kind and normalisation together (they answer one claim)"
+    );
     for norm in Normalisation::ALL {
         let rows: Vec<&DesignResult> = out
             .fastest
@@ -257,13 +411,12 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         let _ = writeln!(s, "### {} — {}\n", norm.name(), norm.describe());
         design_table(&mut s, &rows);
         s.push('\n');
-        for (kind, paper_n) in [(Kind::Ball, 3), (Kind::Roller, 5)] {
-            let of_kind: Vec<&&DesignResult> = rows.iter().filter(|r| r.kind == kind).collect();
-            let runs: Vec<DesignRuns> = of_kind.iter().map(|r| r.runs_by_sample.clone()).collect();
-            let seed = of_kind.first().map_or(0, |r| r.seed);
-            let Some(v) = best_versus_rest(&runs, horizon, alpha, true, seed) else {
-                continue;
-            };
+        for ((_, kind, paper_n, of_kind, _), v) in cases
+            .iter()
+            .zip(&families)
+            .filter(|((n, ..), _)| *n == norm)
+        {
+            let (kind, paper_n) = (*kind, *paper_n);
             let n_of = |id: u32| {
                 of_kind
                     .iter()
@@ -271,67 +424,95 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
                     .map_or(0, |r| r.n)
             };
             let best_n = n_of(v.best);
-            let per_design = runs.iter().map(|r| r.settling.len()).max().unwrap_or(0);
-            let family = format!(
-                "α = {alpha}, Holm-adjusted over the {} comparisons of the fastest {kind} design with the others, n = {per_design} runs per design",
-                v.others.len()
-            );
+            let per_design = of_kind
+                .iter()
+                .map(|r| r.runs_by_sample.settling.len())
+                .max()
+                .unwrap_or(0);
+            let family = format!("{family}; n = {per_design} runs per design");
+            let holm =
+                |c: &Comparison| -> Vec<f64> { c.measures.iter().map(|m| m.p_holm).collect() };
+            let label = criterion.label();
             let beaten = v
                 .others
                 .iter()
-                .filter(|(_, _, x)| *x == Verdict::BestSooner)
+                .filter(|(_, _, x)| *x == Verdict::BestBetter)
                 .count();
             let verdict = if best_n == paper_n {
                 let unclear: Vec<String> = v
                     .others
                     .iter()
-                    .filter(|(_, _, x)| *x != Verdict::BestSooner)
+                    .filter(|(_, _, x)| *x != Verdict::BestBetter)
                     .map(|(c, p, _)| {
                         format!(
                             "{} {kind}s ({}; Holm-adjusted {})",
                             n_of(c.b),
-                            paired_effect(c, &format!("{paper_n}"), &n_of(c.b).to_string()),
+                            measure_list(c, &holm(c), "Holm over the claim"),
                             p_text(*p)
                         )
                     })
                     .collect();
+                let tails: Vec<String> = v
+                    .others
+                    .iter()
+                    .map(|(c, _, _)| {
+                        disagreement(
+                            c,
+                            &holm(c),
+                            alpha,
+                            &format!("{paper_n} {kind}s"),
+                            &format!("{} {kind}s", n_of(c.b)),
+                        )
+                    })
+                    .filter(|t| !t.is_empty())
+                    .collect();
                 if unclear.is_empty() {
                     format!(
-                        "Confirmed: {paper_n} {kind}s have the lowest median settling time and settle sooner than each of the other {beaten} counts ({family})."
+                        "Confirmed on the {label}: {paper_n} {kind}s rank first and are better than each of the other {beaten} counts ({family}).{}",
+                        tails.concat()
                     )
                 } else {
                     format!(
-                        "Partly confirmed: {paper_n} {kind}s have the lowest median, but cannot be told apart from {} ({family}).",
-                        unclear.join("; ")
+                        "Partly confirmed on the {label}: {paper_n} {kind}s rank first, but cannot be told apart from {} ({family}).{}",
+                        unclear.join("; "),
+                        tails.concat()
                     )
                 }
             } else {
                 match v.others.iter().find(|(c, _, _)| n_of(c.b) == paper_n) {
                     Some((c, p, x)) => {
-                        let effect =
-                            paired_effect(c, &format!("{best_n} {kind}s"), &format!("{paper_n}"));
+                        let effect = measure_list(c, &holm(c), "Holm over the claim");
+                        let tail = disagreement(
+                            c,
+                            &holm(c),
+                            alpha,
+                            &format!("{best_n} {kind}s"),
+                            &format!("{paper_n} {kind}s"),
+                        );
                         match x {
-                            Verdict::BestSooner => format!(
-                                "Contradicted: {best_n} {kind}s settle fastest: {effect}; Holm-adjusted {} ({family}).",
+                            Verdict::BestBetter => format!(
+                                "Contradicted on the {label}: {best_n} {kind}s rank first and are better than {paper_n} ({effect}; Holm-adjusted {}; {family}).{tail}",
                                 p_text(*p)
                             ),
                             Verdict::NotDistinguishable => format!(
-                                "Not distinguishable: {best_n} {kind}s have the lowest median, but {effect}; Holm-adjusted {} ({family}).",
+                                "Not distinguishable on the {label}: {best_n} {kind}s rank first, but not significantly ahead of {paper_n} ({effect}; Holm-adjusted {}; {family}).{tail}",
                                 p_text(*p)
                             ),
-                            Verdict::OtherSooner => format!(
-                                "Mixed: {best_n} {kind}s have the lowest median, yet {paper_n} {kind}s settle sooner in more paired runs: {effect}; Holm-adjusted {} ({family}).",
+                            Verdict::OtherBetter => format!(
+                                "Mixed on the {label}: {best_n} {kind}s have the better point estimate, yet {paper_n} {kind}s are significantly better on its paired test ({effect}; Holm-adjusted {}; {family}).{tail}",
                                 p_text(*p)
                             ),
                         }
                     }
-                    None => format!("{best_n} {kind}s are fastest; {paper_n} was not simulated."),
+                    None => format!(
+                        "{best_n} {kind}s rank first on the {label}; {paper_n} was not simulated."
+                    ),
                 }
             };
             let _ = writeln!(s, "- {verdict}");
         }
         s.push('\n');
     }
-    s.push_str("## Notes\n\n- The paper's measure ã (eqs 15/16) ranks designs at p = p_max, the slowest balanced configuration; the simulation ranks by the Kaplan–Meier median settling time over the sampled unbalances (every run counts, unsettled ones as censored) and compares designs on paired runs, so a design can rank differently.\n- Every number above comes from the runs under `results/` of the command at the top; rerunning it rewrites this file.\n");
+    s.push_str("## Notes\n\n- The paper's measure ã (eqs 15/16) ranks designs at p = p_max, the slowest balanced configuration; the simulation ranks by the study's criterion (`[summary] rank_by`; by default the restricted mean settling time, which counts the slow tail) over the sampled unbalances (every run counts, unsettled ones as censored) and compares designs on paired runs, so a design can rank differently. Each verdict names the measure it rests on and lists the others (median, restricted mean, p90, residual p95), and says so where they disagree.\n- Every number above comes from the runs under `results/` of the command at the top; rerunning it rewrites this file.\n");
     s
 }

@@ -22,7 +22,8 @@
 //!   absolute and relative to A_ref.
 //! - Outcome: settled, censored (simulated to the end without settling),
 //!   not_settled (an estimate that predicts no settling), diverged
-//!   (non-finite state or r beyond `divergence_factor`·A_ref) or
+//!   (non-finite state, or r beyond `divergence_factor` times the larger of
+//!   A_ref and the whirl (U + Σ m l)/U · A_ref the weights can drive) or
 //!   solver_failed, each with a reason.
 //!
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
@@ -51,7 +52,7 @@ pub struct MetricOptions {
     pub samples_per_rev: u32,
     /// Stop the run as soon as the hold is satisfied.
     pub stop_when_settled: bool,
-    /// r beyond this multiple of A_ref counts as divergence.
+    /// r beyond this multiple of max(A_ref, (U + Σ m l)/U · A_ref) counts as divergence.
     pub divergence_factor: f64,
     /// End a settled run's hold window early once the linearised flow,
     /// checked against the run, bounds the rest of it (rotating frame with

@@ -137,6 +137,9 @@ pub struct SettlingObserver<'a> {
     system: &'a RotorSystem,
     options: MetricOptions,
     a_ref: f64,
+    /// The whirl divergence is measured against: A_ref, or the larger whirl
+    /// the weights' own unbalance can drive (U + Σ m l)/U · A_ref.
+    divergence_scale: f64,
     u_ref: f64,
     balancing: BalancingGauge,
     /// Decides ε ≤ δ without computing ε where a bound settles it.
@@ -240,11 +243,19 @@ impl<'a> SettlingObserver<'a> {
         let samples = options.samples_per_rev.max(32);
         let ring_len = ((options.hold_revs * f64::from(samples)).ceil() as usize).max(1);
         let a = a_ref(system, omega);
+        // Divergence is judged against the whirl the start itself can throw:
+        // with a tiny sampled unbalance A_ref is tiny, and the weights alone
+        // (clustered, up to Σ m l out of balance) whirl the rotor up to
+        // (U + Σ m l)/U times A_ref without anything diverging.
+        let u = reference_unbalance(system);
+        let weights: f64 = system.cargo().iter().map(|c| c.unbalance()).sum();
+        let start_scale = if u > 0.0 { a * (u + weights) / u } else { a };
         let balancing = BalancingGauge::new(system, reference_unbalance(system));
         SettlingObserver {
             system,
             a_ref: a,
-            u_ref: reference_unbalance(system),
+            divergence_scale: a.max(start_scale),
+            u_ref: u,
             eps_band: BandDecider::new(&balancing),
             balancing,
             band: options.delta * a,
@@ -328,10 +339,10 @@ impl<'a> SettlingObserver<'a> {
         if let Some(gauge) = &self.gap {
             self.closest.sample(gauge, psi);
         }
-        if r > self.options.divergence_factor * self.a_ref {
+        if r > self.options.divergence_factor * self.divergence_scale {
             self.diverged = Some(format!(
-                "r = {r:.3e} exceeded {} A_ref at t = {t:.4}",
-                self.options.divergence_factor
+                "r = {r:.3e} m exceeded {} times the largest whirl the unbalance and the weights can drive ({:.3e} m) at t = {t:.4}",
+                self.options.divergence_factor, self.divergence_scale
             ));
             return Flow::Stop;
         }

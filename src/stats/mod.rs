@@ -15,6 +15,7 @@ pub mod interval;
 pub mod ks;
 pub mod mood;
 pub mod paired;
+pub mod paired_measures;
 pub mod proportion;
 pub mod quantile;
 pub mod survival;

@@ -7,7 +7,7 @@
 
 use super::config::{StopWhen, StudyPlan};
 use super::verdict::{
-    DesignRuns, LEVEL, best_versus_rest, design_runs, restricted_horizon, settling_horizon,
+    DesignRuns, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
 };
 use crate::stats::survival::Transform;
 use polars::prelude::*;
@@ -50,9 +50,10 @@ pub struct Precision {
 /// The precision of the runs in `df` (the columns of
 /// [`super::runs_file::SUMMARY_COLUMNS`]) against `stop`.
 pub fn precision(plan: &StudyPlan, stop: &StopWhen, df: &DataFrame) -> PolarsResult<Precision> {
-    let designs = design_runs(df, settling_horizon(plan))?;
-    // The same horizon as the summary's verdicts, so the same best design.
-    let horizon = restricted_horizon(plan, &designs);
+    // The same horizon, clock and criterion as the summary's verdicts, so
+    // the same best design.
+    let scale = measure_scale(plan);
+    let designs = design_runs(df, scale.tau, SettlingClock::of(plan))?;
     let mut worst = Vec::new();
     if let Some(target) = stop.median_halfwidth_rel {
         worst.push(("median_halfwidth_rel", median_halfwidth(&designs), target));
@@ -60,7 +61,8 @@ pub fn precision(plan: &StudyPlan, stop: &StopWhen, df: &DataFrame) -> PolarsRes
     if let Some(target) = stop.win_share_halfwidth {
         let value = best_versus_rest(
             &designs,
-            horizon,
+            plan.file.summary.rank_by,
+            &scale,
             plan.file.statistics.alpha,
             plan.file.sampling.common_random_numbers,
             plan.file.seed,

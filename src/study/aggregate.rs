@@ -8,9 +8,11 @@
 //! over the sampled unbalances; diverged and failed runs are counted.
 
 use super::config::StudyPlan;
+use super::criterion::{Criterion, Scale};
+use super::diagnosis::{DesignFacts, dead_band, diagnose, settling_band};
 use super::record::{RunRecord, to_dataframe};
 use super::verdict::{
-    BestVersusRest, LEVEL, best_versus_rest, design_runs, restricted_horizon, settling_horizon,
+    BestVersusRest, DesignRuns, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
 };
 use crate::model::gap::GapGauge;
 use crate::stats::interval::wilson_interval;
@@ -31,17 +33,33 @@ fn sorted_values(ca: &Float64Chunked) -> Vec<f64> {
     v
 }
 
-/// The q-quantile (linear interpolation) over every run of a design, runs
-/// that did not settle counting as later than every settled one; `None`
-/// when it falls among them (beyond the run).
-fn quantile_counting_unsettled(settled_sorted: &[f64], runs: u64, q: f64) -> Option<f64> {
-    if runs == 0 {
-        return None;
-    }
-    let h = q * (runs - 1) as f64;
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    let (a, b) = (*settled_sorted.get(lo)?, *settled_sorted.get(hi)?);
-    Some(a + (h - lo as f64) * (b - a))
+/// How runs that ended `diverged`, `solver_failed` or `budget_exceeded`
+/// enter the statistics (stored beside them in `summary.parquet`).
+pub const FAILED_RUNS_COUNTED: &str = "as not settled within the run (censored at the horizon τ) in every settling statistic; left out of the residual statistics";
+
+/// Design ids not dominated on `measures`: no other design is at least as
+/// good on every measure and better on one (a value beyond the run or
+/// missing counts as the worst).
+pub fn pareto_set(designs: &[DesignRuns], measures: &[Criterion], scale: &Scale) -> Vec<u32> {
+    let values: Vec<Vec<Option<f64>>> = designs
+        .iter()
+        .map(|d| measures.iter().map(|m| m.value(d, scale)).collect())
+        .collect();
+    let dominates = |x: usize, y: usize| {
+        let mut strictly = false;
+        for (k, m) in measures.iter().enumerate() {
+            match m.order(values[x][k], values[y][k]) {
+                std::cmp::Ordering::Greater => return false,
+                std::cmp::Ordering::Less => strictly = true,
+                std::cmp::Ordering::Equal => {}
+            }
+        }
+        strictly
+    };
+    (0..designs.len())
+        .filter(|&y| !(0..designs.len()).any(|x| x != y && dominates(x, y)))
+        .map(|y| designs[y].design_id)
+        .collect()
 }
 
 /// One row per design, in design order.
@@ -54,22 +72,31 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
 pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFrame> {
     let design_col = df.column("design_id")?.u32()?.clone();
     let mut rows = SummaryColumns::default();
-    let by_design = design_runs(df, settling_horizon(plan))?;
-    let horizon = restricted_horizon(plan, &by_design);
+    let scale = measure_scale(plan);
+    let clock = SettlingClock::of(plan);
+    let by_design = design_runs(df, scale.tau, clock)?;
+    let criterion = plan.file.summary.rank_by;
     let verdicts = best_versus_rest(
         &by_design,
-        horizon,
+        criterion,
+        &scale,
         plan.file.statistics.alpha,
         plan.file.sampling.common_random_numbers,
         plan.file.seed,
     );
+    let pareto = pareto_set(&by_design, &plan.file.summary.pareto, &scale);
+    let rank_of = |id: u32| -> Option<u32> {
+        match &verdicts {
+            Some(v) => v.order.iter().position(|&d| d == id).map(|r| r as u32 + 1),
+            None => by_design.iter().any(|d| d.design_id == id).then_some(1),
+        }
+    };
     for design in &plan.designs {
         let mine = df.filter(&design_col.equal(design.id))?;
         let outcome = mine.column("outcome")?.str()?.clone();
         let count = |name: &str| outcome.equal(name).sum().unwrap_or(0) as u64;
         let settled_mask = mine.column("settled")?.bool()?.clone();
         let settled = mine.filter(&settled_mask)?;
-        let ts = settled.column("settling_revs")?.f64()?.clone();
         let simulated = mine.filter(
             &(outcome.equal("settled") | outcome.equal("censored") | outcome.equal("not_settled")),
         )?;
@@ -77,7 +104,11 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let runs_n = mine.height() as u64;
         let settled_n = settled.height() as u64;
         let (lo, hi) = wilson_interval(settled_n, runs_n);
+        let runs = by_design.iter().find(|d| d.design_id == design.id);
         rows.design_id.push(design.id);
+        rows.rank.push(rank_of(design.id));
+        rows.rank_by.push(criterion.to_string());
+        rows.settling_from.push(clock.describe().to_string());
         rows.kind.push(design.spec.kind.name().to_string());
         rows.n.push(design.spec.n);
         rows.rho.push(design.rho);
@@ -92,13 +123,9 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         });
         rows.settled_lo.push(lo);
         rows.settled_hi.push(hi);
-        let ts_sorted = sorted_values(&ts);
         rows.ts_p90_all
-            .push(quantile_counting_unsettled(&ts_sorted, runs_n, 0.9));
-        let km = by_design
-            .iter()
-            .find(|d| d.design_id == design.id)
-            .and_then(|d| d.kaplan_meier());
+            .push(runs.and_then(|r| Criterion::P90.value(r, &scale)));
+        let km = runs.and_then(DesignRuns::kaplan_meier);
         let median = km.as_ref().and_then(|k| k.median());
         let (median_lo, median_hi) = km.as_ref().map_or((None, None), |k| {
             k.median_interval(LEVEL, Transform::LogLog)
@@ -106,15 +133,46 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.ts_median_km.push(median);
         rows.ts_median_km_lo.push(median_lo);
         rows.ts_median_km_hi.push(median_hi);
-        let rmst = km.as_ref().map(|k| k.restricted_mean(horizon));
+        let rmst = km.as_ref().map(|k| k.restricted_mean(scale.tau));
         rows.ts_rmst.push(rmst.map(|r| r.estimate));
         let rmst_interval = rmst.map(|r| r.interval(LEVEL));
         rows.ts_rmst_lo
             .push(rmst_interval.map(|i| i.lower.max(0.0)));
         rows.ts_rmst_hi
-            .push(rmst_interval.map(|i| i.upper.min(horizon)));
-        rows.horizon.push(horizon);
+            .push(rmst_interval.map(|i| i.upper.min(scale.tau)));
+        rows.horizon.push(scale.tau);
+        rows.rank_value
+            .push(runs.and_then(|r| criterion.value(r, &scale)));
         rows.push_verdict(verdicts.as_ref(), design.id);
+        rows.pareto.push(pareto.contains(&design.id));
+        rows.balances
+            .push(runs.is_some_and(super::verdict::balances));
+        // What the no-crown checks measure, and their verdict on the first.
+        let a_ref = sorted_values(mine.column("a_ref")?.f64()?);
+        let fraction = sorted_values(mine.column("unbalance_fraction")?.f64()?);
+        let median_of = |v: &[f64]| quantile_sorted(v, 0.5, Interpolation::Linear);
+        let facts = DesignFacts {
+            a_ref_median: median_of(&a_ref).unwrap_or(f64::NAN),
+            unbalance_fraction_median: median_of(&fraction).unwrap_or(f64::NAN),
+            over_capacity_share: if fraction.is_empty() {
+                0.0
+            } else {
+                fraction.iter().filter(|&&f| f > 1.0).count() as f64 / fraction.len() as f64
+            },
+        };
+        rows.a_ref_median.push(median_of(&a_ref));
+        rows.settling_band
+            .push(median_of(&a_ref).map(|a| settling_band(plan, a)));
+        rows.dead_band.push(dead_band(plan, design));
+        rows.over_capacity.push(facts.over_capacity_share);
+        rows.diagnosis.push(match &verdicts {
+            Some(v) if v.best == design.id && !v.works => Some(diagnose(plan, design, &facts)),
+            None if runs.is_some_and(|r| !super::verdict::balances(r)) => {
+                Some(diagnose(plan, design, &facts))
+            }
+            _ => None,
+        });
+        rows.failed_counted.push(FAILED_RUNS_COUNTED.to_string());
         rows.vs_best_alpha.push(plan.file.statistics.alpha);
         rows.res_mean.push(residual.mean());
         let res_sorted = sorted_values(&residual);
@@ -167,6 +225,21 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
 #[derive(Default)]
 struct SummaryColumns {
     design_id: Vec<u32>,
+    rank: Vec<Option<u32>>,
+    rank_by: Vec<String>,
+    rank_value: Vec<Option<f64>>,
+    settling_from: Vec<String>,
+    pareto: Vec<bool>,
+    balances: Vec<bool>,
+    /// Per reported measure (Criterion::REPORTED order): this − best, its
+    /// interval and the Holm-adjusted p.
+    vs_best_measure: [MeasureColumns; 4],
+    a_ref_median: Vec<Option<f64>>,
+    settling_band: Vec<Option<f64>>,
+    dead_band: Vec<Option<f64>>,
+    over_capacity: Vec<f64>,
+    diagnosis: Vec<Option<String>>,
+    failed_counted: Vec<String>,
     kind: Vec<String>,
     n: Vec<u32>,
     rho: Vec<f64>,
@@ -212,6 +285,15 @@ struct SummaryColumns {
     spin_median: Vec<Option<f64>>,
 }
 
+/// One measure's comparison with the best design, per design.
+#[derive(Default)]
+struct MeasureColumns {
+    diff: Vec<Option<f64>>,
+    lo: Vec<Option<f64>>,
+    hi: Vec<Option<f64>>,
+    p_holm: Vec<Option<f64>>,
+}
+
 /// A finite value, or `None` (an infinite paired median difference means
 /// that in half the pairs or more one design did not settle).
 fn finite(x: f64) -> Option<f64> {
@@ -224,19 +306,15 @@ impl SummaryColumns {
     fn push_verdict(&mut self, verdicts: Option<&BestVersusRest>, id: u32) {
         let other = verdicts.and_then(|v| v.others.iter().find(|(c, _, _)| c.b == id));
         self.vs_best_verdict.push(match (verdicts, other) {
-            (Some(v), _) if v.best == id => "best".to_string(),
+            (Some(v), _) if v.best == id && v.works => "best".to_string(),
+            (Some(v), _) if v.best == id => "no_design_balances".to_string(),
             (_, Some((_, _, verdict))) => verdict.name().to_string(),
             _ => "only_design".to_string(),
         });
         let paired = other.and_then(|(c, _, _)| c.paired.as_ref());
-        self.vs_best_test.push(other.map(|(c, _, _)| {
-            if c.paired.is_some() {
-                "sign"
-            } else {
-                "log_rank"
-            }
-            .to_string()
-        }));
+        let on_criterion = other.and_then(|(c, _, _)| c.measures.first());
+        self.vs_best_test
+            .push(on_criterion.and_then(|m| m.difference.map(|d| d.test.to_string())));
         self.vs_best_share.push(paired.map(|p| p.a_sooner_share));
         self.vs_best_share_lo
             .push(paired.map(|p| p.a_sooner_share_interval.0));
@@ -249,58 +327,99 @@ impl SummaryColumns {
         self.vs_best_diff_hi
             .push(paired.and_then(|p| finite(p.median_difference_interval.1)));
         self.vs_best_p_holm.push(other.map(|(_, p, _)| *p));
+        for (k, measure) in Criterion::REPORTED.iter().enumerate() {
+            let m = other.and_then(|(c, _, _)| c.on(*measure));
+            let d = m.and_then(|m| m.difference);
+            let columns = &mut self.vs_best_measure[k];
+            // Stored as this design minus the best.
+            columns.diff.push(d.and_then(|d| finite(-d.difference)));
+            columns.lo.push(d.and_then(|d| finite(-d.interval.1)));
+            columns.hi.push(d.and_then(|d| finite(-d.interval.0)));
+            columns.p_holm.push(m.map(|m| m.p_holm));
+        }
     }
 
     fn into_dataframe(self) -> PolarsResult<DataFrame> {
         let height = self.design_id.len();
-        DataFrame::new(
-            height,
-            vec![
-                Column::new("design_id".into(), self.design_id),
-                Column::new("kind".into(), self.kind),
-                Column::new("n".into(), self.n),
-                Column::new("rho".into(), self.rho),
-                Column::new("drag".into(), self.drag),
-                Column::new("capacity".into(), self.capacity),
-                Column::new("runs".into(), self.runs),
-                Column::new("settled".into(), self.settled),
-                Column::new("settled_fraction".into(), self.settled_fraction),
-                Column::new("settled_fraction_lo".into(), self.settled_lo),
-                Column::new("settled_fraction_hi".into(), self.settled_hi),
-                Column::new("settling_revs_median_km".into(), self.ts_median_km),
-                Column::new("settling_revs_median_km_lo".into(), self.ts_median_km_lo),
-                Column::new("settling_revs_median_km_hi".into(), self.ts_median_km_hi),
-                Column::new("settling_revs_rmst".into(), self.ts_rmst),
-                Column::new("settling_revs_rmst_lo".into(), self.ts_rmst_lo),
-                Column::new("settling_revs_rmst_hi".into(), self.ts_rmst_hi),
-                Column::new("settling_horizon_revs".into(), self.horizon),
-                Column::new("settling_revs_p90_all_runs".into(), self.ts_p90_all),
-                Column::new("vs_best_verdict".into(), self.vs_best_verdict),
-                Column::new("vs_best_test".into(), self.vs_best_test),
-                Column::new("vs_best_sooner_share".into(), self.vs_best_share),
-                Column::new("vs_best_sooner_share_lo".into(), self.vs_best_share_lo),
-                Column::new("vs_best_sooner_share_hi".into(), self.vs_best_share_hi),
-                Column::new("vs_best_median_diff_revs".into(), self.vs_best_diff),
-                Column::new("vs_best_median_diff_revs_lo".into(), self.vs_best_diff_lo),
-                Column::new("vs_best_median_diff_revs_hi".into(), self.vs_best_diff_hi),
-                Column::new("vs_best_p_holm".into(), self.vs_best_p_holm),
-                Column::new("vs_best_alpha".into(), self.vs_best_alpha),
-                Column::new("residual_rel_mean".into(), self.res_mean),
-                Column::new("residual_rel_median".into(), self.res_median),
-                Column::new("residual_rel_p95".into(), self.res_p95),
-                Column::new("censored".into(), self.censored),
-                Column::new("not_settled".into(), self.not_settled),
-                Column::new("diverged".into(), self.diverged),
-                Column::new("solver_failed".into(), self.solver_failed),
-                Column::new("budget_exceeded".into(), self.budget_exceeded),
-                Column::new("contact".into(), self.contact),
-                Column::new("min_gap_rad".into(), self.min_gap),
-                Column::new("max_overlap_fraction".into(), self.max_overlap),
-                Column::new("stall_torque".into(), self.stall_torque),
-                Column::new("reached_operating_speed".into(), self.reached_operating),
-                Column::new("operating_time_s_median".into(), self.operating_median),
-                Column::new("final_spin_rate_median".into(), self.spin_median),
-            ],
-        )
+        let mut measures = Vec::new();
+        for (measure, columns) in Criterion::REPORTED.iter().zip(self.vs_best_measure) {
+            let name = measure.to_string();
+            measures.push(Column::new(
+                format!("vs_best_{name}_diff").into(),
+                columns.diff,
+            ));
+            measures.push(Column::new(
+                format!("vs_best_{name}_diff_lo").into(),
+                columns.lo,
+            ));
+            measures.push(Column::new(
+                format!("vs_best_{name}_diff_hi").into(),
+                columns.hi,
+            ));
+            measures.push(Column::new(
+                format!("vs_best_{name}_p_holm").into(),
+                columns.p_holm,
+            ));
+        }
+        let mut columns = vec![
+            Column::new("design_id".into(), self.design_id),
+            Column::new("rank".into(), self.rank),
+            Column::new("rank_by".into(), self.rank_by),
+            Column::new("rank_value".into(), self.rank_value),
+            Column::new("settling_from".into(), self.settling_from),
+            Column::new("pareto".into(), self.pareto),
+            Column::new("balances".into(), self.balances),
+            Column::new("kind".into(), self.kind),
+            Column::new("n".into(), self.n),
+            Column::new("rho".into(), self.rho),
+            Column::new("drag".into(), self.drag),
+            Column::new("capacity".into(), self.capacity),
+            Column::new("runs".into(), self.runs),
+            Column::new("settled".into(), self.settled),
+            Column::new("settled_fraction".into(), self.settled_fraction),
+            Column::new("settled_fraction_lo".into(), self.settled_lo),
+            Column::new("settled_fraction_hi".into(), self.settled_hi),
+            Column::new("settling_revs_median_km".into(), self.ts_median_km),
+            Column::new("settling_revs_median_km_lo".into(), self.ts_median_km_lo),
+            Column::new("settling_revs_median_km_hi".into(), self.ts_median_km_hi),
+            Column::new("settling_revs_rmst".into(), self.ts_rmst),
+            Column::new("settling_revs_rmst_lo".into(), self.ts_rmst_lo),
+            Column::new("settling_revs_rmst_hi".into(), self.ts_rmst_hi),
+            Column::new("settling_horizon_revs".into(), self.horizon),
+            Column::new("settling_revs_p90_all_runs".into(), self.ts_p90_all),
+            Column::new("vs_best_verdict".into(), self.vs_best_verdict),
+            Column::new("vs_best_test".into(), self.vs_best_test),
+            Column::new("vs_best_sooner_share".into(), self.vs_best_share),
+            Column::new("vs_best_sooner_share_lo".into(), self.vs_best_share_lo),
+            Column::new("vs_best_sooner_share_hi".into(), self.vs_best_share_hi),
+            Column::new("vs_best_median_diff_revs".into(), self.vs_best_diff),
+            Column::new("vs_best_median_diff_revs_lo".into(), self.vs_best_diff_lo),
+            Column::new("vs_best_median_diff_revs_hi".into(), self.vs_best_diff_hi),
+            Column::new("vs_best_p_holm".into(), self.vs_best_p_holm),
+            Column::new("vs_best_alpha".into(), self.vs_best_alpha),
+            Column::new("residual_rel_mean".into(), self.res_mean),
+            Column::new("residual_rel_median".into(), self.res_median),
+            Column::new("residual_rel_p95".into(), self.res_p95),
+            Column::new("censored".into(), self.censored),
+            Column::new("not_settled".into(), self.not_settled),
+            Column::new("diverged".into(), self.diverged),
+            Column::new("solver_failed".into(), self.solver_failed),
+            Column::new("budget_exceeded".into(), self.budget_exceeded),
+            Column::new("contact".into(), self.contact),
+            Column::new("min_gap_rad".into(), self.min_gap),
+            Column::new("max_overlap_fraction".into(), self.max_overlap),
+            Column::new("stall_torque".into(), self.stall_torque),
+            Column::new("reached_operating_speed".into(), self.reached_operating),
+            Column::new("operating_time_s_median".into(), self.operating_median),
+            Column::new("final_spin_rate_median".into(), self.spin_median),
+            Column::new("a_ref_median".into(), self.a_ref_median),
+            Column::new("settling_band_m".into(), self.settling_band),
+            Column::new("dead_band_m".into(), self.dead_band),
+            Column::new("over_capacity_share".into(), self.over_capacity),
+            Column::new("diagnosis".into(), self.diagnosis),
+            Column::new("failed_runs_counted".into(), self.failed_counted),
+        ];
+        columns.extend(measures);
+        DataFrame::new(height, columns)
     }
 }

@@ -3,8 +3,9 @@
 //! otherwise, with the reason pairing was refused.
 
 use super::config::{StudyFile, StudyPlan};
+use super::criterion::{Criterion, Scale};
 use super::io::read_parquet;
-use super::verdict::{Comparison, DesignRuns, compare, design_runs, settling_horizon};
+use super::verdict::{Comparison, DesignRuns, SettlingClock, compare, design_runs, measure_scale};
 use crate::stats::interval::wilson_interval;
 use crate::stats::survival::{KaplanMeier, Transform};
 use polars::prelude::*;
@@ -48,6 +49,12 @@ pub struct Side {
     pub runs: DesignRuns,
     /// Latest settling time its runs can show (revolutions).
     pub horizon: f64,
+    /// τ and the revolution of the side's study.
+    pub scale: Scale,
+    /// Where its settling times count from.
+    pub clock: SettlingClock,
+    /// The criterion its study ranks by (`[summary] rank_by`).
+    pub default_criterion: Criterion,
     /// Sampled unbalance (fraction of capacity) and direction of each run.
     draws: Vec<(Option<f64>, Option<f64>)>,
 }
@@ -80,8 +87,10 @@ impl Side {
         let df = read_parquet(&runs_path)?;
         let mine = df.filter(&df.column("design_id")?.u32()?.equal(id))?;
         let mine = mine.sort(["sample_id"], SortMultipleOptions::default())?;
-        let horizon = settling_horizon(&plan);
-        let runs = design_runs(&mine, horizon)?
+        let scale = measure_scale(&plan);
+        let horizon = scale.tau;
+        let clock = SettlingClock::of(&plan);
+        let runs = design_runs(&mine, horizon, clock)?
             .into_iter()
             .next()
             .ok_or_else(|| CompareError::NotAStudy(format!("{shown} (design {id} has no runs)")))?;
@@ -98,6 +107,9 @@ impl Side {
             ),
             runs,
             horizon,
+            scale,
+            clock,
+            default_criterion: plan.file.summary.rank_by,
             draws: fraction.iter().zip(direction.iter()).collect(),
         })
     }
@@ -152,12 +164,31 @@ pub struct DesignComparison {
     pub unpaired_because: Option<String>,
 }
 
-/// Compare side A with side B (paired when [`pairing_refusal`] allows).
-pub fn compare_sides(a: &Side, b: &Side, seed: u64) -> DesignComparison {
+/// Compare side A with side B (paired when [`pairing_refusal`] allows) on
+/// `criterion` first, then on every measure of [`Criterion::REPORTED`],
+/// with one τ for both sides (the earlier of their horizons).
+pub fn compare_sides(a: &Side, b: &Side, seed: u64, criterion: Criterion) -> DesignComparison {
     let refusal = pairing_refusal(a, b);
+    let mut measures = vec![criterion];
+    measures.extend(Criterion::REPORTED.iter().filter(|&&c| c != criterion));
     DesignComparison {
-        comparison: compare(&a.runs, &b.runs, refusal.is_none(), seed),
+        comparison: compare(
+            &a.runs,
+            &b.runs,
+            refusal.is_none(),
+            &measures,
+            &common_scale(a, b),
+            seed,
+        ),
         unpaired_because: refusal,
+    }
+}
+
+/// The τ both sides are compared up to: the earlier of their horizons.
+pub fn common_scale(a: &Side, b: &Side) -> Scale {
+    Scale {
+        tau: a.scale.tau.min(b.scale.tau),
+        rev_seconds: a.scale.rev_seconds,
     }
 }
 

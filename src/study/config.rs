@@ -52,6 +52,38 @@ pub struct StudyFile {
     /// How designs are compared (significance level of the verdicts).
     #[serde(default)]
     pub statistics: StatisticsSpec,
+    /// What "best" means: the ranking criterion and the measures of the
+    /// Pareto set.
+    #[serde(default)]
+    pub summary: SummarySpec,
+}
+
+/// What the ranking and the recommendation rest on (`[summary]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SummarySpec {
+    /// The criterion designs are ranked by; `study run/compare/claims
+    /// --rank-by` overrides it. Default: the restricted mean settling time
+    /// (it counts the slow tail; docs/statistics.md).
+    #[serde(default)]
+    pub rank_by: super::criterion::Criterion,
+    /// The measures a design must not be dominated on to be in the Pareto
+    /// set (`pareto` column of summary.parquet).
+    #[serde(default = "default_pareto")]
+    pub pareto: Vec<super::criterion::Criterion>,
+}
+
+impl Default for SummarySpec {
+    fn default() -> Self {
+        SummarySpec {
+            rank_by: super::criterion::Criterion::default(),
+            pareto: default_pareto(),
+        }
+    }
+}
+
+fn default_pareto() -> Vec<super::criterion::Criterion> {
+    super::criterion::Criterion::REPORTED.to_vec()
 }
 
 /// How verdicts between designs are reached.
@@ -277,9 +309,19 @@ pub struct UnbalanceSpec {
     /// The distribution.
     #[serde(flatten)]
     pub distribution: Distribution,
-    /// "capacity" (fraction of each design's capacity) or "absolute" (kg·m).
+    /// Required: "capacity" (a fraction of each design's capacity, no unit)
+    /// or "absolute" (kg·m). Never guessed: the same numbers mean a 10⁴-fold
+    /// different unbalance under the two.
     #[serde(default)]
-    pub relative_to: Scale,
+    pub relative_to: Option<Scale>,
+}
+
+impl UnbalanceSpec {
+    /// The scale the values are in (`relative_to`; [`StudyFile::plan`]
+    /// refuses a study without it, so a plan's spec always has one).
+    pub fn scale(&self) -> Scale {
+        self.relative_to.unwrap_or(Scale::Capacity)
+    }
 }
 
 /// schemars flattens the distribution as one alternative per distribution
@@ -290,6 +332,10 @@ fn close_unbalance_tables(schema: &mut schemars::Schema) {
     let shared = schema
         .remove("properties")
         .and_then(|p| p.as_object().cloned())
+        .unwrap_or_default();
+    let shared_required = schema
+        .remove("required")
+        .and_then(|r| r.as_array().cloned())
         .unwrap_or_default();
     let Some(alternatives) = schema
         .get_mut("oneOf")
@@ -304,16 +350,28 @@ fn close_unbalance_tables(schema: &mut schemars::Schema) {
         {
             properties.extend(shared.clone());
         }
+        if let Some(required) = alternative
+            .entry("required")
+            .or_insert_with(|| serde_json::Value::Array(Vec::new()))
+            .as_array_mut()
+        {
+            required.extend(shared_required.iter().cloned());
+            // Units are never guessed: `relative_to` is required, though
+            // the field is an Option so that the parser can name both
+            // choices in its message.
+            if !required.iter().any(|r| r == "relative_to") {
+                required.push("relative_to".into());
+            }
+        }
         alternative.insert("additionalProperties".into(), false.into());
     }
 }
 
 /// Scale of sampled unbalances.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, JsonSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Scale {
     /// A fraction of the design's capacity.
-    #[default]
     Capacity,
     /// kg·m.
     Absolute,
@@ -553,6 +611,13 @@ impl StudyFile {
             ));
         }
         let s = &self.sampling;
+        if s.unbalance.relative_to.is_none() {
+            return Err(invalid(
+                "sampling.unbalance.relative_to",
+                "(missing)".into(),
+                "required: \"capacity\" (the values are fractions of each design's balancing capacity, no unit) or \"absolute\" (the values are unbalances in kg·m)",
+            ));
+        }
         if s.samples == 0 {
             return Err(invalid(
                 "sampling.samples",
@@ -655,7 +720,7 @@ impl StudyFile {
             super::tolerance::validate(t, &designs, &facts)
                 .map_err(|(k, v, r)| invalid(&format!("sampling.tolerances.{k}"), v, &r))?;
         }
-        if s.unbalance.relative_to == Scale::Absolute && s.require_balanceable {
+        if s.unbalance.scale() == Scale::Absolute && s.require_balanceable {
             let upper = s.unbalance.distribution.upper();
             if let Some(d) = designs.iter().find(|d| d.capacity < upper) {
                 return Err(invalid(

@@ -9,6 +9,9 @@
 //! - [`record`]: one row of `runs.parquet`.
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`criterion`]: what "best" means: the declared ranking criterion and its test.
+//! - [`diagnosis`]: why no design balances, when none does.
+//! - [`failures`]: runs that did not finish, and the setting to change.
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
 //! - [`compare_designs`]: two designs of one or two results folders (`study compare`).
 //! - [`merge`]: combining shard outputs.
@@ -20,6 +23,9 @@ pub mod adaptive;
 pub mod aggregate;
 pub mod compare_designs;
 pub mod config;
+pub mod criterion;
+pub mod diagnosis;
+pub mod failures;
 pub mod io;
 pub mod lock;
 pub mod merge;

@@ -265,6 +265,12 @@ pub fn sample_simulation(
 ) -> (Sample, Simulation) {
     let mut sample = draw_sample(plan, design, sample_id);
     let mut scene = plan.scene(design, sample.unbalance, sample.direction);
+    // The design sits in every balancer plane, and so do its start angles
+    // (the sampled unbalance is placed in every plane at one direction too).
+    let planes = plan.file.scene.rotor.as_rotor().planes().max(1);
+    if planes > 1 {
+        sample.initial_angles = sample.initial_angles.repeat(planes);
+    }
     sample.weights = super::tolerance::apply(plan, design, sample_id, &mut scene);
     let simulation = Simulation {
         scene,

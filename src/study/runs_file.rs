@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 pub const WINDOW_RUNS: u64 = 32_768;
 
 /// Columns the per-design summary reads (a slim projection of the runs).
-pub const SUMMARY_COLUMNS: [&str; 11] = [
+pub const SUMMARY_COLUMNS: [&str; 14] = [
     "design_id",
     "sample_id",
     "outcome",
@@ -23,6 +23,9 @@ pub const SUMMARY_COLUMNS: [&str; 11] = [
     "settling_revs",
     "censoring_revs",
     "residual_rel",
+    "residual_abs",
+    "a_ref",
+    "unbalance_fraction",
     "contact",
     "min_gap_rad",
     "operating_time_s",

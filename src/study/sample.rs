@@ -106,7 +106,7 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     };
     let mut rng = stream(seed, shared, sample, Purpose::Unbalance);
     let value = draw(&s.unbalance.distribution, &mut rng);
-    let (unbalance, fraction) = match s.unbalance.relative_to {
+    let (unbalance, fraction) = match s.unbalance.scale() {
         Scale::Capacity => (value * design.capacity, value),
         Scale::Absolute => (value, value / design.capacity),
     };

@@ -4,12 +4,14 @@
 //! best design against every other with Holm's correction.
 
 use super::config::StudyPlan;
+use super::criterion::{Criterion, Scale, sign_difference};
 use super::sample::{Purpose, stream};
 use crate::stats::holm::holm_adjust;
 use crate::stats::paired::{
     Settling, SettlingComparison, WilcoxonResult, compare_settling, median_ratio,
     wilcoxon_signed_rank,
 };
+use crate::stats::paired_measures::{Difference, honest_p};
 use crate::stats::survival::{KaplanMeier, LogRank, Observation, log_rank};
 use polars::prelude::*;
 use rayon::prelude::*;
@@ -31,6 +33,8 @@ pub struct DesignRuns {
     pub settling: Vec<Observation>,
     /// Residual vibration / A_ref of runs simulated to their end.
     pub residual: Vec<Option<f64>>,
+    /// Residual vibration (m) of runs simulated to their end.
+    pub residual_abs: Vec<Option<f64>>,
 }
 
 impl DesignRuns {
@@ -42,25 +46,67 @@ impl DesignRuns {
 
 /// The latest settling time a run of the plan can show (revolutions): the
 /// end of the run less the hold window. Runs that never settled are
-/// censored here.
+/// censored here, and the restricted mean, the capped times of the paired
+/// mean test and the p90 all run up to it: one τ for `summary.parquet`,
+/// `study compare`, `study claims` and `study optimize`.
 pub fn settling_horizon(plan: &StudyPlan) -> f64 {
     plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs
 }
 
-/// The time the restricted mean is taken up to, and the best design chosen
-/// by: the latest time any run of `designs` could show (the plan's horizon,
-/// or a later settling time).
-pub fn restricted_horizon(plan: &StudyPlan, designs: &[DesignRuns]) -> f64 {
-    designs
-        .iter()
-        .flat_map(|d| d.settling.iter().map(|o| o.time))
-        .fold(settling_horizon(plan), f64::max)
+/// τ and the length of a revolution of `plan`.
+pub fn measure_scale(plan: &StudyPlan) -> Scale {
+    Scale {
+        tau: settling_horizon(plan),
+        rev_seconds: 2.0 * std::f64::consts::PI / plan.file.scene.speed.nominal_speed(),
+    }
+}
+
+/// Where settling times are counted from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SettlingClock {
+    /// From t = 0 (a constant speed: the rotor runs at speed from the start).
+    FromStart,
+    /// From the moment the rotor reached its operating speed (a run-up):
+    /// what the balancer takes, not the motor. One revolution lasts this
+    /// many seconds.
+    FromOperatingSpeed(f64),
+}
+
+impl SettlingClock {
+    /// The clock a plan's statistics use: from the operating speed whenever
+    /// the speed law is not constant.
+    pub fn of(plan: &StudyPlan) -> Self {
+        match plan.file.scene.speed {
+            crate::model::speed::SpeedLaw::Constant { .. } => SettlingClock::FromStart,
+            ref law => {
+                SettlingClock::FromOperatingSpeed(2.0 * std::f64::consts::PI / law.nominal_speed())
+            }
+        }
+    }
+
+    /// What tables say about it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            SettlingClock::FromStart => "from t = 0",
+            SettlingClock::FromOperatingSpeed(_) => {
+                "from the moment the operating speed was reached"
+            }
+        }
+    }
 }
 
 /// Every design's runs from a runs table holding the columns of
 /// [`super::runs_file::SUMMARY_COLUMNS`], in design order (designs without
 /// runs are left out).
-pub fn design_runs(df: &DataFrame, horizon: f64) -> PolarsResult<Vec<DesignRuns>> {
+///
+/// With [`SettlingClock::FromOperatingSpeed`], every time is counted from
+/// the run's `operating_time_s` (a run that never reached the operating
+/// speed keeps its censoring time: it is known not to have settled by then).
+pub fn design_runs(
+    df: &DataFrame,
+    horizon: f64,
+    clock: SettlingClock,
+) -> PolarsResult<Vec<DesignRuns>> {
     let design = df.column("design_id")?.u32()?;
     let sample = df.column("sample_id")?.u32()?;
     let outcome = df.column("outcome")?.str()?;
@@ -68,6 +114,8 @@ pub fn design_runs(df: &DataFrame, horizon: f64) -> PolarsResult<Vec<DesignRuns>
     let revs = df.column("settling_revs")?.f64()?;
     let censoring = df.column("censoring_revs")?.f64()?;
     let residual = df.column("residual_rel")?.f64()?;
+    let residual_abs = df.column("residual_abs")?.f64()?;
+    let operating = df.column("operating_time_s")?.f64()?;
     let mut out: Vec<DesignRuns> = Vec::new();
     let mut rows: Vec<usize> = (0..df.height()).collect();
     rows.sort_by_key(|&i| (design.get(i), sample.get(i)));
@@ -79,16 +127,21 @@ pub fn design_runs(df: &DataFrame, horizon: f64) -> PolarsResult<Vec<DesignRuns>
                 sample_ids: Vec::new(),
                 settling: Vec::new(),
                 residual: Vec::new(),
+                residual_abs: Vec::new(),
             });
         }
         let d = out.last_mut().expect("pushed above");
+        let offset = match clock {
+            SettlingClock::FromStart => 0.0,
+            SettlingClock::FromOperatingSpeed(rev) => operating.get(i).map_or(0.0, |t| t / rev),
+        };
         let observation = match (settled.get(i), revs.get(i)) {
             (Some(true), Some(t)) => Observation {
-                time: t,
+                time: (t - offset).max(0.0),
                 settled: true,
             },
             _ => Observation {
-                time: censoring.get(i).unwrap_or(horizon),
+                time: (censoring.get(i).unwrap_or(horizon) - offset).max(0.0),
                 settled: false,
             },
         };
@@ -97,6 +150,8 @@ pub fn design_runs(df: &DataFrame, horizon: f64) -> PolarsResult<Vec<DesignRuns>
         d.settling.push(observation);
         d.residual
             .push(residual.get(i).filter(|r| simulated && r.is_finite()));
+        d.residual_abs
+            .push(residual_abs.get(i).filter(|r| simulated && r.is_finite()));
     }
     Ok(out)
 }
@@ -112,6 +167,34 @@ pub fn pairing_refusal(a: &DesignRuns, b: &DesignRuns) -> Option<String> {
             b.sample_ids.len()
         )
     })
+}
+
+/// Design A against design B on one measure.
+#[derive(Debug, Clone)]
+pub struct MeasureComparison {
+    /// The measure.
+    pub criterion: Criterion,
+    /// A, B and A − B with its interval and unadjusted p-value (`None`:
+    /// nothing to compare, e.g. no residuals).
+    pub difference: Option<Difference>,
+    /// Holm-adjusted p-value over the comparisons of the best design on this
+    /// measure (the unadjusted one until [`best_versus_rest`] adjusts it).
+    pub p_holm: f64,
+}
+
+impl MeasureComparison {
+    /// True when A is better than B on this measure at level `alpha`.
+    pub fn a_better_at(&self, alpha: f64) -> bool {
+        self.difference
+            .is_some_and(|d| self.p_holm <= alpha && self.criterion.a_better(d.difference))
+    }
+
+    /// True when B is better than A on this measure at level `alpha`.
+    pub fn b_better_at(&self, alpha: f64) -> bool {
+        self.difference.is_some_and(|d| {
+            self.p_holm <= alpha && d.difference != 0.0 && !self.criterion.a_better(d.difference)
+        })
+    }
 }
 
 /// Design A against design B.
@@ -133,9 +216,16 @@ pub struct Comparison {
     pub residual_test: Option<WilcoxonResult>,
     /// Median of the paired residual ratios A/B with its interval.
     pub residual_ratio: Option<(f64, (f64, f64))>,
+    /// A against B on each measure asked for, in the order asked.
+    pub measures: Vec<MeasureComparison>,
 }
 
 impl Comparison {
+    /// The comparison on one measure, if it was asked for.
+    pub fn on(&self, criterion: Criterion) -> Option<&MeasureComparison> {
+        self.measures.iter().find(|m| m.criterion == criterion)
+    }
+
     /// The p-value of "A and B settle alike": the sign test when paired,
     /// the log-rank test otherwise; 1 when nothing could be compared.
     pub fn p_value(&self) -> f64 {
@@ -157,8 +247,16 @@ impl Comparison {
 }
 
 /// Compare A with B, paired when `paired` (the caller checked
-/// [`pairing_refusal`]); `seed` seeds the bootstrap intervals.
-pub fn compare(a: &DesignRuns, b: &DesignRuns, paired: bool, seed: u64) -> Comparison {
+/// [`pairing_refusal`]), on every measure in `measures`; `seed` seeds the
+/// bootstrap intervals.
+pub fn compare(
+    a: &DesignRuns,
+    b: &DesignRuns,
+    paired: bool,
+    measures: &[Criterion],
+    scale: &Scale,
+    seed: u64,
+) -> Comparison {
     let median = |d: &DesignRuns| d.kaplan_meier().and_then(|km| km.median());
     let mut rng = stream(
         seed,
@@ -188,62 +286,138 @@ pub fn compare(a: &DesignRuns, b: &DesignRuns, paired: bool, seed: u64) -> Compa
     } else {
         (None, log_rank(&a.settling, &b.settling), None, None)
     };
+    let medians = (median(a), median(b));
+    let measures = measures
+        .iter()
+        .map(|&criterion| {
+            // The paired median reuses the sign test above (same stream).
+            let difference = match (criterion, &settling) {
+                (Criterion::Median, Some(c)) => Some(sign_difference(
+                    c,
+                    medians.0.unwrap_or(f64::INFINITY),
+                    medians.1.unwrap_or(f64::INFINITY),
+                )),
+                (Criterion::Median, None) if !paired => unpaired.map(|u| Difference {
+                    a: medians.0.unwrap_or(f64::INFINITY),
+                    b: medians.1.unwrap_or(f64::INFINITY),
+                    difference: medians.0.unwrap_or(f64::INFINITY)
+                        - medians.1.unwrap_or(f64::INFINITY),
+                    interval: (f64::NEG_INFINITY, f64::INFINITY),
+                    p_value: honest_p(u.p_value),
+                    test: "log_rank",
+                }),
+                _ => criterion.compare(a, b, paired, scale, LEVEL, &mut rng),
+            };
+            MeasureComparison {
+                criterion,
+                p_holm: difference.map_or(1.0, |d| d.p_value),
+                difference,
+            }
+        })
+        .collect();
     Comparison {
         a: a.design_id,
         b: b.design_id,
         runs: (a.settling.len(), b.settling.len()),
-        medians: (median(a), median(b)),
+        medians,
         paired: settling,
         unpaired,
         residual_test,
         residual_ratio,
+        measures,
     }
 }
 
-/// The verdict on the best design against one other.
+/// The verdict on the best design against one other, on the ranking criterion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
-    /// The best design settles sooner (Holm-adjusted p ≤ α).
-    BestSooner,
+    /// The best design is better (Holm-adjusted p ≤ α).
+    BestBetter,
     /// The data cannot tell the two apart at α.
     NotDistinguishable,
-    /// The other design settles sooner in significantly more paired runs,
-    /// although the best has the lower median: the two rankings disagree.
-    OtherSooner,
+    /// The other design is significantly better by the criterion's test,
+    /// although the best ranks first on the criterion's point estimate.
+    OtherBetter,
 }
 
 impl Verdict {
     /// The verdict as stored in `summary.parquet`.
     pub fn name(self) -> &'static str {
         match self {
-            Verdict::BestSooner => "best_sooner",
+            Verdict::BestBetter => "best_better",
             Verdict::NotDistinguishable => "not_distinguishable",
-            Verdict::OtherSooner => "other_sooner",
+            Verdict::OtherBetter => "other_better",
         }
     }
 }
 
+/// The least share of runs the first design must settle in, and the most
+/// residual/A_ref (median) it may leave, to be called a working balancer.
+pub const MIN_SETTLED_SHARE: f64 = 0.5;
+
 /// The best design against every other one.
 #[derive(Debug, Clone)]
 pub struct BestVersusRest {
-    /// The design with the lowest Kaplan–Meier median settling time (ties:
-    /// the lower restricted mean up to the horizon).
+    /// The design ranked first by `criterion` (ties: the lower restricted
+    /// mean, then the lower design id).
     pub best: u32,
-    /// Family-wise error rate of the verdicts.
+    /// What designs were ranked by.
+    pub criterion: Criterion,
+    /// Family-wise error rate of the verdicts (per measure).
     pub alpha: f64,
     /// Whether runs were paired by sample.
     pub paired: bool,
+    /// Whether the first design balances at all: it settles in at least
+    /// [`MIN_SETTLED_SHARE`] of its runs and its median residual/A_ref is at
+    /// most 1. When it does not, no design is called best.
+    pub works: bool,
+    /// Design ids, best first, in ranking order.
+    pub order: Vec<u32>,
     /// One entry per other design: the comparison (A = best), its
-    /// Holm-adjusted p-value and the verdict.
+    /// Holm-adjusted p-value on the criterion and the verdict.
     pub others: Vec<(Comparison, f64, Verdict)>,
 }
 
-/// Rank designs by Kaplan–Meier median (restricted mean up to `horizon` to
-/// break ties and to order designs whose median lies beyond the run) and
-/// compare the first with every other. `None` with fewer than two designs.
+/// Design indices of `designs`, best first by `criterion` (ties: the lower
+/// restricted mean, then the grid order).
+pub fn ranking(designs: &[DesignRuns], criterion: Criterion, scale: &Scale) -> Vec<usize> {
+    let keys: Vec<(Option<f64>, Option<f64>)> = designs
+        .iter()
+        .map(|d| (criterion.value(d, scale), Criterion::Mean.value(d, scale)))
+        .collect();
+    let mut order: Vec<usize> = (0..designs.len()).collect();
+    order.sort_by(|&x, &y| {
+        criterion
+            .order(keys[x].0, keys[y].0)
+            .then(Criterion::Mean.order(keys[x].1, keys[y].1))
+            .then(x.cmp(&y))
+    });
+    order
+}
+
+/// Whether a design balances: it settled in at least [`MIN_SETTLED_SHARE`]
+/// of its runs and left a median residual/A_ref of at most 1.
+pub fn balances(runs: &DesignRuns) -> bool {
+    let n = runs.settling.len();
+    let settled = runs.settling.iter().filter(|o| o.settled).count();
+    let mut residual: Vec<f64> = runs.residual.iter().flatten().copied().collect();
+    residual.sort_by(f64::total_cmp);
+    let median = crate::stats::quantile::quantile_sorted(
+        &residual,
+        0.5,
+        crate::stats::quantile::Interpolation::Linear,
+    );
+    n > 0 && settled as f64 >= MIN_SETTLED_SHARE * n as f64 && median.is_none_or(|m| m <= 1.0)
+}
+
+/// Rank designs by `criterion` and compare the first with every other on
+/// the criterion and on every measure of [`Criterion::REPORTED`], each
+/// measure Holm-adjusted over the comparisons. `None` with fewer than two
+/// designs.
 pub fn best_versus_rest(
     designs: &[DesignRuns],
-    horizon: f64,
+    criterion: Criterion,
+    scale: &Scale,
     alpha: f64,
     common_random_numbers: bool,
     seed: u64,
@@ -251,47 +425,99 @@ pub fn best_versus_rest(
     if designs.len() < 2 {
         return None;
     }
-    let key = |d: &DesignRuns| {
-        let km = d.kaplan_meier();
-        let median = km
-            .as_ref()
-            .and_then(|k| k.median())
-            .unwrap_or(f64::INFINITY);
-        let rmst = km.map_or(f64::INFINITY, |k| k.restricted_mean(horizon).estimate);
-        (median, rmst)
-    };
-    let best = designs.iter().min_by(|x, y| {
-        let (kx, ky) = (key(x), key(y));
-        kx.0.total_cmp(&ky.0).then(kx.1.total_cmp(&ky.1))
-    })?;
+    let order = ranking(designs, criterion, scale);
+    let best = &designs[order[0]];
     let paired =
         common_random_numbers && designs.iter().all(|d| pairing_refusal(best, d).is_none());
+    let mut measures = vec![criterion];
+    measures.extend(Criterion::REPORTED.iter().filter(|&&c| c != criterion));
     // In parallel: each comparison draws from its own stream, and collect
     // keeps the order, so the result does not depend on the thread count.
-    let comparisons: Vec<Comparison> = designs
+    let mut comparisons: Vec<Comparison> = designs
         .par_iter()
         .with_max_len(1) // one comparison per job, as runs (study::run)
         .filter(|d| d.design_id != best.design_id)
-        .map(|d| compare(best, d, paired, seed))
+        .map(|d| compare(best, d, paired, &measures, scale, seed))
         .collect();
-    let p: Vec<f64> = comparisons.iter().map(Comparison::p_value).collect();
-    let adjusted = holm_adjust(&p);
+    for k in 0..measures.len() {
+        let p: Vec<f64> = comparisons
+            .iter()
+            .map(|c| c.measures[k].difference.map_or(1.0, |d| d.p_value))
+            .collect();
+        for (c, p_holm) in comparisons.iter_mut().zip(holm_adjust(&p)) {
+            c.measures[k].p_holm = honest_p(p_holm);
+        }
+    }
     let others = comparisons
         .into_iter()
-        .zip(adjusted)
-        .map(|(c, p_holm)| {
-            let verdict = match (p_holm <= alpha, c.a_is_sooner()) {
-                (true, true) => Verdict::BestSooner,
-                (true, false) => Verdict::OtherSooner,
-                (false, _) => Verdict::NotDistinguishable,
+        .map(|c| {
+            let on = &c.measures[0];
+            let verdict = if on.a_better_at(alpha) {
+                Verdict::BestBetter
+            } else if on.b_better_at(alpha) {
+                Verdict::OtherBetter
+            } else {
+                Verdict::NotDistinguishable
             };
-            (c, p_holm, verdict)
+            let p = on.p_holm;
+            (c, p, verdict)
         })
         .collect();
     Some(BestVersusRest {
         best: best.design_id,
+        criterion,
         alpha,
         paired,
+        works: balances(best),
+        order: order.iter().map(|&i| designs[i].design_id).collect(),
         others,
     })
+}
+
+/// Holm-adjust every measure over the comparisons of several families at
+/// once (the families that answer one question, e.g. one claim under every
+/// normalisation), replacing each family's own adjustment, and recompute the
+/// verdicts on the ranking criterion.
+pub fn holm_across(families: &mut [BestVersusRest]) {
+    let Some(first) = families.first() else {
+        return;
+    };
+    let measures = first.others.first().map_or(0, |(c, _, _)| c.measures.len());
+    for k in 0..measures {
+        let raw: Vec<f64> = families
+            .iter()
+            .flat_map(|f| f.others.iter())
+            .map(|(c, _, _)| {
+                c.measures
+                    .get(k)
+                    .and_then(|m| m.difference)
+                    .map_or(1.0, |d| d.p_value)
+            })
+            .collect();
+        let mut adjusted = holm_adjust(&raw).into_iter();
+        for family in families.iter_mut() {
+            for (c, _, _) in family.others.iter_mut() {
+                let p = adjusted.next().unwrap_or(1.0);
+                if let Some(m) = c.measures.get_mut(k) {
+                    m.p_holm = honest_p(p);
+                }
+            }
+        }
+    }
+    for family in families.iter_mut() {
+        let alpha = family.alpha;
+        for (c, p, verdict) in family.others.iter_mut() {
+            let Some(on) = c.measures.first() else {
+                continue;
+            };
+            *p = on.p_holm;
+            *verdict = if on.a_better_at(alpha) {
+                Verdict::BestBetter
+            } else if on.b_better_at(alpha) {
+                Verdict::OtherBetter
+            } else {
+                Verdict::NotDistinguishable
+            };
+        }
+    }
 }

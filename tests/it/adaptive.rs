@@ -23,7 +23,7 @@ rho = \"optimal\"
 race_radius = 0.05
 drag = [10.0, 50.0]
 [sampling]
-unbalance = {{ distribution = \"uniform\", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }}
 {sampling}
 [metrics]
 t_end_revs = 400

@@ -31,7 +31,7 @@ density = 7850.0
 drag = 10.0
 [sampling]
 samples = 2
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }}
 direction = "uniform"
 initial = "clustered"
 [solver]

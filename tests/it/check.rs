@@ -194,7 +194,7 @@ drag = {drag:?}
 
 [sampling]
 samples = 150
-unbalance = {{ distribution = "fixed", value = 0.5 }}
+unbalance = {{ distribution = "fixed", value = 0.5, relative_to = "capacity" }}
 initial = "even"
 
 [metrics]

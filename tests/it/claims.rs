@@ -20,7 +20,7 @@ race_radius = 0.05
 drag = 10.0
 [sampling]
 samples = 1
-unbalance = { distribution = "fixed", value = 0.5 }
+unbalance = { distribution = "fixed", value = 0.5, relative_to = "capacity" }
 "#,
     ]
     .concat();
@@ -78,7 +78,7 @@ race_radius = 0.05
 drag = 10.0
 [sampling]
 samples = 6
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }}
 [metrics]
 t_end_revs = 300
 "#,

@@ -34,7 +34,7 @@ drag = [10.0, 50.0]
 
 [sampling]
 samples = 24
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }}
 
 [metrics]
 t_end_revs = 800
@@ -72,7 +72,37 @@ fn designs_of_one_study_are_paired_and_foreign_samples_are_not() {
     // β = 10 settles sooner than β = 50 on every shared sample (the golden
     // study shows the same ordering at 800 revolutions).
     assert!(text.contains("A settles sooner in 100 %"), "{text}");
-    assert!(text.contains("verdict: A settles sooner than B"), "{text}");
+    assert!(
+        text.contains("verdict: A is better than B on the restricted mean settling time"),
+        "{text}"
+    );
+    // Every measure is listed with its test; the verdict names the one it rests on.
+    for line in [
+        "median settling time: A",
+        "p90 settling time: A",
+        "p95 residual/A_ref: A",
+    ] {
+        assert!(text.contains(line), "{line:?} in {text}");
+    }
+    assert!(text.contains("paired_t p"), "{text}");
+    // --rank-by switches the measure the verdict rests on.
+    let out = compare(&[a_s, "--designs", "0,1", "--rank-by", "median"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("verdict: A is better than B on the median settling time"),
+        "{text}"
+    );
+    // A closed stdout ends the verb quietly, without a panic.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["compare", a_s, "--designs", "0,1"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
 
     // The same design in two studies of different seeds: the samples differ,
     // so pairing is refused with the reason and the log-rank test is used.

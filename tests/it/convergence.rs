@@ -102,7 +102,7 @@ fn tolerances_outside_their_range_are_refused() {
         ("atol", "0.0"),
     ] {
         let text = format!(
-            "seed = 1\n[scene.rotor]\nmass = 10.0\nkx = 1e5\nky = 1e5\nbx = 100.0\nby = 100.0\n[scene.speed]\nmode = \"constant\"\nomega = 300.0\n[designs]\nkind = \"ball\"\nn = 3\nrho = \"optimal\"\nrace_radius = 0.05\ndrag = 5.0\n[sampling]\nsamples = 2\nunbalance = {{ distribution = \"uniform\", min = 0.1, max = 0.9 }}\n[solver]\n{key} = {value}\n"
+            "seed = 1\n[scene.rotor]\nmass = 10.0\nkx = 1e5\nky = 1e5\nbx = 100.0\nby = 100.0\n[scene.speed]\nmode = \"constant\"\nomega = 300.0\n[designs]\nkind = \"ball\"\nn = 3\nrho = \"optimal\"\nrace_radius = 0.05\ndrag = 5.0\n[sampling]\nsamples = 2\nunbalance = {{ distribution = \"uniform\", min = 0.1, max = 0.9, relative_to = \"capacity\" }}\n[solver]\n{key} = {value}\n"
         );
         let err = StudyFile::parse(&text, "bad.toml")
             .and_then(|f| f.plan(&text, "bad.toml"))

@@ -528,7 +528,7 @@ density = 10.0
 drag = 0.01
 [sampling]
 samples = 2
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.6 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.6, relative_to = "capacity" }}
 [metrics]
 t_end_revs = 20
 hold_revs = 10

@@ -45,7 +45,7 @@ t_end_revs = 300
         .unwrap()
 }
 
-const FIXED: &str = "samples = 1\nunbalance = { distribution = \"fixed\", value = 0.5 }";
+const FIXED: &str = "samples = 1\nunbalance = { distribution = \"fixed\", value = 0.5, relative_to = \"capacity\" }";
 
 #[test]
 fn analytic_capacity_optimum_is_table_1() {
@@ -154,7 +154,7 @@ fn optimisation_is_identical_for_any_thread_count() {
         let p = plan(
             tmp.path(),
             "kind = \"ball\"\nn = [3, 4]\nrho = \"optimal\"\ndrag = 10.0",
-            "samples = 8\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8 }",
+            "samples = 8\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }",
             "objective = \"settling_mean\"\nmax_evaluations = 8",
         );
         let pool = rayon::ThreadPoolBuilder::new()
@@ -195,7 +195,7 @@ fn nelder_mead_searches_rho_and_drag_within_bounds() {
     let p = plan(
         tmp.path(),
         "kind = \"ball\"\nn = 3\nrho = \"optimal\"\ndrag = 3.0",
-        "samples = 6\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8 }",
+        "samples = 6\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }",
         "objective = \"settling_mean\"\nfree = [\"rho\", \"drag\"]\nrho_bounds = [0.2, 0.4]\ndrag_bounds = [1.0, 40.0]\nmax_evaluations = 24",
     );
     let out = optimize(&p).unwrap();
@@ -231,7 +231,7 @@ fn settling_objectives_equal_the_summarys_censoring_aware_statistics() {
         let p = plan(
             tmp.path(),
             "kind = \"ball\"\nn = 3\nrho = 0.3\ndrag = 0.15",
-            "samples = 15\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.9 }",
+            "samples = 15\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.9, relative_to = \"capacity\" }",
             &format!("objective = \"{objective}\""),
         );
         let spec = p.file.optimize.clone().unwrap();

@@ -29,7 +29,7 @@ race_radius = 0.05
 drag = 10.0
 [sampling]
 samples = 2
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }}
 [metrics]
 t_end_revs = 60
 "#,

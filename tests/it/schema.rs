@@ -247,14 +247,21 @@ fn the_schema_refuses_what_the_parser_refuses_and_nothing_valid() {
         ),
         (
             Kind::Study,
-            "max = 0.8 }",
+            "max = 0.8, relative_to = \"capacity\" }",
             "max = 0.8, relative_to = \"absolute\" }",
             false,
         ),
-        (Kind::Study, "max = 0.8 }", "max = 0.8, mean = 0.5 }", true),
         (
             Kind::Study,
-            "max = 0.8 }",
+            "max = 0.8, relative_to = \"capacity\" }",
+            "max = 0.8, mean = 0.5, relative_to = \"capacity\" }",
+            true,
+        ),
+        // Units are never guessed: a study without relative_to is refused.
+        (Kind::Study, ", relative_to = \"capacity\" }", " }", true),
+        (
+            Kind::Study,
+            "max = 0.8, relative_to = \"capacity\" }",
             "max = 0.8, relative_to = \"total\" }",
             true,
         ),

@@ -160,7 +160,7 @@ drag = 10.0
 stall_torque = {list}
 [sampling]
 samples = 1
-unbalance = {{ distribution = "fixed", value = 0.5 }}
+unbalance = {{ distribution = "fixed", value = 0.5, relative_to = "capacity" }}
 [metrics]
 t_end_revs = 100
 "#

@@ -26,7 +26,7 @@ race_radius = 0.05
 drag = 10.0
 [sampling]
 samples = 2
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }}
 [metrics]
 t_end_revs = 50
 "#,
@@ -144,7 +144,10 @@ fn rho_outside_its_range_and_zero_weights_are_named() {
 
 #[test]
 fn absolute_unbalance_beyond_capacity_is_an_error_unless_allowed() {
-    let absolute = |t: String| t.replace("max = 0.8 }", "max = 0.5, relative_to = \"absolute\" }");
+    let absolute = |t: String| {
+        t.replace("relative_to = \"capacity\"", "relative_to = \"absolute\"")
+            .replace("max = 0.8", "max = 0.5")
+    };
     rejects(
         absolute,
         &[
@@ -156,7 +159,8 @@ fn absolute_unbalance_beyond_capacity_is_an_error_unless_allowed() {
     // Allowed explicitly: the study runs and the runs simply do not settle.
     let tmp = tempfile::tempdir().unwrap();
     let text = valid(&tmp.path().join("results"))
-        .replace("max = 0.8 }", "max = 0.5, relative_to = \"absolute\" }")
+        .replace("relative_to = \"capacity\"", "relative_to = \"absolute\"")
+        .replace("max = 0.8", "max = 0.5")
         .replace("samples = 2", "samples = 2\nrequire_balanceable = false");
     let (code, err) = run(tmp.path(), &text);
     assert_eq!(code, Some(0), "{err}");

@@ -36,7 +36,7 @@ drag = [10.0, 50.0]
 
 [sampling]
 samples = {samples}
-unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8 }}
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }}
 
 [metrics]
 t_end_revs = 800

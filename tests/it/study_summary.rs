@@ -7,6 +7,7 @@ use autobal::stats::interval::wilson_interval;
 use autobal::stats::survival::Observation;
 use autobal::study::aggregate::summarize;
 use autobal::study::config::StudyFile;
+use autobal::study::criterion::{Criterion, Scale};
 use autobal::study::record::RunRecord;
 use autobal::study::sample::{Purpose, stream};
 use autobal::study::verdict::{DesignRuns, Verdict, best_versus_rest, settling_horizon};
@@ -23,7 +24,7 @@ race_radius = 0.05
 drag = 10.0
 [sampling]
 samples = 6
-unbalance = { distribution = "fixed", value = 0.5 }
+unbalance = { distribution = "fixed", value = 0.5, relative_to = "capacity" }
 "#,
     ]
     .concat();
@@ -251,8 +252,15 @@ fn design(id: u32, times: &[Option<f64>]) -> DesignRuns {
             })
             .collect(),
         residual: vec![Some(0.01); times.len()],
+        residual_abs: vec![Some(1e-6); times.len()],
     }
 }
+
+/// τ = 100 rev, one revolution 0.02 s.
+const SCALE: Scale = Scale {
+    tau: 100.0,
+    rev_seconds: 0.02,
+};
 
 #[test]
 fn the_best_design_is_compared_with_every_other_on_paired_runs() {
@@ -274,7 +282,7 @@ fn the_best_design_is_compared_with_every_other_on_paired_runs() {
         design(2, &twin),
         design(3, &flaky),
     ];
-    let v = best_versus_rest(&designs, 100.0, 0.05, true, 1).unwrap();
+    let v = best_versus_rest(&designs, Criterion::Median, &SCALE, 0.05, true, 1).unwrap();
     assert!(v.paired);
     // Kaplan–Meier medians: fast and twin 29.5 (the same times; equal
     // restricted means, so the first is the best), flaky 35.5 (its 20th and
@@ -285,7 +293,7 @@ fn the_best_design_is_compared_with_every_other_on_paired_runs() {
     let paired = vs_slow.paired.as_ref().unwrap();
     assert_eq!((paired.a_sooner, paired.b_sooner, paired.ties), (40, 0, 0));
     assert_eq!(paired.median_difference, 5.0);
-    assert_eq!(*slow_verdict, Verdict::BestSooner);
+    assert_eq!(*slow_verdict, Verdict::BestBetter);
     // Sign test 2·0.5⁴⁰, the smallest of three p-values: Holm multiplies it by 3.
     assert!((p_slow / (3.0 * 2.0 * 0.5f64.powi(40)) - 1.0).abs() < 1e-9);
     // The twin differs on two samples, one each way: indistinguishable.
@@ -296,18 +304,76 @@ fn the_best_design_is_compared_with_every_other_on_paired_runs() {
     // says the rankings disagree instead of calling the best faster.
     let (vs_flaky, _, flaky_verdict) = verdict(3);
     assert_eq!(vs_flaky.paired.as_ref().unwrap().b_sooner, 30);
-    assert_eq!(*flaky_verdict, Verdict::OtherSooner);
+    assert_eq!(*flaky_verdict, Verdict::OtherBetter);
     // Holm: adjusted p-values are never below the raw ones.
     for (c, p, _) in &v.others {
         assert!(*p >= c.p_value());
     }
     // Without common random numbers the same runs are compared unpaired (log-rank).
-    let unpaired = best_versus_rest(&designs, 100.0, 0.05, false, 1).unwrap();
+    let unpaired = best_versus_rest(&designs, Criterion::Median, &SCALE, 0.05, false, 1).unwrap();
     assert!(!unpaired.paired);
     assert!(
         unpaired
             .others
             .iter()
             .all(|(c, _, _)| c.paired.is_none() && c.unpaired.is_some())
+    );
+}
+
+/// The main job's reversal in miniature: design 0 has the lower median but
+/// 30 % of its runs take ten times longer; design 1 always takes 12 rev.
+fn fast_median_slow_tail() -> [DesignRuns; 2] {
+    let tail: Vec<Option<f64>> = (0..80)
+        .map(|i| {
+            Some(if i % 10 < 3 {
+                80.0
+            } else {
+                8.0 + 0.01 * f64::from(i)
+            })
+        })
+        .collect();
+    let steady: Vec<Option<f64>> = (0..80).map(|i| Some(12.0 + 0.01 * f64::from(i))).collect();
+    [design(0, &tail), design(1, &steady)]
+}
+
+#[test]
+fn the_default_criterion_counts_the_tail_and_the_median_win_is_reported_beside_it() {
+    let designs = fast_median_slow_tail();
+    assert_eq!(Criterion::default(), Criterion::Mean);
+    // Ranked by the restricted mean (29.6 against 12.4 rev), the steady design leads.
+    let by_mean = best_versus_rest(&designs, Criterion::Mean, &SCALE, 0.05, true, 1).unwrap();
+    assert_eq!(by_mean.best, 1);
+    let (c, p, verdict) = &by_mean.others[0];
+    assert_eq!(*verdict, Verdict::BestBetter, "p {p}");
+    // ... and the other design's median win is measured, significant, and on record.
+    let median = c.on(Criterion::Median).unwrap();
+    assert!(median.b_better_at(0.05), "{median:?}");
+    let p90 = c.on(Criterion::P90).unwrap();
+    assert!(p90.a_better_at(0.05), "{p90:?}");
+    // Ranked by the median, the tail design leads, and the restricted-mean
+    // test says the other is better.
+    let by_median = best_versus_rest(&designs, Criterion::Median, &SCALE, 0.05, true, 1).unwrap();
+    assert_eq!(by_median.best, 0);
+    let mean = by_median.others[0].0.on(Criterion::Mean).unwrap();
+    assert!(mean.b_better_at(0.05), "{mean:?}");
+}
+
+#[test]
+fn share_criteria_rank_by_the_share_and_test_the_discordant_pairs() {
+    let designs = fast_median_slow_tail();
+    // Settled within 30 rev: 56 of 80 against 80 of 80.
+    let within = Criterion::parse("settled_by:30rev").unwrap();
+    let v = best_versus_rest(&designs, within, &SCALE, 0.05, true, 1).unwrap();
+    assert_eq!(v.best, 1);
+    let d = v.others[0].0.measures[0].difference.unwrap();
+    assert_eq!(d.test, "mcnemar");
+    assert!((d.a - 1.0).abs() < 1e-12 && (d.b - 0.7).abs() < 1e-12);
+    // 24 discordant pairs, all one way: 2·0.5²⁴.
+    assert!((d.p_value / (2.0 * 0.5f64.powi(24)) - 1.0).abs() < 1e-9);
+    // In seconds: 30 rev of 0.02 s is 0.6 s, the same ranking.
+    let seconds = Criterion::parse("settled_by:0.6s").unwrap();
+    assert_eq!(
+        seconds.value(&designs[0], &SCALE),
+        within.value(&designs[0], &SCALE)
     );
 }

@@ -5,7 +5,9 @@ use crate::UserError;
 use crate::output::{p_value_text, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
 use autobal::plot::km::{KmCurve, plot_kaplan_meier};
-use autobal::study::compare_designs::{Side, compare_sides, median_with_interval};
+use autobal::stats::holm::holm_adjust;
+use autobal::study::compare_designs::{Side, common_scale, compare_sides, median_with_interval};
+use autobal::study::criterion::Criterion;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -32,6 +34,10 @@ pub struct CompareArgs {
     /// Also draw both designs' Kaplan–Meier curves into this file (.svg or .png, by extension).
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
+    /// The measure the verdict rests on (default: the first study's `[summary] rank_by`):
+    /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
+    #[arg(long, value_parser = crate::run_cmd::parse_criterion, value_name = "CRITERION")]
+    rank_by: Option<Criterion>,
 }
 
 /// "= 0.0123" or "< 0.0001".
@@ -84,7 +90,9 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
     };
     let a = Side::load(dir_a, design_a)?;
     let b = Side::load(dir_b, design_b)?;
-    let result = compare_sides(&a, &b, 0);
+    let criterion = args.rank_by.unwrap_or(a.default_criterion);
+    let scale = common_scale(&a, &b);
+    let result = compare_sides(&a, &b, 0, criterion);
     let c = &result.comparison;
     let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |x| format!("{x:.d$}"));
     let end = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
@@ -94,9 +102,11 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         let (median, (m_lo, m_hi)) = km
             .as_ref()
             .map_or((None, (None, None)), median_with_interval);
-        let rmst = km.map(|k| k.restricted_mean(side.horizon));
+        let rmst = km.map(|k| k.restricted_mean(scale.tau));
         let residual_values: Vec<f64> = side.runs.residual.iter().flatten().copied().collect();
         let residual = autobal::stats::quantile::median(&residual_values);
+        let p90 = Criterion::P90.value(&side.runs, &scale);
+        let residual_p95 = Criterion::ResidualP95.value(&side.runs, &scale);
         vec![
             side.label.clone(),
             format!("{runs}"),
@@ -117,7 +127,9 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                     i.upper
                 )
             }),
+            p90.map_or("beyond the run".into(), |x| format!("{x:.1}")),
             f(residual, 4),
+            f(residual_p95, 4),
             side.dir.display().to_string(),
         ]
     };
@@ -128,7 +140,9 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         "settled [95% CI]",
         "t_s median, Kaplan–Meier [95% CI] (rev)",
         "t_s restricted mean [95% CI] (rev)",
+        "t_s p90 (rev)",
         "residual/A_ref, median",
+        "residual/A_ref, p95",
         "folder",
     ];
     let rows: Vec<Vec<String>> = names
@@ -137,7 +151,11 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         .map(|(i, n)| vec![n.to_string(), ca[i].clone(), cb[i].clone()])
         .collect();
     print!("{}", text_table(&["", "A", "B"], &rows));
-    let p = c.p_value();
+    println!(
+        "(settling times counted {}; a run that did not settle counts as censored; restricted mean and p90 up to τ = {:.1} rev, the earlier horizon of the two)",
+        a.clock.describe(),
+        scale.tau
+    );
     let rev = |x: f64| {
         if x.is_finite() {
             format!("{x:.1}")
@@ -186,14 +204,79 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         }
         (None, None) => println!("nothing to compare: no runs"),
     }
-    let verdict = if p > args.alpha {
-        format!("not distinguishable at α = {}", args.alpha)
-    } else if c.a_is_sooner() {
-        format!("A settles sooner than B (α = {})", args.alpha)
-    } else {
-        format!("B settles sooner than A (α = {})", args.alpha)
+    // Every measure of this one pair, Holm-adjusted over the measures.
+    let raw: Vec<f64> = c
+        .measures
+        .iter()
+        .map(|m| m.difference.map_or(1.0, |d| d.p_value))
+        .collect();
+    let adjusted = holm_adjust(&raw);
+    let mut favours_b = Vec::new();
+    for (m, p_holm) in c.measures.iter().zip(&adjusted) {
+        let Some(d) = m.difference else {
+            println!("{}: nothing to compare", m.criterion.label());
+            continue;
+        };
+        let unit = m.criterion.unit();
+        let scale_by = if unit == "%" { 100.0 } else { 1.0 };
+        let show = |x: f64| {
+            if x.is_finite() {
+                format!("{:.3}", scale_by * x)
+            } else {
+                "∞".into()
+            }
+        };
+        println!(
+            "{}: A {} vs B {}, A − B {} [{}, {}] {unit}, {} p {} (Holm over the {} measures: {})",
+            m.criterion.label(),
+            show(d.a),
+            show(d.b),
+            show(d.difference),
+            show(d.interval.0),
+            show(d.interval.1),
+            d.test,
+            p_eq(d.p_value),
+            c.measures.len(),
+            p_value_text(*p_holm)
+        );
+        if m.criterion != criterion
+            && *p_holm <= args.alpha
+            && d.difference != 0.0
+            && !m.criterion.a_better(d.difference)
+        {
+            favours_b.push(m.criterion.label());
+        }
+    }
+    let on = c.measures.first().and_then(|m| m.difference);
+    let p_on = adjusted.first().copied().unwrap_or(1.0);
+    let verdict = match on {
+        Some(d) if p_on <= args.alpha && criterion.a_better(d.difference) => {
+            format!(
+                "A is better than B on the {} (α = {})",
+                criterion.label(),
+                args.alpha
+            )
+        }
+        Some(d) if p_on <= args.alpha && d.difference != 0.0 => {
+            format!(
+                "B is better than A on the {} (α = {})",
+                criterion.label(),
+                args.alpha
+            )
+        }
+        _ => format!(
+            "not distinguishable on the {} at α = {}",
+            criterion.label(),
+            args.alpha
+        ),
     };
     println!("verdict: {verdict}");
+    if !favours_b.is_empty() && verdict.starts_with("A is better") {
+        println!(
+            "but B is significantly better on the {}: the measures disagree",
+            favours_b.join(" and the ")
+        );
+    }
     if let Some(path) = &args.plot {
         plot_sides(&a, &b, path)?;
         println!("wrote {}", path.display());

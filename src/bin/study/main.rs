@@ -16,6 +16,7 @@ mod optimize_cmd;
 mod output;
 mod plot_cmd;
 mod progress;
+mod ranking;
 mod run_cmd;
 mod simulate_cmd;
 mod sweep_cmd;
@@ -116,6 +117,14 @@ impl<E: std::fmt::Display> From<E> for UserError {
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing to a closed pipe would panic; a
+    // filter such as `| head` should end the verb quietly instead. Every
+    // verb writes its files before it prints, so nothing is left half-written.
+    // SAFETY: setting a signal's disposition to its default before any
+    // thread starts has no other effect.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),

@@ -1,0 +1,572 @@
+//! The ranking `study run` and `study merge` print from `summary.parquet`:
+//! the designs in the order of the declared criterion, the verdict on it,
+//! where the other measures disagree, and the recommendation (or why no
+//! design is recommended).
+
+use crate::UserError;
+use crate::output::{p_value_text, text_table};
+use autobal::study::criterion::Criterion;
+use polars::prelude::DataFrame;
+
+/// Typed access to the summary's columns.
+struct Summary<'a>(&'a DataFrame);
+
+impl Summary<'_> {
+    fn f(&self, name: &str) -> Result<Vec<Option<f64>>, UserError> {
+        Ok(self.0.column(name)?.f64()?.iter().collect())
+    }
+    fn s(&self, name: &str) -> Result<Vec<Option<String>>, UserError> {
+        Ok(self
+            .0
+            .column(name)?
+            .str()?
+            .iter()
+            .map(|s| s.map(str::to_string))
+            .collect())
+    }
+    fn u(&self, name: &str) -> Result<Vec<u64>, UserError> {
+        Ok(self
+            .0
+            .column(name)?
+            .u64()?
+            .iter()
+            .map(Option::unwrap_or_default)
+            .collect())
+    }
+    fn b(&self, name: &str) -> Result<Vec<bool>, UserError> {
+        Ok(self
+            .0
+            .column(name)?
+            .bool()?
+            .iter()
+            .map(Option::unwrap_or_default)
+            .collect())
+    }
+}
+
+/// A number with `digits` decimals, or "–".
+fn num(v: Option<f64>, digits: usize) -> String {
+    v.map_or("–".to_string(), |x| format!("{x:.digits$}"))
+}
+
+/// A value of `criterion` as printed (shares in percent).
+fn measure_text(criterion: Criterion, v: Option<f64>) -> String {
+    match (criterion.unit(), v) {
+        (_, None) => "beyond the run".to_string(),
+        ("%", Some(x)) => format!("{:.1} %", 100.0 * x),
+        ("rev", Some(x)) => format!("{x:.1} rev"),
+        (_, Some(x)) => format!("{x:.4}"),
+    }
+}
+
+/// A difference of `criterion` as printed.
+fn diff_text(criterion: Criterion, v: Option<f64>) -> String {
+    match (criterion.unit(), v) {
+        (_, None) => "–".to_string(),
+        ("%", Some(x)) => format!("{:+.1}", 100.0 * x),
+        ("rev", Some(x)) => format!("{x:+.1}"),
+        (_, Some(x)) => format!("{x:+.4}"),
+    }
+}
+
+/// The criterion the summary was ranked by.
+fn rank_criterion(sum: &Summary) -> Result<Criterion, UserError> {
+    let text = sum.s("rank_by")?.into_iter().flatten().next();
+    Ok(text
+        .and_then(|t| Criterion::parse(&t).ok())
+        .unwrap_or_default())
+}
+
+/// Designs in the order of the summary's `rank` column (ties: grid order).
+fn order_by_rank(summary: &DataFrame) -> Result<Vec<usize>, UserError> {
+    let rank: Vec<Option<u32>> = summary.column("rank")?.u32()?.iter().collect();
+    let mut order: Vec<usize> = (0..summary.height()).collect();
+    order.sort_by_key(|&i| (rank[i].unwrap_or(u32::MAX), i));
+    Ok(order)
+}
+
+/// The ranking, verdicts, disagreements and recommendation of a summary.
+pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
+    let sum = Summary(summary);
+    let criterion = rank_criterion(&sum)?;
+    let order = order_by_rank(summary)?;
+    let ids: Vec<u32> = summary
+        .column("design_id")?
+        .u32()?
+        .iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let kind = sum.s("kind")?;
+    let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
+    let (rho, drag, frac) = (sum.f("rho")?, sum.f("drag")?, sum.f("settled_fraction")?);
+    let (median, median_lo, median_hi) = (
+        sum.f("settling_revs_median_km")?,
+        sum.f("settling_revs_median_km_lo")?,
+        sum.f("settling_revs_median_km_hi")?,
+    );
+    let (rmst, rmst_lo, rmst_hi) = (
+        sum.f("settling_revs_rmst")?,
+        sum.f("settling_revs_rmst_lo")?,
+        sum.f("settling_revs_rmst_hi")?,
+    );
+    let (p90, res95, rank_value) = (
+        sum.f("settling_revs_p90_all_runs")?,
+        sum.f("residual_rel_p95")?,
+        sum.f("rank_value")?,
+    );
+    let failed: Vec<u64> = sum
+        .u("solver_failed")?
+        .iter()
+        .zip(sum.u("budget_exceeded")?)
+        .map(|(a, b)| a + b)
+        .collect();
+    let verdict = sum.s("vs_best_verdict")?;
+    let p_holm = sum.f("vs_best_p_holm")?;
+    let crit_name = criterion.to_string();
+    let (crit_diff, crit_lo, crit_hi) = if Criterion::REPORTED.contains(&criterion) {
+        (
+            sum.f(&format!("vs_best_{crit_name}_diff"))?,
+            sum.f(&format!("vs_best_{crit_name}_diff_lo"))?,
+            sum.f(&format!("vs_best_{crit_name}_diff_hi"))?,
+        )
+    } else {
+        let none = vec![None; summary.height()];
+        (none.clone(), none.clone(), none)
+    };
+    let bound = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+    let rows: Vec<Vec<String>> = order
+        .iter()
+        .enumerate()
+        .map(|(r, &i)| {
+            let versus = match verdict[i].as_deref() {
+                Some("best") => "#1".to_string(),
+                Some("no_design_balances") => "#1 (does not balance)".to_string(),
+                Some("only_design") | None => "–".to_string(),
+                Some(_) if crit_diff[i].is_some() => format!(
+                    "{} [{}, {}], p {}",
+                    diff_text(criterion, crit_diff[i]),
+                    diff_text(criterion, crit_lo[i]),
+                    diff_text(criterion, crit_hi[i]),
+                    p_text(p_holm[i])
+                ),
+                Some(_) => format!("p {}", p_text(p_holm[i])),
+            };
+            let mut row = vec![
+                (r + 1).to_string(),
+                ids[i].to_string(),
+                kind[i].clone().unwrap_or_default(),
+                n[i].map_or("–".into(), |v| v.to_string()),
+                num(rho[i], 4),
+                num(drag[i], 3),
+                num(frac[i].map(|f| 100.0 * f), 1),
+            ];
+            // The ranking criterion's own column carries its interval.
+            row.push(match (median[i], criterion) {
+                (Some(m), Criterion::Median) => {
+                    format!("{m:.1} [{}, {}]", bound(median_lo[i]), bound(median_hi[i]))
+                }
+                (Some(m), _) => format!("{m:.1}"),
+                (None, _) => "beyond".to_string(),
+            });
+            row.push(if criterion == Criterion::Mean {
+                format!(
+                    "{} [{}, {}]",
+                    num(rmst[i], 1),
+                    num(rmst_lo[i], 1),
+                    num(rmst_hi[i], 1)
+                )
+            } else {
+                num(rmst[i], 1)
+            });
+            row.push(p90[i].map_or("beyond".into(), |x| format!("{x:.1}")));
+            row.push(num(res95[i], 4));
+            if !Criterion::REPORTED.contains(&criterion) {
+                row.push(measure_text(criterion, rank_value[i]));
+            }
+            row.push(failed[i].to_string());
+            row.push(versus);
+            row
+        })
+        .collect();
+    // A stall-torque sweep gets its own column after β (designs differ by
+    // it alone); other studies print without it.
+    let torque: Vec<Option<f64>> = match summary.column("stall_torque") {
+        Ok(c) => c.f64()?.iter().collect(),
+        Err(_) => vec![None; summary.height()],
+    };
+    let swept = torque.iter().any(Option::is_some);
+    let rows: Vec<Vec<String>> = if swept {
+        rows.into_iter()
+            .zip(&order)
+            .map(|(mut row, &i)| {
+                row.insert(6, num(torque[i], 3));
+                row
+            })
+            .collect()
+    } else {
+        rows
+    };
+    let mut header: Vec<String> = ["rank", "id", "kind", "n", "ρ", "β (N·s/m)"]
+        .map(String::from)
+        .to_vec();
+    if swept {
+        header.push("M_s (N·m)".into());
+    }
+    header.push("settled %".into());
+    header.push(if criterion == Criterion::Median {
+        "median [95% CI]".into()
+    } else {
+        "median".into()
+    });
+    header.push(if criterion == Criterion::Mean {
+        "mean [95% CI]".into()
+    } else {
+        "mean".into()
+    });
+    header.extend(["p90".into(), "residual p95".into()]);
+    if !Criterion::REPORTED.contains(&criterion) {
+        header.push(criterion.to_string());
+    }
+    header.push("failed".into());
+    header.push(format!("vs #1 on {crit_name}: Δ [95% CI], Holm p"));
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    let from = sum
+        .s("settling_from")?
+        .into_iter()
+        .flatten()
+        .next()
+        .unwrap_or_else(|| "from t = 0".into());
+    let legend = format!(
+        "(ranked by the {}; settling times in revolutions counted {from}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: restricted to τ = {} rev; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window / A_ref; failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1)\n",
+        criterion.label(),
+        num(
+            sum.f("settling_horizon_revs")?.first().copied().flatten(),
+            0
+        )
+    );
+    Ok(text_table(&header, &rows)
+        + &legend
+        + &verdict_line(&sum, &order, criterion)?
+        + &disagreement_line(&sum, &order, criterion)?
+        + &recommendation_line(&sum, &order, criterion)?
+        + &dead_band_line(&sum, &order)?
+        + &contact_line(summary)?
+        + &passage_table(summary)?)
+}
+
+/// An optional p-value as printed.
+fn p_text(p: Option<f64>) -> String {
+    p.map_or("–".to_string(), p_value_text)
+}
+
+/// "#r (design id)" of a summary row.
+fn who(order: &[usize], ids: &[u32], i: usize) -> String {
+    let rank = order.iter().position(|&j| j == i).unwrap_or(0) + 1;
+    format!("#{rank} (design {})", ids[i])
+}
+
+fn design_ids(sum: &Summary) -> Result<Vec<u32>, UserError> {
+    Ok(sum
+        .0
+        .column("design_id")?
+        .u32()?
+        .iter()
+        .map(Option::unwrap_or_default)
+        .collect())
+}
+
+/// The sentence under the ranking: whether #1 balances at all, and against
+/// how many designs it is better on the criterion at α.
+fn verdict_line(sum: &Summary, order: &[usize], criterion: Criterion) -> Result<String, UserError> {
+    let verdict = sum.s("vs_best_verdict")?;
+    let Some(&best) = order.first() else {
+        return Ok(String::new());
+    };
+    let ids = design_ids(sum)?;
+    let runs = sum.u("runs")?;
+    let per_design = runs.iter().max().copied().unwrap_or(0);
+    if verdict[best].as_deref() == Some("no_design_balances")
+        || (verdict[best].as_deref() == Some("only_design") && !sum.b("balances")?[best])
+    {
+        let frac = sum.f("settled_fraction")?[best].unwrap_or(0.0);
+        let residual = sum.f("residual_rel_median")?[best];
+        let why = sum.s("diagnosis")?[best]
+            .clone()
+            .unwrap_or_else(|| "no cause found".into());
+        return Ok(format!(
+            "verdict: no design balances this rotor: even {} settles in {:.1} % of its runs (a working balancer settles in at least 50 %) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {why}\n",
+            who(order, &ids, best),
+            100.0 * frac,
+            residual.map_or("– (no run was simulated to its end)".into(), |r| format!(
+                "{r:.2}"
+            ))
+        ));
+    }
+    if verdict[best].as_deref() != Some("best") {
+        return Ok(String::new());
+    }
+    let alpha = sum
+        .f("vs_best_alpha")?
+        .first()
+        .copied()
+        .flatten()
+        .unwrap_or(f64::NAN);
+    let test = sum
+        .s("vs_best_test")?
+        .into_iter()
+        .flatten()
+        .next()
+        .unwrap_or_default();
+    let paired = test != "log_rank" && test != "bootstrap" && test != "two_proportion";
+    let of = |name: &str| -> Vec<String> {
+        order
+            .iter()
+            .filter(|&&i| verdict[i].as_deref() == Some(name))
+            .map(|&i| who(order, &ids, i))
+            .collect()
+    };
+    let mut line = format!(
+        "verdict on the {}: {} is better than {} of the other {} designs ({}{}, Holm-adjusted at α = {alpha}, {per_design} runs per design)",
+        criterion.label(),
+        who(order, &ids, best),
+        of("best_better").len(),
+        order.len() - 1,
+        criterion.test_name(paired),
+        if paired {
+            " on runs paired by their shared samples"
+        } else {
+            ": the designs did not share samples"
+        },
+    );
+    let unclear = of("not_distinguishable");
+    if !unclear.is_empty() {
+        line += &format!("; not distinguishable from {}", unclear.join(", "));
+    }
+    let reversed = of("other_better");
+    if !reversed.is_empty() {
+        line += &format!(
+            "; {} significantly better on its test although #1 has the better point estimate",
+            reversed.join(", ")
+        );
+    }
+    Ok(line + "\n")
+}
+
+/// One sentence naming every design significantly better than #1 on a
+/// reported measure other than the ranking criterion, with the numbers.
+fn disagreement_line(
+    sum: &Summary,
+    order: &[usize],
+    criterion: Criterion,
+) -> Result<String, UserError> {
+    let Some(&best) = order.first().filter(|_| order.len() > 1) else {
+        return Ok(String::new());
+    };
+    let ids = design_ids(sum)?;
+    let alpha = sum
+        .f("vs_best_alpha")?
+        .first()
+        .copied()
+        .flatten()
+        .unwrap_or(0.05);
+    let value_column = |m: Criterion| match m {
+        Criterion::Median => "settling_revs_median_km",
+        Criterion::Mean => "settling_revs_rmst",
+        Criterion::P90 => "settling_revs_p90_all_runs",
+        _ => "residual_rel_p95",
+    };
+    let mut claims = Vec::new();
+    for &i in order.iter().skip(1) {
+        let mut better = Vec::new();
+        for m in Criterion::REPORTED.iter().filter(|&&m| m != criterion) {
+            let name = m.to_string();
+            let diff = sum.f(&format!("vs_best_{name}_diff"))?[i];
+            let lo = sum.f(&format!("vs_best_{name}_diff_lo"))?[i];
+            let hi = sum.f(&format!("vs_best_{name}_diff_hi"))?[i];
+            let p = sum.f(&format!("vs_best_{name}_p_holm"))?[i];
+            let values = sum.f(value_column(*m))?;
+            let significant = p.is_some_and(|p| p <= alpha);
+            let this_better = diff.is_some_and(|d| {
+                if m.lower_is_better() {
+                    d < 0.0
+                } else {
+                    d > 0.0
+                }
+            });
+            if significant && this_better {
+                better.push(format!(
+                    "{} {} vs {} (Δ {} [{}, {}], Holm p {})",
+                    short(*m),
+                    measure_text(*m, values[i]),
+                    measure_text(*m, values[best]),
+                    diff_text(*m, diff),
+                    diff_text(*m, lo),
+                    diff_text(*m, hi),
+                    p_text(p)
+                ));
+            }
+        }
+        if !better.is_empty() {
+            claims.push(format!(
+                "{} on the {}",
+                who(order, &ids, i),
+                better.join(" and the ")
+            ));
+        }
+    }
+    Ok(if claims.is_empty() {
+        format!(
+            "other measures: no design is significantly better than #1 on any of median, restricted mean, p90 and residual p95 (α = {alpha})\n"
+        )
+    } else {
+        format!(
+            "other measures disagree: better than #1 are {}\n",
+            claims.join("; ")
+        )
+    })
+}
+
+/// A measure's short name in sentences.
+fn short(m: Criterion) -> &'static str {
+    match m {
+        Criterion::Median => "median",
+        Criterion::Mean => "restricted mean",
+        Criterion::P90 => "p90",
+        _ => "residual p95",
+    }
+}
+
+/// The one-line recommendation: #1, and the Pareto set when it has more
+/// than one member; none when #1 does not balance.
+fn recommendation_line(
+    sum: &Summary,
+    order: &[usize],
+    criterion: Criterion,
+) -> Result<String, UserError> {
+    let Some(&best) = order.first() else {
+        return Ok(String::new());
+    };
+    let verdict = sum.s("vs_best_verdict")?;
+    let ids = design_ids(sum)?;
+    if verdict[best].as_deref() == Some("no_design_balances") || !sum.b("balances")?[best] {
+        return Ok("recommendation: none of these designs; remove the cause above first\n".into());
+    }
+    let pareto = sum.b("pareto")?;
+    let members: Vec<String> = order
+        .iter()
+        .filter(|&&i| pareto[i])
+        .map(|&i| who(order, &ids, i))
+        .collect();
+    let mut line = format!(
+        "recommendation: design {} (#1 by the {})",
+        ids[best],
+        criterion.label()
+    );
+    if members.len() > 1 {
+        line += &format!(
+            "; {} designs are not dominated on the study's Pareto measures: {}: if your requirement names another measure, choose among them by it",
+            members.len(),
+            members.join(", ")
+        );
+    }
+    Ok(line + "\n")
+}
+
+/// With rolling resistance: the dead band μ_s·l beside the band δ·A_ref.
+fn dead_band_line(sum: &Summary, order: &[usize]) -> Result<String, UserError> {
+    let dead = sum.f("dead_band_m")?;
+    if dead.iter().all(Option::is_none) {
+        return Ok(String::new());
+    }
+    let band = sum.f("settling_band_m")?;
+    let ids = design_ids(sum)?;
+    let parts: Vec<String> = order
+        .iter()
+        .map(|&i| {
+            format!(
+                "design {} {} µm vs {} µm",
+                ids[i],
+                num(dead[i].map(|d| d * 1e6), 2),
+                num(band[i].map(|b| b * 1e6), 2)
+            )
+        })
+        .collect();
+    Ok(format!(
+        "dead band μ_s·l (l the track radius) against the settling band δ·A_ref (median A_ref), in ranking order: {}\n",
+        parts.join(", ")
+    ))
+}
+
+/// Whether the weights were solid, said under every ranking: a study that
+/// switched contact off prints numbers for weights that pass through each other.
+fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
+    let contact = summary.column("contact")?.bool()?;
+    let deepest = summary
+        .column("max_overlap_fraction")?
+        .f64()?
+        .iter()
+        .flatten()
+        .reduce(f64::max);
+    let closest = deepest.map_or(String::new(), |f| {
+        format!(
+            "; deepest overlap {:.2} % of the touching angle 2α",
+            100.0 * f
+        )
+    });
+    let off = contact.iter().filter(|c| *c == Some(false)).count();
+    Ok(if off == 0 {
+        format!("contact between the weights: on{closest}\n")
+    } else {
+        format!(
+            "contact between the weights: OFF in {} of {} designs (the study switched it off: weights may pass through each other){closest}\n",
+            off,
+            summary.height()
+        )
+    })
+}
+
+/// For a study that sweeps the motor's stall torque: per design, how many
+/// runs reached the operating speed and where the rest were held (the
+/// Sommerfeld effect, docs/realism.md); empty otherwise.
+fn passage_table(summary: &DataFrame) -> Result<String, UserError> {
+    let Ok(torque) = summary.column("stall_torque") else {
+        return Ok(String::new());
+    };
+    let torque: Vec<Option<f64>> = torque.f64()?.iter().collect();
+    if torque.iter().all(Option::is_none) {
+        return Ok(String::new());
+    }
+    let sum = Summary(summary);
+    let kind = sum.s("kind")?;
+    let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
+    let runs = sum.u("runs")?;
+    let reached = sum.u("reached_operating_speed")?;
+    let t_op = sum.f("operating_time_s_median")?;
+    let spin = sum.f("final_spin_rate_median")?;
+    let ids = design_ids(&sum)?;
+    let rows: Vec<Vec<String>> = (0..summary.height())
+        .map(|i| {
+            vec![
+                ids[i].to_string(),
+                kind[i].clone().unwrap_or_else(|| "–".into()),
+                n[i].map_or("–".into(), |v| v.to_string()),
+                num(torque[i], 3),
+                format!("{}/{}", reached[i], runs[i]),
+                num(t_op[i], 2),
+                num(spin[i], 1),
+            ]
+        })
+        .collect();
+    Ok(text_table(
+        &[
+            "design",
+            "kind",
+            "n",
+            "M_s (N·m)",
+            "reached operating speed",
+            "after (s, median)",
+            "final φ̇ median (rad/s)",
+        ],
+        &rows,
+    ) + "(passage through resonance: a run that never reached |φ̇ − ω_sync| ≤ δ ω_sync was held below it for the whole run)\n")
+}

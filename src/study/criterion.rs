@@ -1,0 +1,438 @@
+//! What "best" means: the declared criterion designs are ranked by
+//! (`[summary] rank_by`, `--rank-by`), each with the paired test that fits
+//! it (docs/statistics.md, "Ranking criteria").
+//!
+//! Settling criteria count every run: a run that did not settle within the
+//! run counts as settling at the horizon τ for the restricted mean and the
+//! p90 (never dropped), and as "not settled" for the shares.
+
+use super::verdict::DesignRuns;
+use crate::stats::paired::{Settling, SettlingComparison, compare_settling};
+use crate::stats::paired_measures::{
+    Difference, honest_p, mean_difference_bootstrap, paired_mean_difference, quantile_difference,
+    share_difference,
+};
+use rand::Rng;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A measure designs are ranked and compared by.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(try_from = "String", into = "String")]
+#[schemars(with = "CriterionText")]
+pub enum Criterion {
+    /// Kaplan–Meier median settling time (lower is better).
+    Median,
+    /// Restricted mean settling time up to τ (lower is better): counts the tail.
+    Mean,
+    /// 90th percentile of the settling time over every run (lower is better).
+    P90,
+    /// Share of runs that settled within the run (higher is better).
+    SettledFraction,
+    /// Share of runs settled within a stated time (higher is better).
+    SettledBy(Within),
+    /// 95th percentile of residual vibration / A_ref (lower is better).
+    ResidualP95,
+    /// Share of runs whose residual vibration is below a level in m (higher is better).
+    ResidualBelow(f64),
+}
+
+/// A time limit of [`Criterion::SettledBy`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Within {
+    /// Revolutions (of the nominal speed).
+    Revs(f64),
+    /// Seconds.
+    Seconds(f64),
+}
+
+/// The text form of a criterion, for the schema: median | mean | p90 |
+/// settled_fraction | settled_by:<X>rev | settled_by:<X>s | residual_p95 |
+/// p_residual_below:<X>m.
+#[derive(JsonSchema)]
+#[allow(dead_code)] // only its schema is used
+struct CriterionText(
+    #[schemars(regex(
+        pattern = r"^(median|mean|p90|settled_fraction|residual_p95|settled_by:[0-9.eE+-]+(rev|s)|p_residual_below:[0-9.eE+-]+m)$"
+    ))]
+    String,
+);
+
+/// The forms `--rank-by` and `rank_by` accept, for messages.
+pub const CRITERION_FORMS: &str = "median, mean (restricted mean up to the horizon), p90, settled_fraction, settled_by:<X>rev or settled_by:<X>s, residual_p95, p_residual_below:<X>m";
+
+impl Default for Criterion {
+    /// The restricted mean: it counts every run, the slow tail included
+    /// (docs/statistics.md says why it is the default).
+    fn default() -> Self {
+        Criterion::Mean
+    }
+}
+
+impl Criterion {
+    /// The four measures every verdict reports on, whatever it ranks by.
+    pub const REPORTED: [Criterion; 4] = [
+        Criterion::Median,
+        Criterion::Mean,
+        Criterion::P90,
+        Criterion::ResidualP95,
+    ];
+
+    /// Parse the text form (see [`CRITERION_FORMS`]).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let text = text.trim();
+        let number = |value: &str, unit: &str| -> Result<f64, String> {
+            let v: f64 = value
+                .trim()
+                .strip_suffix(unit)
+                .ok_or_else(|| format!("{text:?}: give the unit, e.g. {value}{unit}"))?
+                .trim()
+                .parse()
+                .map_err(|_| format!("{text:?}: {value:?} is not a number"))?;
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{text:?}: the level must be a positive number"))
+            }
+        };
+        Ok(match text.split_once(':') {
+            None => match text {
+                "median" => Criterion::Median,
+                "mean" => Criterion::Mean,
+                "p90" => Criterion::P90,
+                "settled_fraction" => Criterion::SettledFraction,
+                "residual_p95" => Criterion::ResidualP95,
+                "settled_by" | "p_residual_below" => {
+                    return Err(format!(
+                        "{text:?} needs a level, e.g. settled_by:30rev, settled_by:0.5s or p_residual_below:2e-5m"
+                    ));
+                }
+                _ => {
+                    return Err(format!(
+                        "{text:?} is not a criterion; one of: {CRITERION_FORMS}"
+                    ));
+                }
+            },
+            Some(("settled_by", value)) if value.trim().ends_with("rev") => {
+                Criterion::SettledBy(Within::Revs(number(value, "rev")?))
+            }
+            Some(("settled_by", value)) => {
+                Criterion::SettledBy(Within::Seconds(number(value, "s")?))
+            }
+            Some(("p_residual_below", value)) => Criterion::ResidualBelow(number(value, "m")?),
+            Some(_) => {
+                return Err(format!(
+                    "{text:?} is not a criterion; one of: {CRITERION_FORMS}"
+                ));
+            }
+        })
+    }
+
+    /// Whether a lower value is better.
+    pub fn lower_is_better(self) -> bool {
+        matches!(
+            self,
+            Criterion::Median | Criterion::Mean | Criterion::P90 | Criterion::ResidualP95
+        )
+    }
+
+    /// Short label for tables and sentences, with the level.
+    pub fn label(self) -> String {
+        match self {
+            Criterion::Median => "median settling time".into(),
+            Criterion::Mean => "restricted mean settling time".into(),
+            Criterion::P90 => "p90 settling time".into(),
+            Criterion::SettledFraction => "settled share".into(),
+            Criterion::SettledBy(Within::Revs(x)) => format!("share settled by {x} rev"),
+            Criterion::SettledBy(Within::Seconds(x)) => format!("share settled by {x} s"),
+            Criterion::ResidualP95 => "p95 residual/A_ref".into(),
+            Criterion::ResidualBelow(m) => format!("share with residual below {m:e} m"),
+        }
+    }
+
+    /// Unit of the value (and of differences): "rev", "" or "%" (shares are
+    /// printed in percent).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Criterion::Median | Criterion::Mean | Criterion::P90 => "rev",
+            Criterion::ResidualP95 => "",
+            _ => "%",
+        }
+    }
+
+    /// The test this criterion's comparisons use, paired or not.
+    pub fn test_name(self, paired: bool) -> &'static str {
+        match (self, paired) {
+            (Criterion::Median, true) => "sign test",
+            (Criterion::Median, false) => "bootstrap of the medians",
+            (Criterion::Mean, true) => "paired t-test on min(t, τ)",
+            (Criterion::Mean, false) => "bootstrap of the means of min(t, τ)",
+            (Criterion::P90 | Criterion::ResidualP95, true) => "paired bootstrap",
+            (Criterion::P90 | Criterion::ResidualP95, false) => "bootstrap",
+            (_, true) => "McNemar's exact test",
+            (_, false) => "two-proportion z-test",
+        }
+    }
+
+    /// The design's value of this measure; `None` when it lies beyond the
+    /// run (a median or p90 no run reached) or there are no runs.
+    pub fn value(self, runs: &DesignRuns, scale: &Scale) -> Option<f64> {
+        match self {
+            Criterion::Median => runs.kaplan_meier()?.median(),
+            Criterion::Mean => Some(runs.kaplan_meier()?.restricted_mean(scale.tau).estimate),
+            Criterion::P90 => {
+                let q = quantile(&uncapped_times(runs), 0.9)?;
+                q.is_finite().then_some(q)
+            }
+            Criterion::ResidualP95 => quantile(
+                &runs.residual.iter().flatten().copied().collect::<Vec<_>>(),
+                0.95,
+            ),
+            _ => {
+                let yes = self.outcomes(runs, scale);
+                (!yes.is_empty())
+                    .then(|| yes.iter().filter(|&&y| y).count() as f64 / yes.len() as f64)
+            }
+        }
+    }
+
+    /// Per run: yes when the run meets a share criterion.
+    fn outcomes(self, runs: &DesignRuns, scale: &Scale) -> Vec<bool> {
+        let settled_by = |limit: f64| -> Vec<bool> {
+            runs.settling
+                .iter()
+                .map(|o| o.settled && o.time <= limit)
+                .collect()
+        };
+        match self {
+            Criterion::SettledFraction => runs.settling.iter().map(|o| o.settled).collect(),
+            Criterion::SettledBy(Within::Revs(x)) => settled_by(x),
+            Criterion::SettledBy(Within::Seconds(x)) => settled_by(x / scale.rev_seconds),
+            Criterion::ResidualBelow(m) => runs
+                .residual_abs
+                .iter()
+                .map(|r| r.is_some_and(|r| r <= m))
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Design A against design B on this measure (A − B), paired when
+    /// `paired` (the caller checked that they share samples).
+    pub fn compare(
+        self,
+        a: &DesignRuns,
+        b: &DesignRuns,
+        paired: bool,
+        scale: &Scale,
+        level: f64,
+        rng: &mut impl Rng,
+    ) -> Option<Difference> {
+        match self {
+            Criterion::Median if paired => {
+                let to = |d: &DesignRuns| -> Vec<Settling> {
+                    d.settling
+                        .iter()
+                        .map(|o| Settling::new(o.time, o.settled))
+                        .collect()
+                };
+                let c = compare_settling(&to(a), &to(b), level, rng)?;
+                let value = |d| self.value(d, scale).unwrap_or(f64::INFINITY);
+                Some(sign_difference(&c, value(a), value(b)))
+            }
+            Criterion::Median => quantile_difference(
+                &uncapped_times(a),
+                &uncapped_times(b),
+                0.5,
+                false,
+                level,
+                rng,
+            ),
+            Criterion::Mean if paired => paired_mean_difference(
+                &capped_times(a, scale.tau),
+                &capped_times(b, scale.tau),
+                level,
+            ),
+            Criterion::Mean => mean_difference_bootstrap(
+                &capped_times(a, scale.tau),
+                &capped_times(b, scale.tau),
+                level,
+                rng,
+            ),
+            Criterion::P90 => quantile_difference(
+                &capped_times(a, scale.tau),
+                &capped_times(b, scale.tau),
+                0.9,
+                paired,
+                level,
+                rng,
+            ),
+            Criterion::ResidualP95 => {
+                let (x, y): (Vec<f64>, Vec<f64>) = if paired {
+                    a.residual
+                        .iter()
+                        .zip(&b.residual)
+                        .filter_map(|(x, y)| x.zip(*y))
+                        .unzip()
+                } else {
+                    (
+                        a.residual.iter().flatten().copied().collect(),
+                        b.residual.iter().flatten().copied().collect(),
+                    )
+                };
+                quantile_difference(&x, &y, 0.95, paired, level, rng)
+            }
+            _ => share_difference(
+                &self.outcomes(a, scale),
+                &self.outcomes(b, scale),
+                paired,
+                level,
+            ),
+        }
+    }
+
+    /// Whether A is better than B by the sign of their difference A − B.
+    pub fn a_better(self, difference: f64) -> bool {
+        if self.lower_is_better() {
+            difference < 0.0
+        } else {
+            difference > 0.0
+        }
+    }
+
+    /// Order of two values, better first (`None`, beyond the run or no runs, last).
+    pub fn order(self, x: Option<f64>, y: Option<f64>) -> std::cmp::Ordering {
+        match (x, y) {
+            (Some(x), Some(y)) if self.lower_is_better() => x.total_cmp(&y),
+            (Some(x), Some(y)) => y.total_cmp(&x),
+            (Some(_), None) => std::cmp::Ordering::Less,
+            (None, Some(_)) => std::cmp::Ordering::Greater,
+            (None, None) => std::cmp::Ordering::Equal,
+        }
+    }
+}
+
+/// The paired median comparison as a [`Difference`]: the Kaplan–Meier
+/// medians `a` and `b` (+∞ beyond the run), the median of t_A − t_B over
+/// pairs with its interval, and the sign test's p-value.
+pub fn sign_difference(c: &SettlingComparison, a: f64, b: f64) -> Difference {
+    Difference {
+        a,
+        b,
+        difference: -c.median_difference,
+        interval: (
+            -c.median_difference_interval.1,
+            -c.median_difference_interval.0,
+        ),
+        p_value: honest_p(c.sign_test_p),
+        test: "sign",
+    }
+}
+
+/// What turns the runs into numbers: the restricted-mean horizon τ (rev)
+/// and the length of a revolution (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scale {
+    /// τ: the restricted mean and the capped times run up to it (rev).
+    pub tau: f64,
+    /// One revolution of the nominal speed (s).
+    pub rev_seconds: f64,
+}
+
+/// Settling times with a run that did not settle counted as τ.
+fn capped_times(runs: &DesignRuns, tau: f64) -> Vec<f64> {
+    runs.settling
+        .iter()
+        .map(|o| if o.settled { o.time.min(tau) } else { tau })
+        .collect()
+}
+
+/// Settling times with a run that did not settle counted as +∞.
+fn uncapped_times(runs: &DesignRuns) -> Vec<f64> {
+    runs.settling
+        .iter()
+        .map(|o| if o.settled { o.time } else { f64::INFINITY })
+        .collect()
+}
+
+/// The q-quantile by linear interpolation (polars's rule); +∞ values are
+/// allowed and give +∞ when the quantile falls among them.
+fn quantile(values: &[f64], q: f64) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let h = q * (v.len() - 1) as f64;
+    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+    if v[lo] == v[hi] {
+        return Some(v[lo]);
+    }
+    Some(v[lo] + (h - lo as f64) * (v[hi] - v[lo]))
+}
+
+impl TryFrom<String> for Criterion {
+    type Error = String;
+    fn try_from(text: String) -> Result<Self, String> {
+        Criterion::parse(&text)
+    }
+}
+
+impl From<Criterion> for String {
+    fn from(c: Criterion) -> String {
+        c.to_string()
+    }
+}
+
+impl fmt::Display for Criterion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Criterion::Median => write!(f, "median"),
+            Criterion::Mean => write!(f, "mean"),
+            Criterion::P90 => write!(f, "p90"),
+            Criterion::SettledFraction => write!(f, "settled_fraction"),
+            Criterion::SettledBy(Within::Revs(x)) => write!(f, "settled_by:{x}rev"),
+            Criterion::SettledBy(Within::Seconds(x)) => write!(f, "settled_by:{x}s"),
+            Criterion::ResidualP95 => write!(f, "residual_p95"),
+            Criterion::ResidualBelow(m) => write!(f, "p_residual_below:{m:e}m"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_form_round_trips() {
+        for text in [
+            "median",
+            "mean",
+            "p90",
+            "settled_fraction",
+            "settled_by:30rev",
+            "settled_by:0.5s",
+            "residual_p95",
+            "p_residual_below:2e-5m",
+        ] {
+            let c = Criterion::parse(text).unwrap();
+            assert_eq!(Criterion::parse(&c.to_string()).unwrap(), c, "{text}");
+        }
+    }
+
+    #[test]
+    fn a_level_needs_its_unit() {
+        assert!(
+            Criterion::parse("settled_by:30")
+                .unwrap_err()
+                .contains("unit")
+        );
+        assert!(Criterion::parse("p_residual_below:-1m").is_err());
+        assert!(
+            Criterion::parse("fastest")
+                .unwrap_err()
+                .contains("median, mean")
+        );
+    }
+}

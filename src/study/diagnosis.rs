@@ -1,0 +1,122 @@
+//! Why a design does not balance: when even the first-ranked design settles
+//! in too few runs or leaves more vibration than no balancer, the verdict
+//! names a cause instead of a winner. The checks run in a fixed order and
+//! the first that applies is named (docs/statistics.md, "No crown without
+//! a balancer that works"):
+//!
+//! 1. the dead band of rolling resistance, μ_s·l, against the band δ·A_ref;
+//! 2. a capacity below the unbalances drawn;
+//! 3. a speed at or below the rotor's critical speed;
+//! 4. gravity, g/(l ω²), against δ·U/C;
+//! 5. a horizon too short for the slowest mode, or an unstable balanced
+//!    state (the linear analysis of `study linear`).
+
+use super::config::{Design, StudyPlan};
+use crate::model::linear::analyse;
+use crate::model::rotor::{MAX_DOF, PlaneRotor};
+
+/// What the checks measured for one design (every length in m).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignFacts {
+    /// Median A_ref over the design's runs.
+    pub a_ref_median: f64,
+    /// Median sampled unbalance over capacity, U/C.
+    pub unbalance_fraction_median: f64,
+    /// Share of runs whose sampled unbalance exceeded the capacity.
+    pub over_capacity_share: f64,
+}
+
+/// The dead band μ_s·l of a design (m), with rolling resistance on.
+pub fn dead_band(plan: &StudyPlan, design: &Design) -> Option<f64> {
+    let rr = plan.file.scene.effects.rolling_resistance.as_ref()?;
+    Some(rr.coefficient * rr.static_ratio * design.track_radius)
+}
+
+/// The settling band δ·A_ref (m) at a given A_ref.
+pub fn settling_band(plan: &StudyPlan, a_ref: f64) -> f64 {
+    plan.file.metrics.delta * a_ref
+}
+
+/// The first cause among the checks that applies to `design`, in words with
+/// its numbers; a sentence saying none applied otherwise.
+pub fn diagnose(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String {
+    let band = settling_band(plan, facts.a_ref_median);
+    if let Some(dead) = dead_band(plan, design).filter(|&d| d >= band) {
+        return format!(
+            "the dead band of rolling resistance μ_s·l = {:.3} µm (l = {:.2} mm the track radius) is as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): the weights stop anywhere inside it; lower μ_s, or judge against a band wider than the dead band",
+            dead * 1e6,
+            design.track_radius * 1e3,
+            band * 1e6,
+            facts.a_ref_median * 1e6
+        );
+    }
+    if facts.over_capacity_share >= 0.5 {
+        return format!(
+            "the capacity C = {:.4e} kg·m is below the unbalance drawn in {:.0} % of runs: use more or heavier weights, or a larger race",
+            design.capacity,
+            100.0 * facts.over_capacity_share
+        );
+    }
+    let omega = plan.file.scene.speed.nominal_speed();
+    if let Some(critical) = critical_speed(plan, design).filter(|&w| omega <= w) {
+        return format!(
+            "the speed ω = {omega:.1} rad/s is at or below the rotor's critical speed {critical:.1} rad/s: a passive balancer only balances above it"
+        );
+    }
+    if let Some(g) = plan.file.scene.effects.gravity.as_ref() {
+        let ratio = g.in_plane() / (design.track_radius * omega * omega);
+        let limit = plan.file.metrics.delta * facts.unbalance_fraction_median;
+        if ratio >= limit {
+            return format!(
+                "gravity pulls the weights round every revolution: g/(l ω²) = {ratio:.3e} is above δ·U/C = {limit:.3e}, so the weights swing by more than the band allows"
+            );
+        }
+    }
+    let scene = plan.scene(
+        design,
+        facts.unbalance_fraction_median * design.capacity,
+        0.0,
+    );
+    if plan.file.scene.speed.is_prescribed()
+        && let Ok(report) = scene
+            .build()
+            .map_err(|_| ())
+            .and_then(|s| analyse(&s, None).map_err(|_| ()))
+    {
+        if !report.stable {
+            return format!(
+                "the balanced state is linearly unstable at ω = {omega:.1} rad/s (slowest decay rate σ = {:.3e} 1/s; `study linear` on this design shows the growing mode)",
+                report.slowest_decay
+            );
+        }
+        let needed = report.settling_time(1.0, plan.file.metrics.delta) * omega
+            / (2.0 * std::f64::consts::PI);
+        let horizon = plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs;
+        if needed >= horizon {
+            return format!(
+                "the horizon is too short for the slowest mode: it decays at σ = {:.3e} 1/s and needs about {needed:.0} rev to reach the band, against t_end_revs − hold_revs = {horizon:.0} rev; raise metrics.t_end_revs",
+                report.slowest_decay
+            );
+        }
+    }
+    "none of the usual causes applies (dead band, capacity, critical speed, gravity, horizon): look at single runs with `study simulate` or `study plot run`".to_string()
+}
+
+/// The plane rotor's natural frequency with the weights' mass carried,
+/// √(k_min/(M + Σ m)); `None` for other rotor models.
+fn critical_speed(plan: &StudyPlan, design: &Design) -> Option<f64> {
+    let scene = plan.scene(design, 0.0, 0.0);
+    scene.rotor.downcast_ref::<PlaneRotor>()?;
+    let built = scene.rotor.build();
+    let weights: f64 = scene.cargoes().ok()?.iter().map(|c| c.mass).sum();
+    let mass = built.mass_matrix()[0][0] + weights;
+    let stiffness = |axis: usize| {
+        let mut unit = [0.0; MAX_DOF];
+        unit[axis] = 1.0;
+        let mut f = [0.0; MAX_DOF];
+        built.forces(&unit, &[0.0; MAX_DOF], 0.0, &mut f);
+        -f[axis]
+    };
+    let k = stiffness(0).min(stiffness(1));
+    (k > 0.0).then(|| (k / mass).sqrt())
+}
