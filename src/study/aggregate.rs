@@ -75,6 +75,13 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
     let scale = measure_scale(plan);
     let clock = SettlingClock::of(plan);
     let by_design = design_runs(df, scale.tau, clock)?;
+    // A run-up also reports the clock from t = 0, beside the one it ranks on.
+    let from_start = match clock {
+        SettlingClock::FromStart => None,
+        SettlingClock::FromOperatingSpeed(_) => {
+            Some(design_runs(df, scale.tau, SettlingClock::FromStart)?)
+        }
+    };
     let criterion = plan.file.summary.rank_by;
     let verdicts = best_versus_rest(
         &by_design,
@@ -131,6 +138,14 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
             k.median_interval(LEVEL, Transform::LogLog)
         });
         rows.ts_median_km.push(median);
+        rows.ts_median_from_start.push(match &from_start {
+            None => median,
+            Some(all) => all
+                .iter()
+                .find(|d| d.design_id == design.id)
+                .and_then(DesignRuns::kaplan_meier)
+                .and_then(|k| k.median()),
+        });
         rows.ts_median_km_lo.push(median_lo);
         rows.ts_median_km_hi.push(median_hi);
         let rmst = km.as_ref().map(|k| k.restricted_mean(scale.tau));
@@ -251,6 +266,7 @@ struct SummaryColumns {
     settled_lo: Vec<f64>,
     settled_hi: Vec<f64>,
     ts_median_km: Vec<Option<f64>>,
+    ts_median_from_start: Vec<Option<f64>>,
     ts_median_km_lo: Vec<Option<f64>>,
     ts_median_km_hi: Vec<Option<f64>>,
     ts_rmst: Vec<Option<f64>>,
@@ -381,6 +397,10 @@ impl SummaryColumns {
             Column::new("settled_fraction_hi".into(), self.settled_hi),
             Column::new("settling_revs_median_km".into(), self.ts_median_km),
             Column::new("settling_revs_median_km_lo".into(), self.ts_median_km_lo),
+            Column::new(
+                "settling_revs_median_km_from_start".into(),
+                self.ts_median_from_start,
+            ),
             Column::new("settling_revs_median_km_hi".into(), self.ts_median_km_hi),
             Column::new("settling_revs_rmst".into(), self.ts_rmst),
             Column::new("settling_revs_rmst_lo".into(), self.ts_rmst_lo),

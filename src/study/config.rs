@@ -610,6 +610,13 @@ impl StudyFile {
                 "a significance level in (0, 0.5], e.g. 0.05",
             ));
         }
+        if self.summary.pareto.is_empty() {
+            return Err(invalid(
+                "summary.pareto",
+                "[]".into(),
+                "name at least one measure (median, mean, p90, residual_p95, …), or leave the key out for all four",
+            ));
+        }
         let s = &self.sampling;
         if s.unbalance.relative_to.is_none() {
             return Err(invalid(

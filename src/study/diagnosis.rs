@@ -40,6 +40,21 @@ pub fn settling_band(plan: &StudyPlan, a_ref: f64) -> f64 {
 /// The first cause among the checks that applies to `design`, in words with
 /// its numbers; a sentence saying none applied otherwise.
 pub fn diagnose(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String {
+    let cause = first_cause(plan, design, facts);
+    // Fractions of capacity this small are usually kg·m read as fractions.
+    if facts.unbalance_fraction_median < 0.01
+        && plan.file.sampling.unbalance.scale() == super::config::Scale::Capacity
+    {
+        return format!(
+            "{cause} (note: the median unbalance drawn is {:.1e} of the capacity; if the values were meant in kg·m, set relative_to = \"absolute\")",
+            facts.unbalance_fraction_median
+        );
+    }
+    cause
+}
+
+/// The first of the checks that applies.
+fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String {
     let band = settling_band(plan, facts.a_ref_median);
     if let Some(dead) = dead_band(plan, design).filter(|&d| d >= band) {
         return format!(
@@ -89,7 +104,9 @@ pub fn diagnose(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> Strin
                 report.slowest_decay
             );
         }
-        let needed = report.settling_time(1.0, plan.file.metrics.delta) * omega
+        // From the locked start the whirl is up to (U + C)/U times A_ref.
+        let from = 1.0 + 1.0 / facts.unbalance_fraction_median.max(f64::MIN_POSITIVE);
+        let needed = report.settling_time(from, plan.file.metrics.delta) * omega
             / (2.0 * std::f64::consts::PI);
         let horizon = plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs;
         if needed >= horizon {

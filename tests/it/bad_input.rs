@@ -52,6 +52,27 @@ pub(crate) fn scene() -> String {
 
 /// (what to replace, with what, a text the message must contain).
 pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
+    // Units are never guessed: both choices and their units are named.
+    (
+        ", relative_to = \"capacity\" }",
+        " }",
+        "relative_to = (missing): required: \"capacity\" (the values are fractions of each design's balancing capacity, no unit) or \"absolute\" (the values are unbalances in kg·m)",
+    ),
+    (
+        "[sampling]",
+        "[summary]\nrank_by = \"fastest\"\n[sampling]",
+        "\"fastest\" is not a criterion; one of: median, mean",
+    ),
+    (
+        "[sampling]",
+        "[summary]\nrank_by = \"settled_by:30\"\n[sampling]",
+        "give the unit",
+    ),
+    (
+        "[sampling]",
+        "[summary]\npareto = []\n[sampling]",
+        "summary.pareto",
+    ),
     ("mass = 10.0", "mass = -1.0", "mass"),
     ("mass = 10.0", "mass = 0.0", "mass"),
     ("mass = 10.0", "mass = \"heavy\"", "rotor.mass"),
@@ -215,6 +236,11 @@ fn flag_cases(study_path: &str, scene_path: &str) -> Vec<(Vec<String>, &'static 
     vec![
         (s(&["run", study_path, "--threads", "0"]), "--threads"),
         (s(&["run", study_path, "--threads", "many"]), "--threads"),
+        (s(&["run", study_path, "--rank-by", "fastest"]), "--rank-by"),
+        (
+            s(&["run", study_path, "--rank-by", "p_residual_below:-1m"]),
+            "--rank-by",
+        ),
         (s(&["run", study_path, "--shard", "3/2"]), "shard"),
         (s(&["run", study_path, "--shard", "0/4"]), "shard"),
         (

@@ -13,6 +13,7 @@ mod cli_simulate;
 mod compare;
 mod contact;
 mod convergence;
+mod decisions;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;
