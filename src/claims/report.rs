@@ -106,24 +106,27 @@ fn measure_list(c: &Comparison, holm: &[f64], family: &str) -> String {
         .zip(holm)
         .map(|(m, p)| match m.difference {
             Some(d) => {
-                let scale = if m.criterion.unit() == "%" {
-                    100.0
-                } else {
-                    1.0
+                let (scale, digits) = match m.criterion.unit() {
+                    "%" => (100.0, 1),
+                    "rev" => (1.0, 1),
+                    _ => (1.0, 4),
                 };
                 let x = |v: f64| {
                     if v.is_finite() {
-                        format!("{:.1}", scale * v)
+                        format!("{:.digits$}", scale * v)
                     } else {
                         "∞".into()
                     }
                 };
+                let unit = match m.criterion.unit() {
+                    "" => String::new(),
+                    u => format!(" {u}"),
+                };
                 format!(
-                    "{} {} vs {} {} ({} p {})",
+                    "{} {} vs {}{unit} ({}, {})",
                     m.criterion.label(),
                     x(d.a),
                     x(d.b),
-                    m.criterion.unit(),
                     d.test,
                     p_text(*p)
                 )
@@ -152,7 +155,7 @@ fn disagreement(c: &Comparison, holm: &[f64], alpha: f64, a: &str, b: &str) -> S
                 **p <= alpha && d.difference != 0.0 && m.criterion.a_better(d.difference) != a_ahead
             })
         })
-        .map(|(m, p)| format!("the {} (Holm p {})", m.criterion.label(), p_text(*p)))
+        .map(|(m, p)| format!("the {} (Holm-adjusted {})", m.criterion.label(), p_text(*p)))
         .collect();
     if against.is_empty() {
         return String::new();

@@ -115,6 +115,36 @@ t_end_revs = 300
     ] {
         assert!(report.contains(heading), "missing {heading}");
     }
+    // Every claim-3 verdict names the measure it rests on, lists the others,
+    // and states the one Holm family over the whole claim.
+    let claim3 = &report[report.find("## Claim 3").unwrap()..report.find("## Notes").unwrap()];
+    let verdicts: Vec<&str> = claim3.lines().filter(|l| l.starts_with("- ")).collect();
+    assert!(!verdicts.is_empty(), "{claim3}");
+    for v in verdicts {
+        assert!(v.contains(" on the restricted mean settling time"), "{v}");
+        for measure in [
+            "median settling time",
+            "p90 settling time",
+            "p95 residual/A_ref",
+        ] {
+            assert!(v.contains(measure), "{measure} missing in {v}");
+        }
+        assert!(v.contains("every kind and normalisation together"), "{v}");
+    }
+    // Claim 2: one Holm family over the normalisations.
+    assert!(
+        report.contains("Holm over the 3 normalisations answering claim 2"),
+        "{report}"
+    );
+    // --rank-by median switches the measure the verdicts rest on.
+    let mut by_median = plan.clone();
+    by_median.file.summary.rank_by = autobal::study::criterion::Criterion::Median;
+    let report = render(
+        &by_median,
+        &out,
+        "study claims claims.toml --rank-by median",
+    );
+    assert!(report.contains("on the median settling time"), "{report}");
     assert!(
         tmp.path()
             .join("claims")

@@ -19,15 +19,24 @@ pub struct ClaimsArgs {
     /// Write the markdown report here (default: print it).
     #[arg(long)]
     report: Option<PathBuf>,
+    /// The measure the verdicts rest on (default: the study's `[summary] rank_by`):
+    /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
+    #[arg(long, value_parser = crate::run_cmd::parse_criterion, value_name = "CRITERION")]
+    rank_by: Option<autobal::study::criterion::Criterion>,
 }
 
 /// Run `study claims`.
 pub fn run(args: &ClaimsArgs) -> Result<(), UserError> {
-    let plan = load(&args.study)?;
+    let mut plan = load(&args.study)?;
+    if let Some(criterion) = args.rank_by {
+        plan.file.summary.rank_by = criterion;
+    }
     let out = run_claims(&plan, &NoProgress).map_err(|e| UserError::internal(e.to_string()))?;
     let command = format!(
-        "study claims {}{}",
+        "study claims {}{}{}",
         args.study.display(),
+        args.rank_by
+            .map_or(String::new(), |c| format!(" --rank-by {c}")),
         args.report
             .as_ref()
             .map_or(String::new(), |r| format!(" --report {}", r.display()))

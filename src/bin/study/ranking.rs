@@ -330,7 +330,7 @@ fn verdict_line(sum: &Summary, order: &[usize], criterion: Criterion) -> Result<
             .clone()
             .unwrap_or_else(|| "no cause found".into());
         return Ok(format!(
-            "verdict: no design balances this rotor: even {} settles in {:.1} % of its runs (a working balancer settles in at least 50 %) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {why}\n",
+            "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {why}\n",
             who(order, &ids, best),
             100.0 * frac,
             residual.map_or("– (no run was simulated to its end)".into(), |r| format!(
