@@ -8,6 +8,7 @@
 //! the results.
 
 pub mod evaluate;
+pub mod noisy_simplex;
 pub mod search;
 /// The `[optimize]` table is part of the study file, so it lives with the
 /// study schema; named here as well, where it is used.
@@ -226,7 +227,7 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
         best.extend(complete_rows(&evaluator, &spec));
     }
     let dir = crate::study::run::output_dir(&plan, None);
-    write_outputs(&plan, &dir, &evaluations, &best)
+    write_outputs(&plan, &dir, &evaluations, &best, &terminations)
         .map_err(|e| OptimizeError::Output(e.to_string()))?;
     Ok(OptimizeOutput {
         evaluations,
@@ -361,6 +362,7 @@ fn write_outputs(
     dir: &std::path::Path,
     evals: &[Evaluation],
     best: &[Best],
+    terminations: &[(String, u32, String)],
 ) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(dir)?;
     let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
@@ -369,6 +371,18 @@ fn write_outputs(
     let scopes: Vec<String> = best.iter().map(|b| b.scope.clone()).collect();
     let chosen: Vec<Evaluation> = best.iter().map(|b| b.evaluation.clone()).collect();
     let mut optimum = evaluations_frame(&chosen, Some(&scopes))?;
+    // Why each (kind, n) search stopped: converged, budget, bound or
+    // unconfirmed, with the words `study optimize` prints.
+    let stops: Vec<Option<String>> = scopes
+        .iter()
+        .map(|scope| {
+            terminations
+                .iter()
+                .find(|(kind, n, _)| format!("{kind}_{n}") == *scope)
+                .map(|(_, _, why)| why.clone())
+        })
+        .collect();
+    optimum.with_column(Column::new("stop".into(), stops))?;
     write_parquet(&dir.join("optimum.parquet"), &mut optimum, &provenance)?;
     Ok(())
 }

@@ -3,6 +3,7 @@
 //! by the caller.
 
 use super::evaluate::{Candidate, Evaluation, Evaluator};
+use super::noisy_simplex::{self, SimplexStop, Vertex};
 use super::spec::Variable;
 use crate::design::geometry::rho_max;
 use crate::model::balancer::Kind;
@@ -11,7 +12,7 @@ use argmin::core::{
     TerminationReason, TerminationStatus,
 };
 use argmin::solver::brent::BrentOpt;
-use argmin::solver::neldermead::NelderMead;
+use std::collections::HashMap;
 use std::sync::Mutex;
 
 /// Cost given to infeasible candidates (finite, so the solvers stay well defined).
@@ -131,8 +132,10 @@ impl<'a> Solver<RhoCost<'a>, IterState<f64, (), (), (), (), f64>> for NoiseAware
 pub struct SearchResult {
     /// Every evaluation, in order.
     pub evaluations: Vec<Evaluation>,
-    /// Why the search stopped.
+    /// Why the search stopped, in words (printed, and stored in optimum.parquet).
     pub termination: String,
+    /// Why, in one word: "converged", "budget", "bound", "unconfirmed" or "infeasible".
+    pub stop: &'static str,
 }
 
 /// The ρ interval to search for n weights: the bounds, the fit limit and the housing limit.
@@ -144,6 +147,61 @@ pub fn rho_interval(evaluator: &Evaluator<'_>, n: u32) -> (f64, f64) {
         hi = hi.min(h);
     }
     (lo.min(hi), hi)
+}
+
+/// Most passes of search-and-confirm before the search gives up (each pass
+/// improves the optimum by more than its standard error, so this only
+/// guards against a pathological objective).
+const MAX_PASSES: usize = 20;
+
+/// The best logged evaluation (lowest cost).
+fn best_logged(cost: &CandidateCost<'_>) -> Option<Evaluation> {
+    let log = cost.log.lock().expect("log lock");
+    let key = |e: &Evaluation| match e.value {
+        Some(v) if v.is_finite() && cost.evaluator.spec.objective.maximise() => -v,
+        Some(v) if v.is_finite() => v,
+        _ => INFEASIBLE,
+    };
+    log.iter().min_by(|a, b| key(a).total_cmp(&key(b))).cloned()
+}
+
+/// "; on the lower bound of …" when the optimum sits on a bound.
+fn bound_note(
+    best: &Evaluation,
+    rho: (f64, f64),
+    drag: Option<(f64, f64)>,
+    fit: f64,
+) -> Option<String> {
+    let at = |x: f64, b: f64| (x - b).abs() <= 1e-9 * b.abs().max(1e-12);
+    let c = best.candidate;
+    let mut notes = Vec::new();
+    if at(c.rho, rho.0) {
+        notes.push(format!(
+            "ρ on its lower bound {:.4} (optimize.rho_bounds)",
+            rho.0
+        ));
+    }
+    if at(c.rho, rho.1) {
+        let which = if at(rho.1, fit) {
+            "the largest ρ whose weights fit the race"
+        } else {
+            "optimize.rho_bounds or housing_rho_max"
+        };
+        notes.push(format!("ρ on its upper bound {:.4} ({which})", rho.1));
+    }
+    if let Some((lo, hi)) = drag {
+        if at(c.drag, lo) {
+            notes.push(format!(
+                "β on its lower bound {lo} N·s/m (optimize.drag_bounds)"
+            ));
+        }
+        if at(c.drag, hi) {
+            notes.push(format!(
+                "β on its upper bound {hi} N·s/m (optimize.drag_bounds)"
+            ));
+        }
+    }
+    (!notes.is_empty()).then(|| notes.join(" and "))
 }
 
 /// Search the free variables for one kind and n.
@@ -174,110 +232,311 @@ pub fn search(evaluator: &Evaluator<'_>, kind: Kind, n: u32, drag: f64) -> Searc
     if costs[best] >= INFEASIBLE || hi - lo < 1e-9 {
         return SearchResult {
             evaluations: cost.take_log(),
-            termination: "no feasible ρ in the scan".into(),
+            termination: "infeasible: no feasible ρ in the scan".into(),
+            stop: "infeasible",
         };
     }
-    // … then Brent refines it between the neighbouring scan points.
-    let (a, b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(SCAN - 1)]);
+    // … then Brent refines it between the neighbouring scan points, and the
+    // optimum is checked against its two neighbours at an eighth of the scan
+    // step; a neighbour that beats it by more than its standard error starts
+    // another pass around itself.
     let brent_cost = CandidateCost {
         phase: "brent",
         log: Mutex::new(cost.take_log()),
         ..cost
     };
-    let solver = NoiseAwareBrent {
-        inner: BrentOpt::new(a, b).set_tolerance(1e-4, 1e-5),
-        converged: false,
-    };
-    let result = Executor::new(RhoCost(&brent_cost), solver)
-        .configure(|s| s.max_iters(budget.saturating_sub(SCAN as u64 + 1)))
-        .run();
-    let termination = match result {
-        Ok(r) => r
-            .state()
-            .get_termination_reason()
-            .map_or("done".to_string(), |t| t.text().to_string()),
-        Err(e) => format!("error: {e}"),
-    };
-    SearchResult {
-        evaluations: brent_cost.take_log(),
-        termination,
+    let mut bracket = (grid[best.saturating_sub(1)], grid[(best + 1).min(SCAN - 1)]);
+    let h = (hi - lo) / (8.0 * (SCAN - 1) as f64);
+    let mut stop = "budget";
+    let mut how = String::new();
+    for _ in 0..MAX_PASSES {
+        let used = brent_cost.log.lock().expect("log lock").len() as u64;
+        if used >= budget {
+            break;
+        }
+        let solver = NoiseAwareBrent {
+            inner: BrentOpt::new(bracket.0, bracket.1).set_tolerance(1e-4, 1e-5),
+            converged: false,
+        };
+        let result = Executor::new(RhoCost(&brent_cost), solver)
+            .configure(|s| s.max_iters(budget - used))
+            .run();
+        let reason = match result {
+            Ok(r) => r
+                .state()
+                .get_termination_reason()
+                .map_or("done".to_string(), |t| t.text().to_string()),
+            Err(e) => format!("error: {e}"),
+        };
+        if reason.contains("Maximum number of iterations") || reason.starts_with("error") {
+            stop = "budget";
+            how = reason;
+            break;
+        }
+        // Confirm against the two neighbours.
+        let Some(opt) = best_logged(&brent_cost) else {
+            break;
+        };
+        let (f0, se0) = (cost_of(&brent_cost, &opt), opt.std_err);
+        let mut beaten = None;
+        for r in [opt.candidate.rho - h, opt.candidate.rho + h] {
+            let r = r.clamp(lo, hi);
+            if brent_cost.log.lock().expect("log lock").len() as u64 >= budget {
+                break;
+            }
+            let f = brent_cost.eval(r, drag);
+            if f < f0 - se0 {
+                beaten = Some(r);
+            }
+        }
+        match beaten {
+            None => {
+                stop = "converged";
+                how = format!("{reason}; confirmed against ρ ± {h:.4} on the same samples");
+                break;
+            }
+            Some(r) => {
+                stop = "unconfirmed";
+                how = format!(
+                    "ρ = {r:.4} beats the refined optimum by more than its standard error {se0:.3}"
+                );
+                bracket = ((r - 2.0 * h).max(lo), (r + 2.0 * h).min(hi));
+            }
+        }
+    }
+    let fit = rho_max(n).unwrap_or(1.0) * (1.0 - 1e-9);
+    finish(&brent_cost, stop, how, budget, (lo, hi), None, fit)
+}
+
+/// The cost of a logged evaluation as the solvers see it.
+fn cost_of(cost: &CandidateCost<'_>, e: &Evaluation) -> f64 {
+    match e.value {
+        Some(v) if v.is_finite() && cost.evaluator.spec.objective.maximise() => -v,
+        Some(v) if v.is_finite() => v,
+        _ => INFEASIBLE,
     }
 }
 
-/// Nelder–Mead over (ρ, ln β), starting from a simplex around the middle of
-/// the ρ interval and the given drag; stops when the simplex's costs spread
-/// less than the first evaluation's standard error.
+/// The search's result with its stop stated honestly: a bound overrides
+/// "converged", and a budget stop is never called converged.
+fn finish(
+    cost: &CandidateCost<'_>,
+    stop: &'static str,
+    how: String,
+    budget: u64,
+    rho: (f64, f64),
+    drag: Option<(f64, f64)>,
+    fit: f64,
+) -> SearchResult {
+    let best = best_logged(cost);
+    let used = cost.log.lock().expect("log lock").len();
+    let mut text = match stop {
+        "converged" => format!("converged: {how}"),
+        "unconfirmed" => format!(
+            "unconfirmed: {how}, and optimize.max_evaluations = {budget} is used up; the optimum printed is the best point seen"
+        ),
+        _ => format!(
+            "budget: optimize.max_evaluations = {budget} used up ({used} evaluations) before the search met its tolerance{}; the optimum printed is the best point seen, not a converged one",
+            if how.is_empty() {
+                String::new()
+            } else {
+                format!(" ({how})")
+            }
+        ),
+    };
+    let mut stop = stop;
+    if let Some(note) = best.as_ref().and_then(|b| bound_note(b, rho, drag, fit)) {
+        text = format!("bound: {note}: the optimum may lie beyond it; {text}");
+        stop = "bound";
+    }
+    SearchResult {
+        evaluations: cost.take_log(),
+        termination: text,
+        stop,
+    }
+}
+
+/// The simplex's view of the candidates: (ρ, ln β) clamped into the box,
+/// each distinct point simulated once (same samples, same value), within
+/// the evaluation budget.
+struct SimplexCost<'a, 'b> {
+    cost: &'b CandidateCost<'a>,
+    rho: (f64, f64),
+    ln_drag: (f64, f64),
+    budget: u64,
+    seen: HashMap<(u64, u64), (f64, f64)>,
+}
+
+impl SimplexCost<'_, '_> {
+    fn clamp(&self, x: &[f64]) -> (f64, f64) {
+        (
+            x[0].clamp(self.rho.0, self.rho.1),
+            x[1].clamp(self.ln_drag.0, self.ln_drag.1),
+        )
+    }
+    fn used(&self) -> u64 {
+        self.cost.log.lock().expect("log lock").len() as u64
+    }
+}
+
+impl noisy_simplex::Objective for SimplexCost<'_, '_> {
+    fn eval(&mut self, x: &[f64]) -> Option<(f64, f64)> {
+        let (rho, ln_drag) = self.clamp(x);
+        let key = (rho.to_bits(), ln_drag.to_bits());
+        if let Some(&known) = self.seen.get(&key) {
+            return Some(known);
+        }
+        if self.used() >= self.budget {
+            return None;
+        }
+        let f = self.cost.eval(rho, ln_drag.exp());
+        let se = self
+            .cost
+            .log
+            .lock()
+            .expect("log lock")
+            .last()
+            .map_or(0.0, |e| e.std_err);
+        self.seen.insert(key, (f, se));
+        Some((f, se))
+    }
+}
+
+/// Nelder–Mead over (ρ, ln β) from the middle of the box: it stops when the
+/// simplex's values differ by less than their standard errors, restarts from
+/// its best point (at least once, and again while a restart improves by more
+/// than a standard error), then checks the optimum against its 8 neighbours
+/// at half the first steps on the same samples; a neighbour that beats it by
+/// more than its standard error restarts the search there.
 fn nelder_mead(cost: &CandidateCost<'_>, lo: f64, hi: f64, budget: u64) -> SearchResult {
     let spec = cost.evaluator.spec;
     let [dlo, dhi] = spec
         .drag_bounds
         .unwrap_or([cost.drag / 10.0, cost.drag * 10.0]);
-    let mid = 0.5 * (lo + hi);
-    let ln_drag = cost.drag.ln();
-    let step_rho = 0.25 * (hi - lo);
-    let step_drag = 0.25 * (dhi.ln() - dlo.ln());
-    let bounded = BoundedCost {
-        inner: cost,
+    let ln_drag = (dlo.ln(), dhi.ln());
+    let steps = [0.25 * (hi - lo), 0.25 * (ln_drag.1 - ln_drag.0)];
+    let mut objective = SimplexCost {
+        cost,
         rho: (lo, hi),
-        ln_drag: (dlo.ln(), dhi.ln()),
+        ln_drag,
+        budget,
+        seen: HashMap::new(),
     };
-    let first = bounded.cost(&vec![mid, ln_drag]).unwrap_or(INFEASIBLE);
-    let se = cost
-        .log
-        .lock()
-        .expect("log lock")
-        .last()
-        .map_or(0.0, |e| e.std_err);
-    let _ = first;
-    let simplex = vec![
-        vec![mid, ln_drag],
-        vec![mid + step_rho, ln_drag],
-        vec![mid, ln_drag + step_drag],
-    ];
-    let solver = match NelderMead::new(simplex).with_sd_tolerance(se.max(1e-12)) {
-        Ok(s) => s,
-        Err(e) => {
-            return SearchResult {
-                evaluations: cost.take_log(),
-                termination: format!("error: {e}"),
-            };
+    let mut start = vec![0.5 * (lo + hi), cost.drag.ln().clamp(ln_drag.0, ln_drag.1)];
+    let mut previous: Option<Vertex> = None;
+    let mut restarts = 0;
+    let mut stop = "budget";
+    let mut how = String::new();
+    for _ in 0..MAX_PASSES {
+        let (simplex, why) = noisy_simplex::minimise(&mut objective, &start, &steps);
+        if why == SimplexStop::Budget {
+            break;
         }
-    };
-    let result = Executor::new(bounded, solver)
-        .configure(|s| s.max_iters(budget / 2))
-        .run();
-    let termination = match result {
-        Ok(r) => r
-            .state()
-            .get_termination_reason()
-            .map_or("done".to_string(), |t| t.text().to_string()),
-        Err(e) => format!("error: {e}"),
-    };
-    let mut evaluations = cost.take_log();
-    for e in &mut evaluations {
+        let best = simplex[0].clone();
+        let improved = previous
+            .as_ref()
+            .is_none_or(|p| best.f < p.f - p.se.max(best.se));
+        if improved || restarts == 0 {
+            if previous.as_ref().is_none_or(|p| best.f < p.f) {
+                previous = Some(best.clone());
+            }
+            start = previous.as_ref().map_or(best.x.clone(), |p| p.x.clone());
+            restarts += 1;
+            continue;
+        }
+        // Confirm the optimum against its neighbours.
+        let optimum = previous.clone().unwrap_or(best);
+        let mut beaten: Option<Vertex> = None;
+        let mut out_of_budget = false;
+        'grid: for i in [-1.0, 0.0, 1.0] {
+            for j in [-1.0, 0.0, 1.0] {
+                if i == 0.0 && j == 0.0 {
+                    continue;
+                }
+                let x = vec![
+                    optimum.x[0] + 0.5 * i * steps[0],
+                    optimum.x[1] + 0.5 * j * steps[1],
+                ];
+                match noisy_simplex::Objective::eval(&mut objective, &x) {
+                    None => {
+                        out_of_budget = true;
+                        break 'grid;
+                    }
+                    Some((f, se)) if f < optimum.f - optimum.se => {
+                        if beaten.as_ref().is_none_or(|b| f < b.f) {
+                            beaten = Some(Vertex { x, f, se });
+                        }
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+        match (beaten, out_of_budget) {
+            (None, false) => {
+                stop = "converged";
+                how = format!(
+                    "the simplex's values came within their standard errors, after {restarts} restart{} from its best point; confirmed against its 8 neighbours at ρ ± {:.4}, ln β ± {:.3} on the same samples",
+                    if restarts == 1 { "" } else { "s" },
+                    0.5 * steps[0],
+                    0.5 * steps[1]
+                );
+                break;
+            }
+            (None, true) => break,
+            (Some(v), _) => {
+                let (rho, ln_b) = objective.clamp(&v.x);
+                stop = "unconfirmed";
+                how = format!(
+                    "the neighbour ρ = {rho:.4}, β = {:.4} N·s/m beats the simplex's optimum by more than its standard error {:.3}",
+                    ln_b.exp(),
+                    optimum.se
+                );
+                start = v.x.clone();
+                previous = Some(v);
+                restarts += 1;
+            }
+        }
+    }
+    let fit = rho_max(cost.n).unwrap_or(1.0) * (1.0 - 1e-9);
+    let mut result = finish(cost, stop, how, budget, (lo, hi), Some((dlo, dhi)), fit);
+    for e in &mut result.evaluations {
         e.phase = "nelder_mead";
     }
-    SearchResult {
-        evaluations,
-        termination,
-    }
+    result
 }
 
-/// (ρ, ln β) with box bounds: points outside cost [`INFEASIBLE`] without being simulated.
-struct BoundedCost<'a> {
-    inner: &'a CandidateCost<'a>,
-    rho: (f64, f64),
-    ln_drag: (f64, f64),
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-impl CostFunction for BoundedCost<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
-        if p[0] < self.rho.0 || p[0] > self.rho.1 || p[1] < self.ln_drag.0 || p[1] > self.ln_drag.1
-        {
-            return Ok(INFEASIBLE);
+    fn at(rho: f64, drag: f64) -> Evaluation {
+        Evaluation {
+            candidate: crate::optimize::evaluate::Candidate {
+                kind: Kind::Ball,
+                n: 3,
+                rho,
+                drag,
+            },
+            value: Some(1.0),
+            std_err: 0.1,
+            capacity: None,
+            feasible: true,
+            constraint: "ok".into(),
+            phase: "test",
         }
-        self.inner.cost(p)
+    }
+
+    #[test]
+    fn an_optimum_on_a_bound_names_the_bound() {
+        let rho = (0.02, 0.4);
+        let drag = Some((0.05, 20.0));
+        assert_eq!(bound_note(&at(0.2, 1.0), rho, drag, 0.5), None);
+        let low = bound_note(&at(0.2, 0.05), rho, drag, 0.5).unwrap();
+        assert!(low.contains("β on its lower bound 0.05 N·s/m"), "{low}");
+        let fit = bound_note(&at(0.4, 1.0), rho, drag, 0.4).unwrap();
+        assert!(
+            fit.contains("the largest ρ whose weights fit the race"),
+            "{fit}"
+        );
     }
 }

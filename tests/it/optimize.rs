@@ -264,3 +264,99 @@ fn settling_objectives_equal_the_summarys_censoring_aware_statistics() {
     assert!((mean - rmst).abs() <= 1e-9 * rmst, "{mean} vs {rmst}");
     assert_eq!(Some(median), get("settling_revs_median_km"));
 }
+
+/// The issue's study: an 8 kg rotor on soft supports at 1200 rpm, steel
+/// balls in a 25 mm race, absolute unbalances, settling_mean over (ρ, β).
+fn soft_rotor_plan(output: &Path, max_evaluations: u64) -> StudyPlan {
+    let text = format!(
+        r#"
+name = "soft"
+output = "{}"
+[scene]
+start = "locked_steady"
+[scene.rotor]
+mass = 8.0
+kx = 14000.0
+ky = 14000.0
+bx = 33.5
+by = 33.5
+[scene.speed]
+mode = "constant"
+omega = 125.66
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.025
+density = 7850.0
+drag = 0.5
+[sampling]
+samples = 48
+unbalance = {{ distribution = "uniform", min = 2e-5, max = 2e-4, relative_to = "absolute" }}
+initial = "clustered"
+[optimize]
+objective = "settling_mean"
+free = ["rho", "drag"]
+drag_bounds = [0.05, 20.0]
+max_evaluations = {max_evaluations}
+"#,
+        output.display()
+    );
+    StudyFile::parse(&text, "soft.toml")
+        .unwrap()
+        .plan(&text, "soft.toml")
+        .unwrap()
+}
+
+#[test]
+fn the_simplex_optimum_is_the_grids_best_within_its_standard_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plan = soft_rotor_plan(tmp.path(), 30);
+    let out = optimize(&plan).unwrap();
+    let (_, _, why) = &out.terminations[0];
+    let best = out.best.iter().find(|b| b.scope == "ball_3").unwrap();
+    let (value, se) = (best.evaluation.value.unwrap(), best.evaluation.std_err);
+    // A 9 × 9 grid over ρ × ln β on the same samples.
+    let spec = plan.file.optimize.clone().unwrap();
+    let evaluator = Evaluator {
+        plan: &plan,
+        spec: &spec,
+        samples: 48,
+    };
+    let rho_hi = autobal::optimize::search::rho_interval(&evaluator, 3).1;
+    let mut grid_best = f64::INFINITY;
+    for i in 0..9 {
+        for j in 0..9 {
+            let rho = 0.02 + (rho_hi - 0.02) * f64::from(i) / 8.0;
+            let drag = (0.05f64.ln() + (20.0f64 / 0.05).ln() * f64::from(j) / 8.0).exp();
+            let e = evaluator.evaluate(
+                Candidate {
+                    kind: Kind::Ball,
+                    n: 3,
+                    rho,
+                    drag,
+                },
+                "grid",
+            );
+            if let Some(v) = e.value {
+                grid_best = grid_best.min(v);
+            }
+        }
+    }
+    assert!(
+        value <= grid_best + se,
+        "optimum {value} ± {se}, grid best {grid_best}: {why}"
+    );
+}
+
+#[test]
+fn a_budget_stop_is_never_called_converged() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = optimize(&soft_rotor_plan(tmp.path(), 12)).unwrap();
+    let (_, _, why) = &out.terminations[0];
+    assert!(
+        why.contains("budget: optimize.max_evaluations = 12 used up"),
+        "{why}"
+    );
+    assert!(!why.contains("converged:"), "{why}");
+}
