@@ -29,6 +29,7 @@
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
 //! the ramp's final speed or the motor's synchronous speed).
 
+pub mod balance_angle;
 pub mod certify;
 pub mod observer;
 pub mod reference;

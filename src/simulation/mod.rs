@@ -147,11 +147,14 @@ impl Simulation {
 }
 
 /// The largest angle (degrees) from the final cargo angles to the nearest
-/// balanced state, found by the linear analysis' Newton iteration from them.
-/// At rest the friction torque vanishes, so the balanced states are those of
-/// the scene without it; it is left out because its regularised sign has a
-/// slope that no finite-difference Jacobian resolves. `None` at variable
-/// speed or with no balanced state near.
+/// balanced state: the linear analysis' Newton iteration from them finds one
+/// balanced state, which fixes each plane's correction unbalance T; the
+/// nearest member of the whole balanced set {Σ c_j e^{iψ_j} = T} is then
+/// found by [`crate::metrics::balance_angle`]. At rest the friction torque
+/// vanishes, so the balanced states are those of the scene without it; it
+/// is left out because its regularised sign has a slope that no
+/// finite-difference Jacobian resolves. `None` at variable speed or with no
+/// balanced state near.
 fn balance_angle_error(scene: &Scene, final_deg: &[f64]) -> Option<f64> {
     let mut frictionless = scene.clone();
     frictionless.effects.rolling_resistance = None;
@@ -160,13 +163,25 @@ fn balance_angle_error(scene: &Scene, final_deg: &[f64]) -> Option<f64> {
     let psi: Vec<f64> = final_deg.iter().map(|d| d.to_radians()).collect();
     let state = crate::model::linear::steady_state(&frame, &psi).ok()?;
     let head = system.layout().head();
-    psi.iter()
-        .zip(&state[head..head + psi.len()])
-        .map(|(a, b)| {
-            crate::model::effect::contact::wrapped(a - b)
-                .abs()
-                .to_degrees()
+    let balanced = &state[head..head + psi.len()];
+    let cargo = system.cargo();
+    let planes = cargo.iter().map(|c| c.plane).max()? + 1;
+    (0..planes)
+        .filter_map(|p| {
+            let members: Vec<usize> = (0..cargo.len()).filter(|&j| cargo[j].plane == p).collect();
+            let c: Vec<f64> = members.iter().map(|&j| cargo[j].unbalance()).collect();
+            let phi: Vec<f64> = members.iter().map(|&j| psi[j]).collect();
+            let target: num_complex::Complex64 = members
+                .iter()
+                .map(|&j| num_complex::Complex64::from_polar(cargo[j].unbalance(), balanced[j]))
+                .sum();
+            let upper = members
+                .iter()
+                .map(|&j| crate::model::effect::contact::wrapped(psi[j] - balanced[j]).abs())
+                .fold(0.0, f64::max);
+            crate::metrics::balance_angle::nearest_balanced_angle(&c, &phi, target, upper)
         })
+        .map(f64::to_degrees)
         .reduce(f64::max)
 }
 
