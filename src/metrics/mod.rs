@@ -24,7 +24,8 @@
 //!   not_settled (an estimate that predicts no settling), diverged
 //!   (non-finite state, or r beyond `divergence_factor` times the larger of
 //!   A_ref and the whirl (U + Σ m l)/U · A_ref the weights can drive) or
-//!   solver_failed, each with a reason.
+//!   solver_failed, or merged (two identical weights coincided exactly, a
+//!   state the equations never leave), each with a reason.
 //!
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
 //! the ramp's final speed or the motor's synchronous speed).
@@ -95,6 +96,11 @@ pub enum Outcome {
     BudgetExceeded,
     /// The integrator could not continue (step-size underflow, Newton failure).
     SolverFailed,
+    /// Two identical weights coincided exactly (angle and rate): the
+    /// equations keep identical weights together for ever, which no real
+    /// pair of weights does, so the rest of the run is not physics and it
+    /// ends here (docs/model.md, "Identical weights that meet").
+    Merged,
 }
 
 impl Outcome {
@@ -107,6 +113,7 @@ impl Outcome {
             Outcome::Diverged => "diverged",
             Outcome::BudgetExceeded => "budget_exceeded",
             Outcome::SolverFailed => "solver_failed",
+            Outcome::Merged => "merged",
         }
     }
 }

@@ -165,6 +165,11 @@ pub struct SettlingObserver<'a> {
     operating_since: Option<f64>,
     omega: f64,
     diverged: Option<String>,
+    /// Pairs of weights with identical parameters in one plane (they can
+    /// coincide and never part), and the reason once two did.
+    twins: Vec<(usize, usize)>,
+    /// The first pair that coincided, and when.
+    merged: Option<(usize, usize, f64)>,
     series: Option<Series>,
     frame: Option<f64>,
     certifier: Option<HoldCertifier<'a>>,
@@ -203,6 +208,51 @@ const TAIL_CHECK_STRIDE: usize = 4;
 /// Tracking starts once r has stayed below this fraction of the band for a
 /// revolution: deep enough inside for the linearisation to hold.
 const READY_FRACTION: f64 = 0.2;
+
+/// Pairs (i, j) of weights in the same plane with identical parameters:
+/// the only ones whose states can become equal and then stay equal.
+fn identical_pairs(cargo: &[crate::model::cargo::Cargo]) -> Vec<(usize, usize)> {
+    let mut pairs = Vec::new();
+    for i in 0..cargo.len() {
+        for j in i + 1..cargo.len() {
+            let (a, b) = (&cargo[i], &cargo[j]);
+            if a.plane == b.plane
+                && a.mass == b.mass
+                && a.track_radius == b.track_radius
+                && a.drag == b.drag
+                && a.kappa == b.kappa
+                && a.rolling_coupling == b.rolling_coupling
+                && a.rolling_inertia == b.rolling_inertia
+                && a.radius == b.radius
+            {
+                pairs.push((i, j));
+            }
+        }
+    }
+    pairs
+}
+
+/// Two angles (or rates) this close are the same number to the last bits:
+/// a few units in the last place of the larger.
+fn same_to_the_last_bits(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 8.0 * f64::EPSILON * a.abs().max(b.abs()).max(1.0)
+}
+
+/// The first of `pairs` whose angles (mod 2π) and rates are equal to the
+/// last bits in state y.
+fn coincident_pair(
+    pairs: &[(usize, usize)],
+    lay: crate::model::system::Layout,
+    y: &[f64],
+) -> Option<(usize, usize)> {
+    let (head, nq) = (lay.head(), lay.nq());
+    pairs.iter().copied().find(|&(i, j)| {
+        let (a, b) = (y[head + i], y[head + j]);
+        let gap = crate::model::effect::contact::wrapped(a - b);
+        same_to_the_last_bits(a, a - gap)
+            && same_to_the_last_bits(y[nq + head + i], y[nq + head + j])
+    })
+}
 
 impl<'a> SettlingObserver<'a> {
     /// The state holds rotor-frame (u, v) turning at `omega`: r and ε are the
@@ -275,6 +325,8 @@ impl<'a> SettlingObserver<'a> {
             operating_since: None,
             omega,
             diverged: None,
+            twins: identical_pairs(system.cargo()),
+            merged: None,
             series: record.then(|| Series {
                 psi: vec![Vec::new(); system.cargo().len()],
                 ..Series::default()
@@ -313,6 +365,60 @@ impl<'a> SettlingObserver<'a> {
         self.operating_since.is_some()
     }
 
+    /// The first pair of identical weights whose angles (mod 2π) and rates
+    /// are equal to the last bits in the scratch state, if any.
+    fn coincident(&self) -> Option<(usize, usize)> {
+        coincident_pair(&self.twins, self.system.layout(), &self.scratch)
+    }
+
+    /// The state in inertial coordinates (the rotating frame integrates the
+    /// plane rotor's (u, v): turn them and their rates back).
+    fn inertial(&self, t: f64, y: &[f64]) -> Vec<f64> {
+        let mut out = y.to_vec();
+        if let Some(w) = self.frame {
+            let nq = self.system.layout().nq();
+            let (s, c) = (w * t).sin_cos();
+            let (u, v, ud, vd) = (y[0], y[1], y[nq], y[nq + 1]);
+            out[0] = u * c - v * s;
+            out[1] = u * s + v * c;
+            out[nq] = ud * c - vd * s - w * out[1];
+            out[nq + 1] = ud * s + vd * c + w * out[0];
+        }
+        out
+    }
+
+    /// The growth rate (1/s) of the antisymmetric mode of weights i and j at
+    /// state y: δ = ψ_i − ψ_j obeys δ̈ = a δ + b δ̇ to first order, from
+    /// central differences of the right-hand side; positive when the pair,
+    /// once apart, would part further (real weights would separate).
+    fn parting_rate(&self, t: f64, y: &[f64], i: usize, j: usize) -> f64 {
+        let lay = self.system.layout();
+        let (head, nq) = (lay.head(), lay.nq());
+        let y0 = self.inertial(t, y);
+        let response = |offset: usize, h: f64| {
+            let mut plus = y0.clone();
+            let mut minus = y0.clone();
+            plus[offset + head + i] += h;
+            plus[offset + head + j] -= h;
+            minus[offset + head + i] -= h;
+            minus[offset + head + j] += h;
+            let (mut dp, mut dm) = (vec![0.0; y0.len()], vec![0.0; y0.len()]);
+            crate::integrate::OdeSystem::rhs(self.system, t, &plus, &mut dp);
+            crate::integrate::OdeSystem::rhs(self.system, t, &minus, &mut dm);
+            let ddot = |d: &[f64]| d[nq + head + i] - d[nq + head + j];
+            (ddot(&dp) - ddot(&dm)) / (4.0 * h)
+        };
+        let a = response(0, 1e-7);
+        let b = response(nq, 1e-7 * self.omega.max(1.0));
+        // Largest real part of the roots of λ² − b λ − a.
+        let disc = b * b + 4.0 * a;
+        if disc >= 0.0 {
+            0.5 * (b + disc.sqrt())
+        } else {
+            0.5 * b
+        }
+    }
+
     /// Process one sample; returns Stop when the run should end.
     fn sample(&mut self, t: f64) -> Flow {
         let operating = self.at_operating_speed(t);
@@ -345,6 +451,9 @@ impl<'a> SettlingObserver<'a> {
                 self.options.divergence_factor, self.divergence_scale
             ));
             return Flow::Stop;
+        }
+        if self.merged.is_none() {
+            self.merged = self.coincident().map(|(i, j)| (i, j, t));
         }
         self.ring.push(r * r);
         self.r_hold
@@ -581,6 +690,18 @@ impl<'a> SettlingObserver<'a> {
         let (t_s, hold_complete) = self.r_hold.settling_time();
         let (t_eps, _) = self.eps_hold.settling_time();
         let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
+        // Identical weights that met and are still one at the end: a result
+        // only if the pair is stable there (real weights would stay together
+        // too); where it is unstable, real weights would have parted.
+        let merged_apart = self.merged.and_then(|(i, j, t_met)| {
+            coincident_pair(&[(i, j)], lay, y_final)?;
+            let rate = self.parting_rate(t_final, y_final, i, j);
+            (rate > 1e-6 * self.omega).then(|| {
+                format!(
+                    "weights {i} and {j} (identical) coincided at t = {t_met:.4} and moved as one to the end, where the pair is unstable (once apart it would part at {rate:.3e} 1/s): the equations keep identical weights together for ever, real ones would separate; add [sampling.tolerances] to give them the differences real parts have"
+                )
+            })
+        });
         let (outcome, reason) = match (&self.diverged, &report.status) {
             (Some(why), _) => (Outcome::Diverged, why.clone()),
             (None, Status::Failed(Failure::NonFinite { t })) => {
@@ -593,6 +714,9 @@ impl<'a> SettlingObserver<'a> {
                 ),
             ) => (Outcome::BudgetExceeded, f.to_string()),
             (None, Status::Failed(f)) => (Outcome::SolverFailed, f.to_string()),
+            (None, _) if merged_apart.is_some() => {
+                (Outcome::Merged, merged_apart.clone().unwrap_or_default())
+            }
             (None, _) => match t_s {
                 Some(t) if hold_complete => (
                     Outcome::Settled,

@@ -199,6 +199,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.diverged.push(count("diverged"));
         rows.solver_failed.push(count("solver_failed"));
         rows.budget_exceeded.push(count("budget_exceeded"));
+        rows.merged.push(count("merged"));
         // Whether the weights were solid, and how close they came in the
         // worst run (negative: they overlapped).
         let contact = mine.column("contact")?.bool()?.clone();
@@ -292,6 +293,7 @@ struct SummaryColumns {
     diverged: Vec<u64>,
     solver_failed: Vec<u64>,
     budget_exceeded: Vec<u64>,
+    merged: Vec<u64>,
     contact: Vec<bool>,
     min_gap: Vec<Option<f64>>,
     max_overlap: Vec<Option<f64>>,
@@ -425,6 +427,7 @@ impl SummaryColumns {
             Column::new("diverged".into(), self.diverged),
             Column::new("solver_failed".into(), self.solver_failed),
             Column::new("budget_exceeded".into(), self.budget_exceeded),
+            Column::new("merged".into(), self.merged),
             Column::new("contact".into(), self.contact),
             Column::new("min_gap_rad".into(), self.min_gap),
             Column::new("max_overlap_fraction".into(), self.max_overlap),

@@ -208,6 +208,7 @@ fn outcome_from(name: &str) -> PolarsResult<Outcome> {
         "censored" => Outcome::Censored,
         "budget_exceeded" => Outcome::BudgetExceeded,
         "diverged" => Outcome::Diverged,
+        "merged" => Outcome::Merged,
         "solver_failed" => Outcome::SolverFailed,
         other => polars_bail!(ComputeError: "unknown outcome '{other}' in runs file"),
     })

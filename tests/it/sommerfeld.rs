@@ -242,3 +242,56 @@ fn study_run_prints_the_stall_torque_and_the_passage_table() {
     // 100 revolutions at 300 rad/s are 2.1 s: too short for 4 N·m to get there.
     assert!(stdout.contains("0/1"), "{stdout}");
 }
+
+/// The pendulum design of `studies/sommerfeld.toml` at the given stall torque.
+fn shipped_pendulums(torque: f64, tolerances: &str) -> (autobal::study::config::StudyPlan, u32) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/studies/sommerfeld.toml");
+    let text = std::fs::read_to_string(path).unwrap() + tolerances;
+    let plan = autobal::study::config::StudyFile::parse(&text, path)
+        .unwrap()
+        .plan(&text, path)
+        .unwrap();
+    let id = plan
+        .designs
+        .iter()
+        .find(|d| d.spec.kind.name() == "pendulum" && d.stall_torque == Some(torque))
+        .unwrap()
+        .id;
+    (plan, id)
+}
+
+#[test]
+fn identical_pendulums_that_meet_end_merged_instead_of_reporting_the_pair_as_physics() {
+    use autobal::metrics::Outcome;
+    use autobal::study::run::run_design_sample;
+    let (plan, id) = shipped_pendulums(12.0, "");
+    let design = plan.designs[id as usize].clone();
+    let run = run_design_sample(&plan, &design, 9, 9);
+    assert_eq!(
+        run.metrics.outcome,
+        Outcome::Merged,
+        "{}",
+        run.metrics.reason
+    );
+    assert!(
+        run.metrics.reason.contains("coincided"),
+        "{}",
+        run.metrics.reason
+    );
+    assert!(!run.metrics.settled);
+    // The same run with the weights' masses spread by 1e-6: no pair is
+    // identical, nothing merges, and the run balances.
+    let (plan, id) = shipped_pendulums(
+        12.0,
+        "\n[sampling.tolerances]\nmass = { sigma = 1e-6, relative = true }\n",
+    );
+    let design = plan.designs[id as usize].clone();
+    let run = run_design_sample(&plan, &design, 9, 9);
+    assert_ne!(
+        run.metrics.outcome,
+        Outcome::Merged,
+        "{}",
+        run.metrics.reason
+    );
+    assert!(run.metrics.residual_rel < 0.05, "{}", run.metrics.reason);
+}

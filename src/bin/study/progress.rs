@@ -127,7 +127,7 @@ impl Progress for RunProgress {
         }
         let failed = matches!(
             record.metrics.outcome,
-            Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded
+            Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded | Outcome::Merged
         );
         if failed {
             self.failures.fetch_add(1, Ordering::Relaxed);

@@ -285,6 +285,7 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
         + &verdict_line(&sum, &order, criterion)?
         + &disagreement_line(&sum, &order, criterion)?
         + &recommendation_line(&sum, &order, criterion)?
+        + &merged_line(&sum, &order)?
         + &dead_band_line(&sum, &order)?
         + &contact_line(summary)?
         + &passage_table(summary)?)
@@ -506,6 +507,32 @@ fn recommendation_line(
         );
     }
     Ok(line + "\n")
+}
+
+/// Runs that ended `merged`: how many, of which designs, and the way out.
+fn merged_line(sum: &Summary, order: &[usize]) -> Result<String, UserError> {
+    let Ok(column) = sum.0.column("merged") else {
+        return Ok(String::new());
+    };
+    let merged: Vec<u64> = column
+        .u64()?
+        .iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let ids = design_ids(sum)?;
+    let parts: Vec<String> = order
+        .iter()
+        .filter(|&&i| merged[i] > 0)
+        .map(|&i| format!("{} in design {}", merged[i], ids[i]))
+        .collect();
+    if parts.is_empty() {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "merged: {} runs ended when two identical weights coincided ({}), a state the equations never leave and real parts never reach: they count as not settled and their residuals are left out; give the weights their tolerances in [sampling.tolerances] (docs/model.md, \"Identical weights that meet\")\n",
+        merged.iter().sum::<u64>(),
+        parts.join(", ")
+    ))
 }
 
 /// With rolling resistance: the dead band μ_s·l beside the band δ·A_ref.
