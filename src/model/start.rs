@@ -78,6 +78,13 @@ pub fn is_plane_translation(system: &RotorSystem) -> bool {
 /// unbalance U e^{i(ωt+θ)} as M_Σ ẍ + b ẋ + k x = ω² U cos(ωt + θ).
 pub fn locked_response(system: &RotorSystem, psi0: &[f64], omega: f64) -> [f64; 4] {
     let (ux, uy) = total_unbalance(system, psi0);
+    // With an off-centre race the weights' own mass is carried at e_r too.
+    let (ex, ey) = system.effects_locked_unbalance();
+    let (ux, uy) = if (ex, ey) == (0.0, 0.0) {
+        (ux, uy)
+    } else {
+        (ux + ex, uy + ey)
+    };
     let rotor = system.rotor();
     let m_total = rotor.mass_matrix()[0][0] + system.cargo().iter().map(|c| c.mass).sum::<f64>();
     // Support stiffness and damping along each axis, read off the rotor's forces.

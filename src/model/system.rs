@@ -161,6 +161,15 @@ impl RotorSystem {
         &self.speed
     }
 
+    /// The unbalance (kg·m, (U_x, U_y) at φ = 0) the enabled effects add
+    /// with the weights locked (the race's mass carried off the axis).
+    pub fn effects_locked_unbalance(&self) -> (f64, f64) {
+        self.effects
+            .iter()
+            .map(|e| e.locked_unbalance())
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y))
+    }
+
     /// Names of the enabled effects.
     pub fn effect_names(&self) -> Vec<&'static str> {
         self.effects.iter().map(|e| e.name()).collect()

@@ -727,6 +727,31 @@ impl StudyFile {
             super::tolerance::validate(t, &designs, &facts)
                 .map_err(|(k, v, r)| invalid(&format!("sampling.tolerances.{k}"), v, &r))?;
         }
+        let demand = self.eccentricity_demand();
+        if demand > 0.0 && s.require_balanceable {
+            // The weights must also hold the race centred: the unbalance they
+            // supply grows by up to e_r·|M − (k + ibω)/ω²| (docs/model.md).
+            let upper = s.unbalance.distribution.upper();
+            let drawn = |d: &Design| match s.unbalance.scale() {
+                Scale::Absolute => upper,
+                Scale::Capacity => upper * d.capacity,
+            };
+            if let Some(d) = designs.iter().find(|d| d.capacity < drawn(d) + demand) {
+                return Err(invalid(
+                    "sampling.unbalance.max",
+                    upper.to_string(),
+                    &format!(
+                        "the largest unbalance drawn, {:.4e} kg·m, plus the {demand:.4e} kg·m the weights must add to centre the off-centre race (effects.race_eccentricity: e_r·|M − (k + ibω)/ω²|) exceeds the capacity {:.4e} kg·m of design {} ({} n = {} ρ = {:.4}); lower it or set require_balanceable = false",
+                        drawn(d),
+                        d.capacity,
+                        d.id,
+                        d.spec.kind,
+                        d.spec.n,
+                        d.rho
+                    ),
+                ));
+            }
+        }
         if s.unbalance.scale() == Scale::Absolute && s.require_balanceable {
             let upper = s.unbalance.distribution.upper();
             if let Some(d) = designs.iter().find(|d| d.capacity < upper) {
@@ -758,6 +783,26 @@ impl StudyFile {
             designs,
             text: text.to_string(),
         })
+    }
+
+    /// The unbalance (kg·m) the weights must add, besides cancelling the
+    /// rotor's, to hold an off-centre race on the axis:
+    /// e_r·|M − (k + ibω)/ω²| on the plane rotor at its nominal speed (the
+    /// larger of the two axes); 0 without race eccentricity.
+    pub fn eccentricity_demand(&self) -> f64 {
+        let Some(e) = self.scene.effects.race_eccentricity.as_ref() else {
+            return 0.0;
+        };
+        let Some(r) = self
+            .scene
+            .rotor
+            .downcast_ref::<crate::model::rotor::PlaneRotor>()
+        else {
+            return 0.0;
+        };
+        let w = self.scene.speed.nominal_speed();
+        let axis = |k: f64, b: f64| (r.mass - k / (w * w)).hypot(b / w);
+        e.offset * axis(r.kx, r.bx).max(axis(r.ky, r.by))
     }
 
     /// Validate one design of this study's scene and compute its mass and capacity.

@@ -106,3 +106,25 @@ fn a_motor_driven_rotor_is_refused_naming_the_field() {
     );
     assert!(message.contains("prescribed speed"), "{message}");
 }
+
+#[test]
+fn the_locked_start_carries_the_weights_mass_at_the_offset() {
+    // Weights held by a drag a million times the rotor's damping: they barely
+    // move in the first revolutions, so a start that is the locked system's
+    // steady state keeps r constant; one that leaves out the weights' mass
+    // carried at e_r starts a transient of the size of m_Σ e_r against U.
+    let text = scene(5e-3, 40.0, 0.02, "")
+        .replace("drag = 0.01", "drag = 1.0e5")
+        .replace("t_end_revs = 600", "t_end_revs = 3\nhold_revs = 1");
+    let series = run(&text).series.expect("recorded");
+    let r0 = series.r[0];
+    let wander = series
+        .r
+        .iter()
+        .map(|r| (r - r0).abs() / r0)
+        .fold(0.0, f64::max);
+    assert!(
+        wander < 2e-4,
+        "r wanders by {wander:.2e} of r(0) = {r0:.4e}"
+    );
+}

@@ -66,6 +66,12 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn rotor_forces_from_weights(&self) -> bool {
         true
     }
+    /// The unbalance (kg·m, rotor axes at φ = 0, as (U_x, U_y)) the effect
+    /// adds when the weights are locked to the rotor: what a locked start's
+    /// forced response must include. None by default.
+    fn locked_unbalance(&self) -> (f64, f64) {
+        (0.0, 0.0)
+    }
 }
 
 /// What an effect may need to know of the rest of the scene to accept it.

@@ -103,6 +103,12 @@ impl Effect for OffCentreRace {
         "race_eccentricity"
     }
 
+    /// The weights' own mass m_Σ carried at e_r e^{iθ}.
+    fn locked_unbalance(&self) -> (f64, f64) {
+        let (s, c) = self.angle.sin_cos();
+        (self.mass_offset * c, self.mass_offset * s)
+    }
+
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
         let (rate, accel) = (ctx.spin_rate, ctx.spin_accel);
         for ((f, mel), psi) in forces
