@@ -80,6 +80,11 @@ fn paired_effect(c: &Comparison, a: &str, b: &str) -> String {
     )
 }
 
+/// The results of one normalisation.
+fn of_normalisation(results: &[DesignResult], norm: Normalisation) -> Vec<&DesignResult> {
+    results.iter().filter(|r| r.normalisation == norm).collect()
+}
+
 /// Holm-adjusted p-values per measure over the comparisons of one family
 /// (one claim): `result[i][k]` for comparison i and measure k.
 fn holm_per_measure(comparisons: &[&Comparison]) -> Vec<Vec<f64>> {
@@ -300,11 +305,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
     // Every normalisation answers the same claim: one Holm family over them.
     let mut shift_cases = Vec::new();
     for norm in Normalisation::ALL {
-        let rows: Vec<&DesignResult> = out
-            .shift
-            .iter()
-            .filter(|r| r.normalisation == norm)
-            .collect();
+        let rows = of_normalisation(&out.shift, norm);
         let two = rows.iter().find(|r| r.n == 2);
         let three = rows.iter().find(|r| r.n == 3);
         let c = two.zip(three).map(|(two, three)| {
@@ -381,11 +382,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
     // Every normalisation and kind answers claim 3: one Holm family over all.
     let mut cases = Vec::new();
     for norm in Normalisation::ALL {
-        let rows: Vec<&DesignResult> = out
-            .fastest
-            .iter()
-            .filter(|r| r.normalisation == norm)
-            .collect();
+        let rows = of_normalisation(&out.fastest, norm);
         for (kind, paper_n) in [(Kind::Ball, 3), (Kind::Roller, 5)] {
             let of_kind: Vec<&DesignResult> =
                 rows.iter().copied().filter(|r| r.kind == kind).collect();
@@ -403,11 +400,7 @@ pub fn render(plan: &StudyPlan, out: &ClaimsOutput, command: &str) -> String {
         "α = {alpha}, Holm-adjusted over all {comparisons} comparisons of the fastest design with the others, every kind and normalisation together (they answer one claim)"
     );
     for norm in Normalisation::ALL {
-        let rows: Vec<&DesignResult> = out
-            .fastest
-            .iter()
-            .filter(|r| r.normalisation == norm)
-            .collect();
+        let rows = of_normalisation(&out.fastest, norm);
         if rows.is_empty() {
             continue;
         }

@@ -12,24 +12,7 @@ fn drum_like(results: &Path, name: &str, unbalance: &str, extra: &str) -> String
     format!(
         r#"name = "{name}"
 output = "{}"
-[scene]
-start = "locked_steady"
-[scene.rotor]
-mass = 8.0
-kx = 14000.0
-ky = 14000.0
-bx = 33.5
-by = 33.5
-[scene.speed]
-mode = "constant"
-omega = 125.66
-[designs]
-kind = "ball"
-n = 3
-rho = "optimal"
-race_radius = 0.025
-density = 7850.0
-drag = [0.5, 2.0]
+{}drag = [0.5, 2.0]
 [sampling]
 samples = 4
 unbalance = {unbalance}
@@ -38,7 +21,8 @@ initial = "clustered"
 hold_revs = 20
 t_end_revs = 120
 {extra}"#,
-        results.display()
+        results.display(),
+        crate::fixtures::SOFT_ROTOR
     )
 }
 

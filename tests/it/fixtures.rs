@@ -16,6 +16,29 @@ omega = 300.0
 /// The dimensionless plane rotor of `scenes/three_balls.toml` (M = 1, k = 1:
 /// natural frequency 1) with `n` equal point weights, as scene-file text up
 /// to (not including) its `[speed]` table.
+/// The soft rotor of issues 29 and 30: 8 kg on 14 kN/m supports at 1200
+/// rpm, steel balls in a 25 mm race, starting locked (a study's [scene]
+/// and the fixed keys of its [designs]; the drag and what follows are the
+/// caller's).
+pub const SOFT_ROTOR: &str = r#"[scene]
+start = "locked_steady"
+[scene.rotor]
+mass = 8.0
+kx = 14000.0
+ky = 14000.0
+bx = 33.5
+by = 33.5
+[scene.speed]
+mode = "constant"
+omega = 125.66
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.025
+density = 7850.0
+"#;
+
 pub fn point_weights_scene(n: usize) -> String {
     let mut text = String::from(
         "[rotor]\nmass = 1.0\neccentricity = 0.01\nkx = 1.0\nky = 1.0\nbx = 0.1\nby = 0.1\n",

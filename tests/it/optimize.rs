@@ -272,24 +272,7 @@ fn soft_rotor_plan(output: &Path, max_evaluations: u64) -> StudyPlan {
         r#"
 name = "soft"
 output = "{}"
-[scene]
-start = "locked_steady"
-[scene.rotor]
-mass = 8.0
-kx = 14000.0
-ky = 14000.0
-bx = 33.5
-by = 33.5
-[scene.speed]
-mode = "constant"
-omega = 125.66
-[designs]
-kind = "ball"
-n = 3
-rho = "optimal"
-race_radius = 0.025
-density = 7850.0
-drag = 0.5
+{}drag = 0.5
 [sampling]
 samples = 48
 unbalance = {{ distribution = "uniform", min = 2e-5, max = 2e-4, relative_to = "absolute" }}
@@ -300,7 +283,8 @@ free = ["rho", "drag"]
 drag_bounds = [0.05, 20.0]
 max_evaluations = {max_evaluations}
 "#,
-        output.display()
+        output.display(),
+        crate::fixtures::SOFT_ROTOR
     );
     StudyFile::parse(&text, "soft.toml")
         .unwrap()
