@@ -6,7 +6,7 @@
 //! run counts as settling at the horizon τ for the restricted mean and the
 //! p90 (never dropped), and as "not settled" for the shares.
 
-use super::verdict::DesignRuns;
+use super::design_runs::DesignRuns;
 use crate::stats::paired::{Settling, SettlingComparison, compare_settling};
 use crate::stats::paired_measures::{
     Difference, honest_p, mean_difference_bootstrap, paired_mean_difference, quantile_difference,

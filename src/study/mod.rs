@@ -10,6 +10,7 @@
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
 //! - [`criterion`]: what "best" means: the declared ranking criterion and its test.
+//! - [`design_runs`]: each design's runs as the statistics count them (clock, τ).
 //! - [`diagnosis`]: why no design balances, when none does.
 //! - [`failures`]: runs that did not finish, and the setting to change.
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
@@ -24,6 +25,7 @@ pub mod aggregate;
 pub mod compare_designs;
 pub mod config;
 pub mod criterion;
+pub mod design_runs;
 pub mod diagnosis;
 pub mod failures;
 pub mod io;

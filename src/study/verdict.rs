@@ -3,8 +3,10 @@
 //! designs met the same sampled unbalances (common random numbers), and the
 //! best design against every other with Holm's correction.
 
-use super::config::StudyPlan;
 use super::criterion::{Criterion, Scale, sign_difference};
+pub use super::design_runs::{
+    DesignRuns, SettlingClock, design_runs, measure_scale, settling_horizon,
+};
 use super::sample::{Purpose, stream};
 use crate::stats::holm::holm_adjust;
 use crate::stats::paired::{
@@ -12,149 +14,11 @@ use crate::stats::paired::{
     wilcoxon_signed_rank,
 };
 use crate::stats::paired_measures::{Difference, honest_p};
-use crate::stats::survival::{KaplanMeier, LogRank, Observation, log_rank};
-use polars::prelude::*;
+use crate::stats::survival::{LogRank, log_rank};
 use rayon::prelude::*;
 
 /// Level of every interval the comparisons report.
 pub const LEVEL: f64 = 0.95;
-
-/// The runs of one design, in sample order: its settling observations and
-/// residual vibrations.
-#[derive(Debug, Clone)]
-pub struct DesignRuns {
-    /// The design.
-    pub design_id: u32,
-    /// Sample index of each run (what pairs runs of two designs).
-    pub sample_ids: Vec<u32>,
-    /// Settled at t (revolutions), or censored: at `censoring_revs` for a
-    /// run simulated to its end, at the horizon for one that diverged,
-    /// failed or ran out of budget (it never settled within the run).
-    pub settling: Vec<Observation>,
-    /// Residual vibration / A_ref of runs simulated to their end.
-    pub residual: Vec<Option<f64>>,
-    /// Residual vibration (m) of runs simulated to their end.
-    pub residual_abs: Vec<Option<f64>>,
-}
-
-impl DesignRuns {
-    /// The Kaplan–Meier estimate of its settling.
-    pub fn kaplan_meier(&self) -> Option<KaplanMeier> {
-        KaplanMeier::fit(&self.settling)
-    }
-}
-
-/// The latest settling time a run of the plan can show (revolutions): the
-/// end of the run less the hold window. Runs that never settled are
-/// censored here, and the restricted mean, the capped times of the paired
-/// mean test and the p90 all run up to it: one τ for `summary.parquet`,
-/// `study compare`, `study claims` and `study optimize`.
-pub fn settling_horizon(plan: &StudyPlan) -> f64 {
-    plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs
-}
-
-/// τ and the length of a revolution of `plan`.
-pub fn measure_scale(plan: &StudyPlan) -> Scale {
-    Scale {
-        tau: settling_horizon(plan),
-        rev_seconds: 2.0 * std::f64::consts::PI / plan.file.scene.speed.nominal_speed(),
-    }
-}
-
-/// Where settling times are counted from.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SettlingClock {
-    /// From t = 0 (a constant speed: the rotor runs at speed from the start).
-    FromStart,
-    /// From the moment the rotor reached its operating speed (a run-up):
-    /// what the balancer takes, not the motor. One revolution lasts this
-    /// many seconds.
-    FromOperatingSpeed(f64),
-}
-
-impl SettlingClock {
-    /// The clock a plan's statistics use: from the operating speed whenever
-    /// the speed law is not constant.
-    pub fn of(plan: &StudyPlan) -> Self {
-        match plan.file.scene.speed {
-            crate::model::speed::SpeedLaw::Constant { .. } => SettlingClock::FromStart,
-            ref law => {
-                SettlingClock::FromOperatingSpeed(2.0 * std::f64::consts::PI / law.nominal_speed())
-            }
-        }
-    }
-
-    /// What tables say about it.
-    pub fn describe(self) -> &'static str {
-        match self {
-            SettlingClock::FromStart => "from t = 0",
-            SettlingClock::FromOperatingSpeed(_) => {
-                "from the moment the operating speed was reached"
-            }
-        }
-    }
-}
-
-/// Every design's runs from a runs table holding the columns of
-/// [`super::runs_file::SUMMARY_COLUMNS`], in design order (designs without
-/// runs are left out).
-///
-/// With [`SettlingClock::FromOperatingSpeed`], every time is counted from
-/// the run's `operating_time_s` (a run that never reached the operating
-/// speed keeps its censoring time: it is known not to have settled by then).
-pub fn design_runs(
-    df: &DataFrame,
-    horizon: f64,
-    clock: SettlingClock,
-) -> PolarsResult<Vec<DesignRuns>> {
-    let design = df.column("design_id")?.u32()?;
-    let sample = df.column("sample_id")?.u32()?;
-    let outcome = df.column("outcome")?.str()?;
-    let settled = df.column("settled")?.bool()?;
-    let revs = df.column("settling_revs")?.f64()?;
-    let censoring = df.column("censoring_revs")?.f64()?;
-    let residual = df.column("residual_rel")?.f64()?;
-    let residual_abs = df.column("residual_abs")?.f64()?;
-    let operating = df.column("operating_time_s")?.f64()?;
-    let mut out: Vec<DesignRuns> = Vec::new();
-    let mut rows: Vec<usize> = (0..df.height()).collect();
-    rows.sort_by_key(|&i| (design.get(i), sample.get(i)));
-    for i in rows {
-        let id = design.get(i).unwrap_or_default();
-        if out.last().is_none_or(|d| d.design_id != id) {
-            out.push(DesignRuns {
-                design_id: id,
-                sample_ids: Vec::new(),
-                settling: Vec::new(),
-                residual: Vec::new(),
-                residual_abs: Vec::new(),
-            });
-        }
-        let d = out.last_mut().expect("pushed above");
-        let offset = match clock {
-            SettlingClock::FromStart => 0.0,
-            SettlingClock::FromOperatingSpeed(rev) => operating.get(i).map_or(0.0, |t| t / rev),
-        };
-        let observation = match (settled.get(i), revs.get(i)) {
-            (Some(true), Some(t)) => Observation {
-                time: (t - offset).max(0.0),
-                settled: true,
-            },
-            _ => Observation {
-                time: (censoring.get(i).unwrap_or(horizon) - offset).max(0.0),
-                settled: false,
-            },
-        };
-        let simulated = matches!(outcome.get(i), Some("settled" | "censored" | "not_settled"));
-        d.sample_ids.push(sample.get(i).unwrap_or_default());
-        d.settling.push(observation);
-        d.residual
-            .push(residual.get(i).filter(|r| simulated && r.is_finite()));
-        d.residual_abs
-            .push(residual_abs.get(i).filter(|r| simulated && r.is_finite()));
-    }
-    Ok(out)
-}
 
 /// Why two designs' runs cannot be paired.
 pub fn pairing_refusal(a: &DesignRuns, b: &DesignRuns) -> Option<String> {
