@@ -315,7 +315,8 @@ struct MeasureColumns {
 /// A finite value, or `None` (an infinite paired median difference means
 /// that in half the pairs or more one design did not settle).
 fn finite(x: f64) -> Option<f64> {
-    x.is_finite().then_some(x)
+    // + 0.0 turns a −0.0 (the negation of an exact 0) into 0.0.
+    x.is_finite().then_some(x + 0.0)
 }
 
 impl SummaryColumns {
