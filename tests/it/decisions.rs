@@ -132,6 +132,30 @@ fn runs_out_of_budget_make_the_study_exit_1_naming_max_steps_after_writing_every
             .iter()
             .any(|o| o == "budget_exceeded")
     );
+    // Run as two shards, the merge says the same.
+    for shard in ["1/2", "2/2"] {
+        let out = run(tmp.path(), &text, &["--overwrite", "--shard", shard]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let merged = tmp.path().join("merged");
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["merge", "--out", merged.to_str().unwrap()])
+        .arg(dir.join("shard-1-of-2"))
+        .arg(dir.join("shard-2-of-2"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("raise [solver] max_steps (now 150)"),
+        "{stderr}"
+    );
+    assert!(merged.join("summary.parquet").exists());
 }
 
 #[test]

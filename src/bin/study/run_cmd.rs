@@ -158,6 +158,14 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         ),
     }
     eprintln!("wrote {}", output.dir.display());
+    if args.shard.is_some() {
+        // A shard's failed runs are reported here and fail the merge, the
+        // step that completes the study: a batch system then still runs it.
+        if let Some(advice) = failure_advice(&plan, &output.dir.join("runs.parquet"))? {
+            eprintln!("warning: {advice} (`study merge` will exit 1)");
+        }
+        return Ok(());
+    }
     fail_on_unfinished_runs(&plan, &output.dir)
 }
 
@@ -167,12 +175,7 @@ fn fail_on_unfinished_runs(
     plan: &autobal::study::config::StudyPlan,
     dir: &std::path::Path,
 ) -> Result<(), UserError> {
-    let runs = dir.join("runs.parquet");
-    if !runs.exists() {
-        // A shard: its runs are checked when the shards are merged.
-        return Ok(());
-    }
-    match failure_advice(plan, &runs)? {
+    match failure_advice(plan, &dir.join("runs.parquet"))? {
         Some(advice) => Err(UserError(advice, 1)),
         None => Ok(()),
     }
@@ -185,7 +188,10 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
         print!("{}", ranked_table(summary)?);
     }
     eprintln!("merged {} runs into {}", output.runs, output.dir.display());
-    Ok(())
+    // The shards' failed runs are never absorbed either: the study text
+    // stored beside the merged files names the settings.
+    let plan = load(&output.dir.join("study.toml"))?;
+    fail_on_unfinished_runs(&plan, &output.dir)
 }
 
 /// Where adaptive sampling stopped: how many samples it took, and the
