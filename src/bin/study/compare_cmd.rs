@@ -226,14 +226,23 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 "∞".into()
             }
         };
+        // The log-rank test gives no interval of the difference of medians.
+        let interval = if d.interval.0.is_finite() || d.interval.1.is_finite() {
+            format!(" [{}, {}]", show(d.interval.0), show(d.interval.1))
+        } else {
+            String::new()
+        };
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
         println!(
-            "{}: A {} vs B {}, A − B {} [{}, {}] {unit}, {} p {} (Holm over the {} measures: {})",
+            "{}: A {} vs B {}, A − B {}{interval}{unit}, {} p {} (Holm over the {} measures: {})",
             m.criterion.label(),
             show(d.a),
             show(d.b),
             show(d.difference),
-            show(d.interval.0),
-            show(d.interval.1),
             d.test,
             p_eq(d.p_value),
             c.measures.len(),
