@@ -223,7 +223,7 @@ pub const MIN_SETTLED_SHARE: f64 = 0.5;
 #[derive(Debug, Clone)]
 pub struct BestVersusRest {
     /// The design ranked first by `criterion` (ties: the lower restricted
-    /// mean, then the lower design id).
+    /// mean, the lower residual p95, then the lower design id).
     pub best: u32,
     /// What designs were ranked by.
     pub criterion: Criterion,
@@ -243,17 +243,27 @@ pub struct BestVersusRest {
 }
 
 /// Design indices of `designs`, best first by `criterion` (ties: the lower
-/// restricted mean, then the grid order).
+/// restricted mean, then the lower residual p95, then the grid order).
 pub fn ranking(designs: &[DesignRuns], criterion: Criterion, scale: &Scale) -> Vec<usize> {
-    let keys: Vec<(Option<f64>, Option<f64>)> = designs
+    // Ties (every design at τ when none settles, for instance) go to the
+    // lower restricted mean, then to the lower residual p95: of designs that
+    // do not settle, the one leaving the least vibration is the least bad.
+    let keys: Vec<[Option<f64>; 3]> = designs
         .iter()
-        .map(|d| (criterion.value(d, scale), Criterion::Mean.value(d, scale)))
+        .map(|d| {
+            [
+                criterion.value(d, scale),
+                Criterion::Mean.value(d, scale),
+                Criterion::ResidualP95.value(d, scale),
+            ]
+        })
         .collect();
     let mut order: Vec<usize> = (0..designs.len()).collect();
     order.sort_by(|&x, &y| {
         criterion
-            .order(keys[x].0, keys[y].0)
-            .then(Criterion::Mean.order(keys[x].1, keys[y].1))
+            .order(keys[x][0], keys[y][0])
+            .then(Criterion::Mean.order(keys[x][1], keys[y][1]))
+            .then(Criterion::ResidualP95.order(keys[x][2], keys[y][2]))
             .then(x.cmp(&y))
     });
     order

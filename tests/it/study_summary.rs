@@ -377,3 +377,15 @@ fn share_criteria_rank_by_the_share_and_test_the_discordant_pairs() {
         within.value(&designs[0], &SCALE)
     );
 }
+
+#[test]
+fn when_nothing_settles_the_design_leaving_the_least_vibration_ranks_first() {
+    let never: Vec<Option<f64>> = vec![None; 10];
+    let mut shaky = design(0, &never);
+    shaky.residual = vec![Some(3.0); 10];
+    let mut calm = design(1, &never);
+    calm.residual = vec![Some(0.4); 10];
+    let v = best_versus_rest(&[shaky, calm], Criterion::Mean, &SCALE, 0.05, true, 1).unwrap();
+    assert_eq!(v.best, 1);
+    assert!(!v.works, "nothing settled: no design balances");
+}
