@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parent.parent / "src"
 
 # Layers, lowest first: a module may import its own layer and the ones below.
 CRATE_LAYERS = [
-    {"stats", "design", "integrate"},
+    {"stats", "design", "integrate", "build_info"},
     {"model"},
     {"metrics"},
     {"simulation", "scene_file"},
@@ -29,7 +29,8 @@ CRATE_LAYERS = [
     {"optimize", "claims", "tradeoff", "check", "plot", "schema"},
 ]
 MODEL_LAYERS = [
-    {"validate", "cargo", "speed", "rotor", "effect", "balancer"},
+    {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",
+     "tilt_inertia", "sommerfeld"},
     {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "quasi_static", "start",
      "unbalance", "zero_approx"},
 ]

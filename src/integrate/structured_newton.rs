@@ -1011,7 +1011,7 @@ fn local_change(local: &Local, probe: &Probe, dz: &[f64], p: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::race_ring::uniform;
+    use crate::stats::test_stream::uniform;
 
     /// A rotor-like head (x, y) and n weights on rings: each weight feels
     /// its ring neighbours through a nonlinear spring, the head coordinates

@@ -369,7 +369,7 @@ pub fn start_clash(cargo: &[Cargo], angles: &[f64]) -> Option<StartClash> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::race_ring::uniform;
+    use crate::stats::test_stream::uniform;
     use std::f64::consts::TAU;
 
     /// n balls dealt to `planes` planes, each plane's race (radius 0.05)

@@ -81,13 +81,3 @@ pub fn for_each_ring(
         visit(ring);
     }
 }
-
-/// Deterministic pseudo-random numbers in [0, 1) for the tests of the
-/// neighbour searches (no RNG crate needed).
-#[cfg(test)]
-pub(crate) fn uniform(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6_364_136_223_846_793_005)
-        .wrapping_add(1_442_695_040_888_963_407);
-    (*state >> 11) as f64 / (1u64 << 53) as f64
-}

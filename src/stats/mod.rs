@@ -19,3 +19,5 @@ pub mod paired_measures;
 pub mod proportion;
 pub mod quantile;
 pub mod survival;
+#[cfg(test)]
+pub(crate) mod test_stream;

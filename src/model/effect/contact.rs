@@ -227,7 +227,7 @@ mod wrap_tests {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::race_ring::uniform;
+    use crate::stats::test_stream::uniform;
 
     /// For many weights, the neighbour search finds exactly the forces of the
     /// exhaustive one, on packed states where many pairs overlap, in one
