@@ -210,13 +210,16 @@ const TAIL_CHECK_STRIDE: usize = 4;
 const READY_FRACTION: f64 = 0.2;
 
 /// Pairs (i, j) of weights in the same plane with identical parameters:
-/// the only ones whose states can become equal and then stay equal.
-fn identical_pairs(cargo: &[crate::model::cargo::Cargo]) -> Vec<(usize, usize)> {
+/// the only ones whose states can become equal and then stay equal. With
+/// contact on, weights of finite size never meet (the contact force keeps
+/// them 2α apart), so they are left out and cost nothing per sample.
+fn identical_pairs(cargo: &[crate::model::cargo::Cargo], contact: bool) -> Vec<(usize, usize)> {
     let mut pairs = Vec::new();
     for i in 0..cargo.len() {
         for j in i + 1..cargo.len() {
             let (a, b) = (&cargo[i], &cargo[j]);
             if a.plane == b.plane
+                && !(contact && a.radius > 0.0)
                 && a.mass == b.mass
                 && a.track_radius == b.track_radius
                 && a.drag == b.drag
@@ -325,7 +328,7 @@ impl<'a> SettlingObserver<'a> {
             operating_since: None,
             omega,
             diverged: None,
-            twins: identical_pairs(system.cargo()),
+            twins: identical_pairs(system.cargo(), system.effect_names().contains(&"contact")),
             merged: None,
             series: record.then(|| Series {
                 psi: vec![Vec::new(); system.cargo().len()],
