@@ -32,6 +32,7 @@
 
 pub mod balance_angle;
 pub mod certify;
+pub mod never_settles;
 pub mod observer;
 pub mod reference;
 
@@ -60,6 +61,10 @@ pub struct MetricOptions {
     /// checked against the run, bounds the rest of it (rotating frame with
     /// early stop; docs/metrics.md, "Certified hold").
     pub certified_hold: bool,
+    /// End a run early as `not_settled` once its state repeats every
+    /// revolution, contracting, outside the band or below the operating
+    /// speed (early stop; docs/metrics.md, "Certified not settled").
+    pub certified_not_settled: bool,
 }
 
 impl Default for MetricOptions {
@@ -72,6 +77,7 @@ impl Default for MetricOptions {
             stop_when_settled: true,
             divergence_factor: 1e4,
             certified_hold: true,
+            certified_not_settled: true,
         }
     }
 }

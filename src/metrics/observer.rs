@@ -2,6 +2,9 @@
 //! detects settling, watches for divergence, and optionally records a series.
 
 use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, Tracked, residual_share};
+use super::never_settles::{
+    Criteria, FIRST_REVS, LAG, NeverSettles, RepeatWatch, Stroboscope, WINDOW,
+};
 use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
@@ -179,6 +182,11 @@ pub struct SettlingObserver<'a> {
     certified: Option<(f64, Vec<f64>)>,
     /// The rest of the window as the tracked flow predicts it.
     plan: Option<TailPlan>,
+    /// Watches the state once per revolution for a repeat outside the band.
+    repeats: Option<RepeatWatch>,
+    /// The certificate that ended the run as never settling, the boundary
+    /// time and the state there.
+    never: Option<(NeverSettles, f64, Vec<f64>)>,
 }
 
 /// The samples first..=last of a hold window predicted on a tracked flow:
@@ -290,6 +298,19 @@ impl<'a> SettlingObserver<'a> {
         self
     }
 
+    /// End a run that will not settle once its state repeats every
+    /// revolution, contracting, outside the band or below the operating
+    /// speed (plane rotors; see [`super::never_settles`]).
+    pub fn certify_not_settled(mut self) -> Self {
+        let whole = (self.options.t_end_revs - self.options.t_end_revs.round()).abs() < 1e-9;
+        // The horizon must fall on a revolution boundary: the run's final
+        // state is then the boundary state the watch saw.
+        if self.plane && whole {
+            self.repeats = Some(RepeatWatch::default());
+        }
+        self
+    }
+
     /// An observer for `system` running at nominal speed `omega`.
     pub fn new(system: &'a RotorSystem, omega: f64, options: MetricOptions, record: bool) -> Self {
         let rev = 2.0 * PI / omega;
@@ -339,6 +360,8 @@ impl<'a> SettlingObserver<'a> {
             residual_share: 0.0,
             certified: None,
             plan: None,
+            repeats: None,
+            never: None,
             options,
         }
     }
@@ -484,6 +507,24 @@ impl<'a> SettlingObserver<'a> {
         if self.options.stop_when_settled && self.r_hold.met_at.is_some() {
             return Flow::Stop;
         }
+        // A run that settled (and goes on, `stop_when_settled = false`) has
+        // its answer; identical weights that coincided end as `merged` or
+        // not at all.
+        if self.repeats.is_some()
+            && self.r_hold.met_at.is_none()
+            && self.merged.is_none()
+            && self.revolution_boundary(t)
+        {
+            let state = self.stroboscope(t);
+            let criteria = self.repeat_criteria(t, operating);
+            if let Some(watch) = &mut self.repeats
+                && let Some(never) = watch.observe(state, criteria)
+                && self.eps_at_horizon(t).is_some()
+            {
+                self.never = Some((never, t, self.scratch.clone()));
+                return Flow::Stop;
+            }
+        }
         if self.certifier.is_none() {
             return Flow::Continue;
         }
@@ -506,6 +547,83 @@ impl<'a> SettlingObserver<'a> {
             return self.end_on_flow(&tracked);
         }
         Flow::Continue
+    }
+
+    /// Samples per revolution.
+    fn per_rev(&self) -> u64 {
+        u64::from(self.options.samples_per_rev.max(32))
+    }
+
+    /// Whether sample time t ends a revolution (at least [`FIRST_REVS`]
+    /// into the run) and the horizon is more than a hold window away.
+    fn revolution_boundary(&self, t: f64) -> bool {
+        let index = ((t - self.t0) / self.dt).round() as u64;
+        let per = self.per_rev();
+        let rev = self.dt * per as f64;
+        index.is_multiple_of(per)
+            && index >= FIRST_REVS * per
+            && t + self.window < self.t0 + self.options.t_end_revs * rev
+    }
+
+    /// The scratch state at a revolution boundary, as the watch compares
+    /// it: the rotor's position and velocity in its body frame (scaled by
+    /// A_ref and A_ref·ω), the weights' angles and rates (rates over ω), the
+    /// spin rate over ω; and r/A_ref over the [`LAG`] revolutions that end here.
+    fn stroboscope(&self, t: f64) -> Stroboscope {
+        let lay = self.system.layout();
+        let nq = lay.nq();
+        let y = &self.scratch;
+        // The rotating frame already holds body-frame (u, v); inertial (x, y)
+        // are turned back by the spin angle.
+        let (s, c) = match self.frame {
+            Some(_) => (0.0, 1.0),
+            None => (-self.system.spin(t, y).0).sin_cos(),
+        };
+        let turn = |a: f64, b: f64| (a * c - b * s, a * s + b * c);
+        let (u, v) = turn(y[0], y[1]);
+        let (ud, vd) = turn(y[nq], y[nq + 1]);
+        let (a, w) = (self.a_ref, self.omega);
+        let mut smooth = vec![u / a, v / a, ud / (a * w), vd / (a * w)];
+        smooth.extend(y[nq + lay.head()..2 * nq].iter().map(|rate| rate / w));
+        smooth.push(self.system.spin(t, y).1 / w);
+        let (older, newer) = self.ring.latest(LAG * self.per_rev() as usize);
+        Stroboscope {
+            smooth,
+            angles: y[lay.head()..nq].to_vec(),
+            r: older.iter().chain(newer).map(|r2| r2.sqrt() / a).collect(),
+        }
+    }
+
+    /// The ε settling time the full run would report at the horizon, for a
+    /// state that repeats every revolution from boundary t on: a hold met,
+    /// or a stretch begun revolutions before the repeat, stands; a stretch
+    /// begun in the last revolution begins again, at the same phase, in
+    /// every later one. `None` when neither is sure (a stretch begun a few
+    /// revolutions ago); `Some(None)` for no stretch at the boundary.
+    #[allow(clippy::option_option)]
+    fn eps_at_horizon(&self, t: f64) -> Option<Option<f64>> {
+        let rev = self.dt * self.per_rev() as f64;
+        let horizon = self.t0 + self.options.t_end_revs * rev;
+        if let Some(met) = self.eps_hold.met_at {
+            return Some(Some(met));
+        }
+        match self.eps_hold.stretch_start {
+            None => Some(None),
+            Some(start) if start <= t - (2 * WINDOW * LAG) as f64 * rev => Some(Some(start)),
+            Some(start) if start > t - rev => Some(Some(start + (horizon - t))),
+            Some(_) => None,
+        }
+    }
+
+    /// The band, the speed and the revolutions left, at boundary time t.
+    fn repeat_criteria(&self, t: f64, operating: bool) -> Criteria {
+        let rev = self.dt * self.per_rev() as f64;
+        Criteria {
+            delta: self.options.delta,
+            operating,
+            spin_ratio: self.system.spin(t, &self.scratch).1 / self.omega,
+            remaining_revs: (self.t0 + self.options.t_end_revs * rev - t) / rev,
+        }
     }
 
     /// Whether no two weights are within [`CONTACT_MARGIN`] of touching (in
@@ -683,16 +801,31 @@ impl<'a> SettlingObserver<'a> {
     /// Turn the observations and the solver's report into the run's metrics.
     pub fn finish(self, report: &SolveReport) -> (RunMetrics, Option<Series>) {
         let lay = self.system.layout();
-        // A certified hold ends the run at the sample that certified it.
-        let (t_final, y_final) = match &self.certified {
-            Some((t, y)) => (*t, y.as_slice()),
-            None => (report.t, report.y.as_slice()),
+        let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
+        // The run's end as the integration computes it, to the last bit.
+        let horizon = self.t0 + self.options.t_end_revs * 2.0 * PI / self.omega;
+        // A certified hold ends the run at the sample that certified it; a
+        // certified "not settled" at a revolution boundary, whose state every
+        // later boundary, the horizon's too, repeats within the bound.
+        let (t_final, y_final) = match (&self.certified, &self.never) {
+            (Some((t, y)), _) => (*t, y.as_slice()),
+            (None, Some((_, _, y))) => (horizon, y.as_slice()),
+            (None, None) => (report.t, report.y.as_slice()),
         };
         let psi = &y_final[lay.head()..lay.nq()];
-        let rms = self.ring.rms();
         let (t_s, hold_complete) = self.r_hold.settling_time();
-        let (t_eps, _) = self.eps_hold.settling_time();
-        let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
+        let (mut t_eps, _) = self.eps_hold.settling_time();
+        // A run certified never to settle repeats its last revolutions to
+        // the horizon: the last hold window's RMS is theirs.
+        let rms = match &self.never {
+            Some((_, t, _)) => {
+                t_eps = self.eps_at_horizon(*t).flatten();
+                let (older, newer) = self.ring.latest(LAG * self.per_rev() as usize);
+                let count = older.len() + newer.len();
+                (older.iter().chain(newer).sum::<f64>() / count.max(1) as f64).sqrt()
+            }
+            None => self.ring.rms(),
+        };
         // Identical weights that met and are still one at the end: a result
         // only if the pair is stable there (real weights would stay together
         // too); where it is unstable, real weights would have parted.
@@ -719,6 +852,16 @@ impl<'a> SettlingObserver<'a> {
             (None, Status::Failed(f)) => (Outcome::SolverFailed, f.to_string()),
             (None, _) if merged_apart.is_some() => {
                 (Outcome::Merged, merged_apart.clone().unwrap_or_default())
+            }
+            (None, _) if self.never.is_some() => {
+                let (never, t, _) = self.never.as_ref().expect("checked");
+                (
+                    Outcome::NotSettled,
+                    format!(
+                        "not settled: from t = {t:.4} the state repeats every {LAG} revolutions (changing by at most {:.1e} per {LAG} revolutions, not growing: every later state within {:.1e} of it, scaled); {} to the horizon",
+                        never.largest, never.tail, never.why
+                    ),
+                )
             }
             (None, _) => match t_s {
                 Some(t) if hold_complete => (
@@ -789,7 +932,7 @@ impl<'a> SettlingObserver<'a> {
             method: String::new(),
             fidelity: String::new(),
             min_gap_rad: self.gap.as_ref().map(|_| self.closest.smallest()),
-            censoring_revs: (outcome == Outcome::Censored).then(|| {
+            censoring_revs: matches!(outcome, Outcome::Censored | Outcome::NotSettled).then(|| {
                 let t_op = self.operating_since.unwrap_or(t_final);
                 ((t_final - self.window).max(t_op) - self.t0) / rev
             }),
@@ -824,7 +967,11 @@ impl StepObserver for SettlingObserver<'_> {
                 (Some(c), Some(since)) => c.needs_full_state(t, since),
                 _ => false,
             };
-            let needed = if certifying || (self.t_op.is_none() && self.operating_since.is_none()) {
+            let watching = self.repeats.is_some() && self.revolution_boundary(t);
+            let needed = if certifying
+                || watching
+                || (self.t_op.is_none() && self.operating_since.is_none())
+            {
                 self.scratch.len()
             } else {
                 self.system.layout().nq()

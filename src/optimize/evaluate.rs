@@ -15,13 +15,16 @@ use rayon::prelude::*;
 
 /// A run's residual vibration for the robust-design objectives: the
 /// measured `residual_abs` (m) of a run simulated to its end or to its
-/// settling (settled or censored: the residual is observed either way, as
-/// the RMS over the last hold window), +∞ for a run that has none (diverged,
-/// failed, out of budget, or only estimated), so that it never meets a spec.
+/// settling (settled, censored, or integrated and certified not to settle:
+/// the residual is observed either way, as the RMS over the last hold
+/// window), +∞ for a run that has none (diverged, failed, out of budget, or
+/// only estimated), so that it never meets a spec.
 pub fn measured_residual(m: &crate::metrics::RunMetrics) -> f64 {
     use crate::metrics::Outcome;
     match m.outcome {
         Outcome::Settled | Outcome::Censored if m.residual_abs.is_finite() => m.residual_abs,
+        // An estimate's `not_settled` took no step and measured nothing.
+        Outcome::NotSettled if m.steps > 0 && m.residual_abs.is_finite() => m.residual_abs,
         _ => f64::INFINITY,
     }
 }

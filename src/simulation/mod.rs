@@ -108,6 +108,10 @@ impl Simulation {
         );
         let explicit = !method.is_implicit();
         let mut observer = SettlingObserver::new(system, omega, self.metrics.clone(), record);
+        // A recorded series keeps every integrated sample.
+        if self.metrics.certified_not_settled && !record {
+            observer = observer.certify_not_settled();
+        }
         if let Some(w) = frame {
             observer = observer.in_rotating_frame(w);
             // A recorded series keeps every integrated sample.

@@ -84,7 +84,12 @@ fn one_cargo_heavier_than_the_unbalance_overshoots_opposite() {
         &[90.0],
         400.0,
     ));
-    assert_eq!(m.outcome, Outcome::Censored);
+    // Never settles: run to the horizon, or certified early not to.
+    assert!(
+        matches!(m.outcome, Outcome::Censored | Outcome::NotSettled),
+        "{}",
+        m.reason
+    );
     // Opposite the unbalance, shifted by the rotor's phase lag
     // atan(bω/(Mω² − k)) = 1.5° here.
     let lag = (0.1f64 * 4.0).atan2(1.0 * 16.0 - 1.0).to_degrees();
@@ -128,7 +133,12 @@ fn tiny_weights_gather_opposite_an_unbalance_they_cannot_cancel() {
     }
     let total: f64 = cargo.iter().map(Cargo::unbalance).sum();
     let m = run(&sim(rotor(0.01), cargo, 4.0, &[60.0, 90.0, 120.0], 400.0));
-    assert_eq!(m.outcome, Outcome::Censored);
+    // Never settles: run to the horizon, or certified early not to.
+    assert!(
+        matches!(m.outcome, Outcome::Censored | Outcome::NotSettled),
+        "{}",
+        m.reason
+    );
     assert!(
         (m.balancing_error - (1.0 - total / 0.01)).abs() < 1e-9,
         "ε = {}",
@@ -337,7 +347,12 @@ fn ten_times_capacity_cannot_balance() {
         &[60.0, 90.0, 120.0],
         400.0,
     ));
-    assert_eq!(m.outcome, Outcome::Censored);
+    // Never settles: run to the horizon, or certified early not to.
+    assert!(
+        matches!(m.outcome, Outcome::Censored | Outcome::NotSettled),
+        "{}",
+        m.reason
+    );
     assert!(!m.reason.is_empty());
     assert!(
         (m.balancing_error - 0.9).abs() < 0.01,

@@ -27,6 +27,7 @@ mod model_flexible;
 mod model_linear;
 mod model_physics;
 mod model_two_support;
+mod never_settles;
 mod newton_reduction;
 mod operating_point;
 mod optimize;

@@ -374,7 +374,11 @@ fn weights_in_contact_carry_the_capacity_of_seed_000() {
             sim.scene.effects.contact = contact.then(ContactSpec::default);
             sim.metrics.t_end_revs = 300.0;
             let m = sim.run(false).unwrap().metrics;
-            assert_eq!(m.outcome, Outcome::Censored, "{}", m.reason);
+            assert!(
+                matches!(m.outcome, Outcome::Censored | Outcome::NotSettled),
+                "{}",
+                m.reason
+            );
             let psi: Vec<f64> = m
                 .final_rel_angles_deg
                 .iter()

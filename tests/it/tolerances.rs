@@ -167,7 +167,7 @@ fn by_hand(runs: &[RunRecord], spec: f64) -> (f64, f64) {
     let mut r: Vec<f64> = runs
         .iter()
         .map(|r| match r.metrics.outcome.name() {
-            "settled" | "censored" => r.metrics.residual_abs,
+            "settled" | "censored" | "not_settled" => r.metrics.residual_abs,
             _ => f64::INFINITY,
         })
         .collect();

@@ -1,0 +1,77 @@
+//! The certified "not settled" (`metrics.certified_not_settled`,
+//! src/metrics/never_settles.rs) ends runs whose state repeats every two
+//! revolutions outside the band (or below the operating speed). On every shipped study, run by run, it must
+//! report what the full integration reports: `not_settled` only where the
+//! full run ends `censored`, the residual within 1 %, the same ε settling
+//! time, censoring time and horizon, the peak r and closest approach; a run
+//! it does not end early must be the full run, bit for bit.
+
+use crate::fixtures::{shipped_plan_edited, shipped_studies};
+use autobal::metrics::Outcome;
+use autobal::metrics::never_settles::RESIDUAL_SHARE;
+use autobal::study::run::run_one;
+
+/// Samples per design of each shipped study (sample 1 of gravity_horizontal's
+/// pendulums locks on a periodic orbit outside the band).
+const SAMPLES: u32 = 3;
+
+#[test]
+fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study() {
+    let (mut runs, mut certified) = (0usize, 0usize);
+    let (mut worst_residual, mut full_calls, mut early_calls) = (0.0f64, 0u64, 0u64);
+    for path in &shipped_studies() {
+        let full = shipped_plan_edited(path, SAMPLES, |f| f.metrics.certified_not_settled = false);
+        let early = shipped_plan_edited(path, SAMPLES, |f| f.metrics.certified_not_settled = true);
+        for id in 0..full.total_runs() {
+            let a = run_one(&full, id).metrics;
+            let b = run_one(&early, id).metrics;
+            let what = format!("{} run {id}", path.display());
+            assert_ne!(
+                a.outcome,
+                Outcome::NotSettled,
+                "{what}: with the option off"
+            );
+            runs += 1;
+            if b.outcome != Outcome::NotSettled {
+                assert_eq!(a, b, "{what}: not certified, so the full run bit for bit");
+                continue;
+            }
+            certified += 1;
+            assert_eq!(a.outcome, Outcome::Censored, "{what}: {}", b.reason);
+            let off = (b.residual_rel / a.residual_rel - 1.0).abs();
+            assert!(
+                off <= 0.01,
+                "{what}: residual {} against {} of the full run",
+                b.residual_rel,
+                a.residual_rel
+            );
+            worst_residual = worst_residual.max(off);
+            assert_eq!(a.settling_time_eps, b.settling_time_eps, "{what}");
+            assert_eq!(a.censoring_revs, b.censoring_revs, "{what}");
+            assert_eq!(a.t_final, b.t_final, "{what}");
+            assert_eq!(a.operating_time, b.operating_time, "{what}");
+            assert!((b.peak_r / a.peak_r - 1.0).abs() <= 0.01, "{what}: peak r");
+            if let (Some(x), Some(y)) = (a.min_gap_rad, b.min_gap_rad) {
+                assert!((x - y).abs() <= 1e-4, "{what}: closest approach");
+            }
+            // The certificate's own bound on every later state, angles in
+            // rad among them: its tail is at most RESIDUAL_SHARE of the RMS.
+            let bound = RESIDUAL_SHARE * b.residual_rel * 1.01;
+            for (x, y) in a.final_rel_angles_deg.iter().zip(&b.final_rel_angles_deg) {
+                let d = ((x - y + 180.0).rem_euclid(360.0) - 180.0).to_radians();
+                assert!(d.abs() <= bound, "{what}: final angle {y} against {x}");
+            }
+            // Radau5 may cross a stuck tail in a step or two: never dearer.
+            assert!(b.rhs_calls <= a.rhs_calls, "{what}: certified but dearer");
+            full_calls += a.rhs_calls;
+            early_calls += b.rhs_calls;
+        }
+    }
+    eprintln!(
+        "{certified} of {runs} runs certified not to settle, at {:.3} of the full runs' RHS calls; \
+         largest residual change {worst_residual:.2e}",
+        early_calls as f64 / full_calls.max(1) as f64
+    );
+    // Not vacuous: gravity_horizontal's locked pendulums are certified.
+    assert!(certified >= 1, "no run certified");
+}
