@@ -57,6 +57,10 @@ pub struct BenchArgs {
     /// constants and autobal's own answer.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["thread_scaling", "peer_cases", "fidelity"])]
     lean_inputs: Option<std::path::PathBuf>,
+    /// With --lean-inputs: export this study's runs instead of the main
+    /// job's (one plane rotor in the rotating frame; e.g. bench/lean/peer.toml).
+    #[arg(long, value_name = "STUDY", requires = "lean_inputs")]
+    lean_study: Option<std::path::PathBuf>,
     /// Samples per design with --thread-scaling (default 25; 1 with --quick)
     /// or --lean-inputs (default 20).
     #[arg(long)]
@@ -132,7 +136,7 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
         ));
     }
     if let Some(path) = &args.lean_inputs {
-        return write_lean_inputs(path, args.samples.unwrap_or(20));
+        return write_lean_inputs(path, args.lean_study.as_deref(), args.samples.unwrap_or(20));
     }
     if args.peer_cases {
         return run_peer_cases(args);
@@ -161,9 +165,18 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     Ok(())
 }
 
-/// Export the main job's runs for `bench/lean` (each run is solved once by autobal).
-fn write_lean_inputs(path: &std::path::Path, samples: u32) -> Result<(), UserError> {
-    let plan = bench::lean_inputs::lean_plan(samples);
+/// Export the main job's runs, or `study`'s, for `bench/lean` (each run is
+/// solved once by autobal).
+fn write_lean_inputs(
+    path: &std::path::Path,
+    study: Option<&std::path::Path>,
+    samples: u32,
+) -> Result<(), UserError> {
+    let plan = match study {
+        Some(file) => bench::lean_inputs::lean_plan_of(file, samples)
+            .map_err(|e| UserError(format!("{}: {e}", file.display()), 2))?,
+        None => bench::lean_inputs::lean_plan(samples),
+    };
     let rows = bench::lean_inputs::lean_rows(&plan).map_err(UserError::internal)?;
     let write = || -> std::io::Result<()> {
         let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);

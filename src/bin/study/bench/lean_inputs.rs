@@ -135,6 +135,18 @@ pub fn lean_plan(samples: u32) -> StudyPlan {
     })
 }
 
+/// The study in `path` at `samples` per design, held to the lean program's
+/// rule (every hold window to its end).
+pub fn lean_plan_of(path: &Path, samples: u32) -> Result<StudyPlan, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let shown = path.display().to_string();
+    let mut file =
+        autobal::study::config::StudyFile::parse(&text, &shown).map_err(|e| e.to_string())?;
+    file.sampling.samples = samples.max(1);
+    file.metrics.certified_hold = false;
+    file.plan(&text, &shown).map_err(|e| e.to_string())
+}
+
 /// Every run of `plan` as a row, in run order (each run is solved by autobal once).
 pub fn lean_rows(plan: &StudyPlan) -> Result<Vec<LeanRow>, String> {
     let samples = u64::from(plan.file.sampling.samples);
