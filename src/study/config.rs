@@ -251,6 +251,10 @@ pub struct Sampling {
     /// Manufacturing tolerances of the weights, sampled per run (off unless given).
     #[serde(default)]
     pub tolerances: Option<super::tolerance::Tolerances>,
+    /// The couple unbalance of a rotor on two supports (off unless given;
+    /// `sampling.unbalance` is then the static part).
+    #[serde(default)]
+    pub couple: Option<super::couple::CoupleSpec>,
 }
 
 fn default_batch() -> u32 {
@@ -665,6 +669,14 @@ impl StudyFile {
         }
         check_distribution(&s.unbalance.distribution)
             .map_err(|(k, v, r)| invalid(&format!("sampling.unbalance.{k}"), v, r))?;
+        if let Some(couple) = &s.couple {
+            super::couple::validate(couple, &self.scene.rotor, |u| {
+                check_distribution(&u.distribution).map_err(|(k, v, r)| {
+                    (format!("sampling.couple.unbalance.{k}"), v, r.to_string())
+                })
+            })
+            .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+        }
         if let DirectionSpec::Fixed(d) = s.direction
             && !d.is_finite()
         {
@@ -748,6 +760,44 @@ impl StudyFile {
                         d.spec.kind,
                         d.spec.n,
                         d.rho
+                    ),
+                ));
+            }
+        }
+        if let Some(couple) = &s.couple
+            && s.require_balanceable
+        {
+            // Either part in kg·m: the worst plane takes both at full size.
+            let static_upper = s.unbalance.distribution.upper();
+            let absolute = s.unbalance.scale() == Scale::Absolute
+                || couple
+                    .unbalance
+                    .as_ref()
+                    .is_some_and(|u| u.scale() == Scale::Absolute);
+            let in_kgm = |v: f64, scale: Scale, d: &Design| match scale {
+                Scale::Absolute => v,
+                Scale::Capacity => v * d.capacity,
+            };
+            let worst = |d: &Design| {
+                let u_s = in_kgm(static_upper, s.unbalance.scale(), d);
+                match (&couple.unbalance, couple.follows_static) {
+                    (Some(u), _) => u_s + in_kgm(u.distribution.upper(), u.scale(), d),
+                    (None, Some(c)) => u_s * (1.0 + c.abs()),
+                    (None, None) => u_s,
+                }
+            };
+            if absolute && let Some(d) = designs.iter().find(|d| d.capacity < worst(d)) {
+                let key = if couple.unbalance.is_some() {
+                    "sampling.couple.unbalance.max"
+                } else {
+                    "sampling.couple.follows_static"
+                };
+                return Err(invalid(
+                    key,
+                    format!("{:.4e} kg·m in the worse plane", worst(d)),
+                    &format!(
+                        "the largest static plus couple unbalance a plane can take exceeds the capacity {:.4e} kg·m of design {} ({} n = {} ρ = {:.4}); lower them or set require_balanceable = false",
+                        d.capacity, d.id, d.spec.kind, d.spec.n, d.rho
                     ),
                 ));
             }

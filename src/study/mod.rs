@@ -24,6 +24,7 @@ pub mod adaptive;
 pub mod aggregate;
 pub mod compare_designs;
 pub mod config;
+pub mod couple;
 pub mod criterion;
 pub mod design_runs;
 pub mod diagnosis;

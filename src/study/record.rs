@@ -1,6 +1,7 @@
 //! One row of `runs.parquet`: the design, the sample, every metric, the
 //! outcome and the solver's cost; and its conversion to and from polars.
 
+use super::couple::{SampledCouple, plane_unbalances};
 use super::tolerance::SampledWeights;
 use crate::metrics::{Outcome, RunMetrics};
 use polars::prelude::*;
@@ -51,9 +52,12 @@ pub struct RunRecord {
     /// The weights as built, when the study samples tolerances (columns
     /// `weight_masses`, `weight_radii`, `track_radii`; absent otherwise).
     pub weights: Option<SampledWeights>,
+    /// The couple part of the unbalance, when the study samples one
+    /// (`[sampling.couple]`; columns [`COUPLE_COLUMNS`], absent otherwise).
+    pub couple: Option<SampledCouple>,
 }
 
-/// As derived, but `weights` is shown only when the study sampled them: the
+/// As derived, but `weights` and `couple` are shown only when the study sampled them: the
 /// golden files print records with `{:?}`, and a study without tolerances
 /// must print exactly what it printed before they existed.
 impl std::fmt::Debug for RunRecord {
@@ -81,6 +85,9 @@ impl std::fmt::Debug for RunRecord {
         if let Some(w) = &self.weights {
             s.field("weights", w);
         }
+        if let Some(c) = &self.couple {
+            s.field("couple", c);
+        }
         s.finish()
     }
 }
@@ -88,6 +95,18 @@ impl std::fmt::Debug for RunRecord {
 /// Columns of the sampled weights, in order; written only by studies with
 /// `[sampling.tolerances]`, so that other studies' files keep their schema.
 pub const WEIGHT_COLUMNS: [&str; 3] = ["weight_masses", "weight_radii", "track_radii"];
+
+/// Columns of the couple part U_c (kg·m per plane), U_c/capacity and θ_c
+/// (degrees), and of the unbalance each balancer plane takes (magnitude
+/// kg·m and direction degrees per plane, in plane order); written only by
+/// studies with `[sampling.couple]`.
+pub const COUPLE_COLUMNS: [&str; 5] = [
+    "couple_unbalance",
+    "couple_fraction",
+    "couple_direction_deg",
+    "plane_unbalances",
+    "plane_directions_deg",
+];
 
 /// Columns of the race centre's offset (m) and direction (degrees), written
 /// with the weight columns; null when neither sampled nor set by the scene.
@@ -188,6 +207,33 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         let [offset, angle] = RACE_COLUMNS;
         columns.push(Column::new(offset.into(), race(|r| r.0)));
         columns.push(Column::new(angle.into(), race(|r| r.1)));
+    }
+    // All rows of a study sample a couple or none do.
+    if rows.iter().any(|r| r.couple.is_some()) {
+        let [u, fraction, direction, planes, plane_dirs] = COUPLE_COLUMNS;
+        let pick = |f: fn(&SampledCouple) -> f64| {
+            rows.iter()
+                .map(|r| r.couple.as_ref().map(f))
+                .collect::<Vec<_>>()
+        };
+        columns.push(Column::new(u.into(), pick(|c| c.unbalance)));
+        columns.push(Column::new(fraction.into(), pick(|c| c.fraction)));
+        columns.push(Column::new(direction.into(), pick(|c| c.direction_deg)));
+        let per_plane = |r: &RunRecord| {
+            r.couple.as_ref().map_or_else(Vec::new, |c| {
+                plane_unbalances((r.unbalance, r.direction_deg.to_radians()), c).to_vec()
+            })
+        };
+        columns.push(list_column(
+            planes,
+            rows.iter()
+                .map(|r| per_plane(r).iter().map(|p| p.0).collect()),
+        ));
+        columns.push(list_column(
+            plane_dirs,
+            rows.iter()
+                .map(|r| per_plane(r).iter().map(|p| p.1.to_degrees()).collect()),
+        ));
     }
     DataFrame::new(rows.len(), columns)
 }
@@ -341,6 +387,24 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
         optional("final_spin_rate")?,
     );
     let angle_error = optional("balance_angle_error_deg")?;
+    let couple: Option<Vec<SampledCouple>> = if df.column(COUPLE_COLUMNS[0]).is_ok() {
+        let (u, fraction, direction) = (
+            f64s(COUPLE_COLUMNS[0])?,
+            f64s(COUPLE_COLUMNS[1])?,
+            f64s(COUPLE_COLUMNS[2])?,
+        );
+        Some(
+            (0..df.height())
+                .map(|i| SampledCouple {
+                    unbalance: u[i].unwrap_or(f64::NAN),
+                    fraction: fraction[i].unwrap_or(f64::NAN),
+                    direction_deg: direction[i].unwrap_or(f64::NAN),
+                })
+                .collect(),
+        )
+    } else {
+        None
+    };
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -392,6 +456,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
             stall_torque: stall[i],
             wall_time_s: wall[i],
             weights: weights.as_ref().map(|w| w[i].clone()),
+            couple: couple.as_ref().map(|c| c[i]),
         });
     }
     Ok(out)

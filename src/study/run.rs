@@ -271,6 +271,10 @@ pub fn sample_simulation(
     if planes > 1 {
         sample.initial_angles = sample.initial_angles.repeat(planes);
     }
+    if let Some(couple) = &sample.couple {
+        let planes = super::couple::plane_unbalances((sample.unbalance, sample.direction), couple);
+        super::couple::apply(&mut scene.rotor, &planes);
+    }
     sample.weights = super::tolerance::apply(plan, design, sample_id, &mut scene);
     let simulation = Simulation {
         scene,
@@ -340,6 +344,7 @@ pub fn run_design_sample(
         stall_torque: design.stall_torque,
         wall_time_s: clock.elapsed().as_secs_f64(),
         weights: sample.weights,
+        couple: sample.couple,
     }
 }
 

@@ -42,6 +42,8 @@ pub enum Purpose {
     RadiusTolerance = 6,
     /// The race centre's offset from the axis ([`super::tolerance`]).
     EccentricityTolerance = 7,
+    /// The couple unbalance of a two-plane rotor ([`super::couple`]).
+    Couple = 8,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for
@@ -69,6 +71,13 @@ pub struct Sample {
     /// The weights as built, when the study samples tolerances (filled by
     /// [`super::run::sample_simulation`], which builds the scene).
     pub weights: Option<SampledWeights>,
+    /// The couple part, when the study samples one (`[sampling.couple]`).
+    pub couple: Option<super::couple::SampledCouple>,
+}
+
+/// One value of distribution `d` from `rng`.
+pub fn draw_value(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
+    draw(d, rng)
 }
 
 fn draw(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
@@ -144,6 +153,9 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         direction,
         initial_angles,
         weights: None,
+        couple: s.couple.as_ref().map(|spec| {
+            super::couple::draw(spec, seed, shared, design, sample, (unbalance, direction))
+        }),
     }
 }
 

@@ -168,6 +168,17 @@ pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
         "initial = \"clustered\"\ntolerances = { masss = { sigma = 0.01 } }",
         "masss",
     ),
+    // A couple unbalance needs two balancer planes on two supports.
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ncouple = { follows_static = 0.5 }",
+        "sampling.couple",
+    ),
+    (
+        "initial = \"clustered\"",
+        "initial = \"clustered\"\ncouple = { follows_static = 0.5, phasee = \"uniform\" }",
+        "phasee",
+    ),
     (
         "initial = \"clustered\"",
         "initial = \"clustered\"\ntolerances = { mass = { sigma = 0.01, sd = 0.1 } }",

@@ -13,6 +13,7 @@ mod cli_simulate;
 mod compare;
 mod contact;
 mod convergence;
+mod couple_unbalance;
 mod decisions;
 mod design_capacity;
 mod design_criterion;

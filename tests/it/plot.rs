@@ -289,6 +289,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                 stall_torque: None,
                 wall_time_s: 0.001,
                 weights: None,
+                couple: None,
             });
         }
     }

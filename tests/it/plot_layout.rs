@@ -275,6 +275,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                     stall_torque: None,
                     wall_time_s: 0.001,
                     weights: None,
+                    couple: None,
                 });
             }
             let p = settled_count as f64 / f64::from(samples);

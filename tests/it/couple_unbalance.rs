@@ -1,0 +1,232 @@
+//! `[sampling.couple]` (src/study/couple.rs): a rotor on two supports draws
+//! a couple unbalance beside the static one, each balancer plane takes
+//! U_s e^{iθ_s} ± U_c e^{iθ_c}, the static draws stay those of the study
+//! without the table, every design meets the same draws, and a bad table is
+//! refused naming its key.
+
+use autobal::model::rotor::RotorModel;
+use autobal::study::config::StudyFile;
+use autobal::study::record::{COUPLE_COLUMNS, from_dataframe};
+use autobal::study::run::{run_one, sample_simulation};
+use num_complex::Complex64;
+
+fn study(sampling_extra: &str, rotor_model: &str) -> String {
+    let rotor = if rotor_model == "two_support" {
+        r#"model = "two_support"
+mass = 1.0
+transverse_inertia = 1.0
+polar_inertia = 0.2
+k1 = 1.0
+l1 = 2.0
+k2 = 1.0
+l2 = 2.0
+b1 = 0.05
+b2 = 0.05
+planes = [-1.0, 1.0]"#
+    } else {
+        "mass = 1.0\nkx = 1.0\nky = 1.0\nbx = 0.1\nby = 0.1"
+    };
+    format!(
+        r#"name = "couple"
+[scene.rotor]
+{rotor}
+[scene.speed]
+mode = "constant"
+omega = 6.3
+[designs]
+kind = "ball"
+n = 2
+rho = 0.1
+race_radius = 1.0
+density = 10.0
+drag = [0.01, 0.02]
+[sampling]
+samples = 6
+unbalance = {{ distribution = "uniform", min = 0.2, max = 0.6, relative_to = "capacity" }}
+{sampling_extra}
+[metrics]
+t_end_revs = 20
+hold_revs = 10
+"#
+    )
+}
+
+fn plan(text: &str) -> autobal::study::config::StudyPlan {
+    StudyFile::parse(text, "couple.toml")
+        .unwrap()
+        .plan(text, "couple.toml")
+        .unwrap()
+}
+
+/// The point unbalances the run's rotor carries, as complex numbers in plane order.
+fn rotor_planes(scene: &autobal::model::scene::Scene) -> Vec<Complex64> {
+    match &scene.rotor {
+        RotorModel::TwoSupport(r) => r
+            .unbalances
+            .iter()
+            .map(|u| Complex64::from_polar(u.s, u.angle))
+            .collect(),
+        other => panic!("not a two-support rotor: {other:?}"),
+    }
+}
+
+const DRAWN: &str = r#"[sampling.couple]
+unbalance = { distribution = "uniform", min = 0.1, max = 0.5, relative_to = "capacity" }
+phase = "uniform""#;
+
+#[test]
+fn each_plane_takes_the_static_part_plus_or_minus_the_couple() {
+    let with = plan(&study(DRAWN, "two_support"));
+    let without = plan(&study("", "two_support"));
+    let mut couples = Vec::new();
+    for design in &with.designs {
+        for sample in 0..6 {
+            let (s, sim) = sample_simulation(&with, design, sample);
+            let (s0, sim0) = sample_simulation(&without, design, sample);
+            // The static part is the study's without the table, to the bit.
+            assert_eq!((s.unbalance, s.direction), (s0.unbalance, s0.direction));
+            let c = s.couple.expect("a couple drawn");
+            assert!((0.1..=0.5).contains(&c.fraction), "{c:?}");
+            assert_eq!(c.unbalance, c.fraction * design.capacity);
+            let st = Complex64::from_polar(s.unbalance, s.direction);
+            let cp = Complex64::from_polar(c.unbalance, c.direction_deg.to_radians());
+            let planes = rotor_planes(&sim.scene);
+            assert_eq!(planes.len(), 2);
+            assert!((planes[0] - (st + cp)).norm() <= 1e-15 * st.norm());
+            assert!((planes[1] - (st - cp)).norm() <= 1e-15 * st.norm());
+            // Without the table every plane takes U_s, as before.
+            for p in rotor_planes(&sim0.scene) {
+                assert!((p - st).norm() <= 1e-15 * st.norm());
+            }
+            couples.push((design.id, sample, c));
+        }
+    }
+    // Common random numbers: both designs (same capacity) meet the same couples.
+    for (id, sample, c) in &couples {
+        let twin = couples
+            .iter()
+            .find(|(i, s, _)| i != id && s == sample)
+            .expect("the other design");
+        assert_eq!(c, &twin.2);
+    }
+    // Not one couple for all: the draws vary.
+    assert!(
+        couples
+            .windows(2)
+            .any(|w| w[0].2.fraction != w[1].2.fraction)
+    );
+}
+
+#[test]
+fn a_couple_that_follows_the_static_part_is_one_load_at_one_axial_position() {
+    // c = 0.5: a load at z = −0.5 between planes at −1 and 1 splits 3:1.
+    let tied = plan(&study(
+        "[sampling.couple]\nfollows_static = 0.5",
+        "two_support",
+    ));
+    let design = &tied.designs[0];
+    let (s, sim) = sample_simulation(&tied, design, 3);
+    let planes = rotor_planes(&sim.scene);
+    let u = Complex64::from_polar(s.unbalance, s.direction);
+    assert!((planes[0] - 1.5 * u).norm() <= 1e-15 * u.norm());
+    assert!((planes[1] - 0.5 * u).norm() <= 1e-15 * u.norm());
+    // Physics: that is the one point unbalance 2U at z = −0.5 (static 2U,
+    // moment −U), as the rotor itself sums point unbalances.
+    if let RotorModel::TwoSupport(r) = &sim.scene.rotor {
+        let (st, moment) = r.unbalance();
+        assert!((st - 2.0 * u).norm() <= 1e-14 * u.norm());
+        assert!((moment - (-0.5) * 2.0 * u).norm() <= 1e-14 * u.norm());
+    }
+}
+
+#[test]
+fn runs_parquet_carries_the_couple_and_each_planes_unbalance() {
+    let p = plan(&study(DRAWN, "two_support"));
+    let rows: Vec<_> = (0..p.total_runs()).map(|id| run_one(&p, id)).collect();
+    let df = autobal::study::record::to_dataframe(&rows).unwrap();
+    for name in COUPLE_COLUMNS {
+        assert!(df.column(name).is_ok(), "{name}");
+    }
+    let back = from_dataframe(&df).unwrap();
+    assert_eq!(back.len(), rows.len());
+    for (a, b) in rows.iter().zip(&back) {
+        assert_eq!(a.couple, b.couple, "run {}", a.run_id);
+    }
+    // A study without the table keeps its schema.
+    let plain = plan(&study("", "two_support"));
+    let df = autobal::study::record::to_dataframe(&[run_one(&plain, 0)]).unwrap();
+    assert!(df.column(COUPLE_COLUMNS[0]).is_err());
+}
+
+#[test]
+fn a_bad_couple_table_is_refused_naming_its_key() {
+    let cases = [
+        (study(DRAWN, "plane"), "sampling.couple"),
+        (
+            study(
+                "[sampling.couple]\nfollows_static = 0.5\nunbalance = { distribution = \"fixed\", value = 0.1, relative_to = \"capacity\" }",
+                "two_support",
+            ),
+            "sampling.couple.follows_static",
+        ),
+        (
+            study("[sampling.couple]\n", "two_support"),
+            "sampling.couple",
+        ),
+        (
+            study(
+                "[sampling.couple]\nunbalance = { distribution = \"fixed\", value = 0.1 }",
+                "two_support",
+            ),
+            "sampling.couple.unbalance.relative_to",
+        ),
+        (
+            study(
+                "[sampling.couple]\nunbalance = { distribution = \"uniform\", min = -1.0, max = 0.1, relative_to = \"capacity\" }",
+                "two_support",
+            ),
+            "sampling.couple.unbalance.min",
+        ),
+        (
+            study(
+                "[sampling.couple]\nfollows_static = 0.5\nphase = { fixed = 10.0 }",
+                "two_support",
+            ),
+            "sampling.couple.phase",
+        ),
+    ];
+    for (text, key) in cases {
+        let err = StudyFile::parse(&text, "couple.toml")
+            .and_then(|f| f.plan(&text, "couple.toml"))
+            .expect_err(key)
+            .to_string();
+        assert!(err.contains(key), "{key}: {err}");
+    }
+}
+
+#[test]
+fn static_plus_couple_beyond_capacity_in_kilogram_metres_is_refused() {
+    let capacity = plan(&study("", "two_support")).designs[0].capacity;
+    let text = study(
+        &format!(
+            "[sampling.couple]\nunbalance = {{ distribution = \"fixed\", value = {}, relative_to = \"absolute\" }}",
+            0.6 * capacity
+        ),
+        "two_support",
+    );
+    // The static part may reach 0.6 of capacity: 1.2 in the worse plane.
+    let err = StudyFile::parse(&text, "couple.toml")
+        .and_then(|f| f.plan(&text, "couple.toml"))
+        .expect_err("beyond capacity")
+        .to_string();
+    assert!(err.contains("sampling.couple.unbalance.max"), "{err}");
+    let allowed = text.replace(
+        "[sampling.couple]",
+        "require_balanceable = false\n[sampling.couple]",
+    );
+    assert!(
+        StudyFile::parse(&allowed, "couple.toml")
+            .and_then(|f| f.plan(&allowed, "couple.toml"))
+            .is_ok()
+    );
+}
