@@ -11,7 +11,8 @@ use crate::model::system::RotorSystem;
 use crate::model::unbalance::planar_norm;
 pub use crate::model::unbalance::{balancing_error, reference_unbalance};
 
-/// A_ref at speed ω: the largest balancer-plane orbit radius of the locked
+/// A_ref at speed ω: the largest orbit radius over the watched planes
+/// (balancer planes, and the rotor's own unbalance planes) of the locked
 /// response to the rotor's own unbalance (to U in plane 0 when it has none),
 /// with the cargoes' masses but not their unbalance. For the plane rotor this
 /// is U ω² / |k_x − M_Σ ω² + i b_x ω| (its x amplitude, the orbit radius for
@@ -31,8 +32,10 @@ pub fn a_ref(system: &RotorSystem, omega: f64) -> f64 {
         }
     }
     match harmonic_response(system, &fc, &fs, omega) {
-        Some(h) => (0..rotor.planes())
-            .map(|p| plane_orbit_radius(&h, &rotor.plane_map(p)))
+        Some(h) => system
+            .watch_maps()
+            .iter()
+            .map(|map| plane_orbit_radius(&h, map))
             .fold(0.0, f64::max),
         None => f64::INFINITY,
     }
@@ -54,16 +57,18 @@ fn plane_a_ref(system: &RotorSystem, omega: f64) -> f64 {
 }
 
 /// Vibration r: the largest displacement |(u_p, v_p)| over the balancer
-/// planes (for the plane rotor, sqrt(x² + y²)).
+/// planes and any other plane the rotor watches, where its own unbalance
+/// sits (for the plane rotor, sqrt(x² + y²)).
 pub fn vibration(system: &RotorSystem, q: &[f64]) -> f64 {
     let rotor = system.rotor();
     if is_plane_translation(system) {
         return planar_norm(q[0], q[1]);
     }
     let k = rotor.dof();
-    (0..rotor.planes())
-        .map(|p| {
-            let [gu, gv] = rotor.plane_map(p);
+    system
+        .watch_maps()
+        .iter()
+        .map(|&[gu, gv]| {
             let u: f64 = (0..k).map(|i| gu[i] * q[i]).sum();
             let v: f64 = (0..k).map(|i| gv[i] * q[i]).sum();
             planar_norm(u, v)

@@ -64,6 +64,8 @@ pub struct RotorSystem {
     /// κ m l² per cargo (cached: used twice per cargo per call).
     inertia: Vec<f64>,
     plane_maps: Vec<[DofVec; 2]>,
+    /// Where vibration counts ([`Rotor::watch_maps`]), once per system.
+    watch_maps: Vec<[DofVec; 2]>,
     /// Tilt maps of the planes whose weights' tilt inertia is modelled.
     tilt_maps: Vec<Option<[DofVec; 2]>>,
     speed: SpeedLaw,
@@ -108,6 +110,7 @@ impl RotorSystem {
             spin_free: !speed.is_prescribed(),
             cargoes: cargo.len(),
         };
+        let rotor_watch = rotor.watch_maps();
         RotorSystem {
             inertia: cargo.iter().map(Cargo::inertia).collect(),
             trig: std::cell::RefCell::new(vec![(0.0, 0.0); cargo.len()]),
@@ -115,6 +118,7 @@ impl RotorSystem {
             rotor,
             cargo,
             plane_maps,
+            watch_maps: rotor_watch,
             tilt_maps,
             speed,
             effects,
@@ -149,6 +153,11 @@ impl RotorSystem {
     /// Mass matrix of the rotor coordinates with the cargoes' masses (constant).
     pub fn head_mass(&self) -> &[DofVec; MAX_DOF] {
         &self.head_mass
+    }
+
+    /// Maps (G_u, G_v) of the places whose vibration counts in r and A_ref.
+    pub fn watch_maps(&self) -> &[[DofVec; 2]] {
+        &self.watch_maps
     }
 
     /// Map (G_u, G_v) of the plane cargo j runs in.

@@ -40,6 +40,12 @@ pub struct CoupleSpec {
     /// at one axial position; see the module documentation).
     #[serde(default)]
     pub follows_static: Option<f64>,
+    /// Axial positions z₁, z₂ (m) of the two planes the static ± couple
+    /// parts sit in; default the rotor's two balancer planes. Given, the
+    /// rotor may carry one balancer plane: a single balancer against a
+    /// load's static and couple unbalance.
+    #[serde(default)]
+    pub at: Option<[f64; 2]>,
 }
 
 /// A couple part as drawn for one run.
@@ -61,15 +67,35 @@ pub fn validate(
     check_distribution: impl Fn(&UnbalanceSpec) -> Result<(), (String, String, String)>,
 ) -> Result<(), (String, String, String)> {
     let planes = match rotor {
-        RotorModel::TwoSupport(r) => r.planes.len(),
-        _ => 0,
+        RotorModel::TwoSupport(r) => Some(r.planes.len()),
+        _ => None,
     };
-    if planes != 2 {
-        return Err((
-            "sampling.couple".into(),
-            format!("rotor.model = \"{}\"", rotor.as_rotor().name()),
-            "a couple unbalance needs a rotor on two supports with two balancer planes (rotor.model = \"two_support\", rotor.planes = [z1, z2])".into(),
-        ));
+    match (planes, spec.at) {
+        (None, _) => {
+            return Err((
+                "sampling.couple".into(),
+                format!("rotor.model = \"{}\"", rotor.as_rotor().name()),
+                "a couple unbalance needs a rotor on two supports (rotor.model = \"two_support\")"
+                    .into(),
+            ));
+        }
+        (Some(n), None) if n != 2 => {
+            return Err((
+                "sampling.couple.at".into(),
+                "(missing)".into(),
+                format!(
+                    "the rotor has {n} balancer plane(s): give the axial positions [z1, z2] (m) of the two planes the static and couple parts sit in"
+                ),
+            ));
+        }
+        (_, Some([a, b])) if !(a.is_finite() && b.is_finite() && a != b) => {
+            return Err((
+                "sampling.couple.at".into(),
+                format!("[{a}, {b}]"),
+                "two distinct finite axial positions (m)".into(),
+            ));
+        }
+        _ => {}
     }
     match (&spec.unbalance, spec.follows_static) {
         (Some(_), Some(c)) => Err((
@@ -164,14 +190,14 @@ pub fn plane_unbalances(static_part: (f64, f64), couple: &SampledCouple) -> [(f6
     [s + c, s - c].map(|u| (u.norm(), u.arg()))
 }
 
-/// Put the per-plane unbalances on the rotor (its two balancer planes, in
-/// order), replacing the static part it was given.
-pub fn apply(rotor: &mut RotorModel, planes: &[(f64, f64); 2]) {
+/// Put the per-plane unbalances on the rotor at `at` (default its two
+/// balancer planes, in order), replacing the static part it was given.
+pub fn apply(rotor: &mut RotorModel, at: Option<[f64; 2]>, planes: &[(f64, f64); 2]) {
     if let RotorModel::TwoSupport(r) = rotor {
+        let z = at.unwrap_or_else(|| [r.planes[0], r.planes[1]]);
         r.static_unbalance = 0.0;
         r.moment_unbalance = 0.0;
-        r.unbalances = r
-            .planes
+        r.unbalances = z
             .iter()
             .zip(planes)
             .map(|(&z, &(s, angle))| PointUnbalance { s, z, angle })

@@ -273,7 +273,8 @@ pub fn sample_simulation(
     }
     if let Some(couple) = &sample.couple {
         let planes = super::couple::plane_unbalances((sample.unbalance, sample.direction), couple);
-        super::couple::apply(&mut scene.rotor, &planes);
+        let at = plan.file.sampling.couple.as_ref().and_then(|c| c.at);
+        super::couple::apply(&mut scene.rotor, at, &planes);
     }
     sample.weights = super::tolerance::apply(plan, design, sample_id, &mut scene);
     let simulation = Simulation {

@@ -230,3 +230,95 @@ fn static_plus_couple_beyond_capacity_in_kilogram_metres_is_refused() {
             .is_ok()
     );
 }
+
+/// A drum-like rotor above both rigid-body critical speeds with the load
+/// drawn as static plus couple, balanced by 3 balls in each end plane, or
+/// by one balancer at z = 1 alone (`at` keeps the load's planes at ±1).
+fn drum(single: bool) -> String {
+    let planes = if single { "[1.0]" } else { "[-1.0, 1.0]" };
+    let at = if single { "at = [1.0, -1.0]" } else { "" };
+    format!(
+        r#"name = "drum"
+[scene.rotor]
+model = "two_support"
+mass = 1.0
+transverse_inertia = 1.0
+polar_inertia = 0.2
+k1 = 1.0
+l1 = 2.0
+k2 = 1.0
+l2 = 2.0
+b1 = 0.05
+b2 = 0.05
+planes = {planes}
+[scene.speed]
+mode = "constant"
+omega = 6.3
+[designs]
+kind = "ball"
+n = 3
+rho = 0.1
+race_radius = 1.0
+density = 10.0
+drag = 0.05
+[sampling]
+samples = 12
+unbalance = {{ distribution = "uniform", min = 0.1, max = 0.4, relative_to = "capacity" }}
+[sampling.couple]
+unbalance = {{ distribution = "uniform", min = 0.1, max = 0.4, relative_to = "capacity" }}
+{at}
+[metrics]
+t_end_revs = 400
+hold_revs = 20
+"#
+    )
+}
+
+#[test]
+fn a_single_balancer_fails_where_two_succeed_on_the_same_samples() {
+    let (two, one) = (plan(&drum(false)), plan(&drum(true)));
+    let (mut settled_two, mut settled_one) = (0, 0);
+    let mut residual_one = Vec::new();
+    for id in 0..two.total_runs() {
+        let a = run_one(&two, id);
+        let b = run_one(&one, id);
+        // The same load: static and couple parts equal run by run.
+        assert_eq!(
+            (a.unbalance, a.direction_deg),
+            (b.unbalance, b.direction_deg)
+        );
+        assert_eq!(a.couple, b.couple);
+        settled_two += usize::from(a.metrics.settled);
+        settled_one += usize::from(b.metrics.settled);
+        residual_one.push(b.metrics.residual_rel);
+    }
+    // Seed 003: one plane cannot cancel a couple; the far end whirls on
+    // (r counts the load's planes too).
+    assert_eq!(settled_one, 0, "a single balancer settled");
+    residual_one.sort_by(f64::total_cmp);
+    assert!(residual_one[6] > 0.1, "{residual_one:?}");
+    assert!(
+        settled_two >= 10,
+        "two balancers settled only {settled_two} of 12"
+    );
+}
+
+#[test]
+fn a_single_plane_rotor_needs_the_loads_planes() {
+    for (text, key) in [
+        (
+            drum(true).replace("at = [1.0, -1.0]", ""),
+            "sampling.couple.at",
+        ),
+        (
+            drum(true).replace("at = [1.0, -1.0]", "at = [1.0, 1.0]"),
+            "sampling.couple.at",
+        ),
+    ] {
+        let err = StudyFile::parse(&text, "drum.toml")
+            .and_then(|f| f.plan(&text, "drum.toml"))
+            .expect_err(key)
+            .to_string();
+        assert!(err.contains(key), "{key}: {err}");
+    }
+}

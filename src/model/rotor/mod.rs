@@ -49,6 +49,14 @@ pub trait Rotor: Any + Send + Sync + std::fmt::Debug {
     /// Rows G_u, G_v of the map from rotor coordinates to the displacement
     /// (u, v) of balancer plane `plane`'s centre.
     fn plane_map(&self, plane: usize) -> [DofVec; 2];
+    /// Maps (G_u, G_v) of every place whose vibration counts in r and
+    /// A_ref (docs/metrics.md): the balancer planes and, by default, no
+    /// other. A rotor whose own unbalance may sit elsewhere adds those
+    /// planes, so that a balancer that calms its own plane while the load's
+    /// plane still whirls is not called settled.
+    fn watch_maps(&self) -> Vec<[DofVec; 2]> {
+        (0..self.planes()).map(|p| self.plane_map(p)).collect()
+    }
     /// Rows T_α, T_β of the map from rotor coordinates to the tilt (α, β) of
     /// balancer plane `plane` (axis direction (β, −α, 1)), when the weights'
     /// tilt inertia (the m R² terms, `src/model/tilt_inertia.rs`) is

@@ -153,6 +153,21 @@ impl Rotor for TwoSupportRotor {
         [[1.0, 0.0, 0.0, z], [0.0, 1.0, -z, 0.0]]
     }
 
+    /// The balancer planes, then every point unbalance's plane that is not
+    /// one of them (a load between or beyond the balancers).
+    fn watch_maps(&self) -> Vec<[DofVec; 2]> {
+        let mut places = self.planes.clone();
+        for u in &self.unbalances {
+            if !places.contains(&u.z) {
+                places.push(u.z);
+            }
+        }
+        places
+            .into_iter()
+            .map(|z| [[1.0, 0.0, 0.0, z], [0.0, 1.0, -z, 0.0]])
+            .collect()
+    }
+
     fn tilt_map(&self, _plane: usize) -> Option<[DofVec; 2]> {
         self.weights_tilt_inertia
             .then_some([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
