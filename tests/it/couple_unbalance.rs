@@ -322,3 +322,62 @@ fn a_single_plane_rotor_needs_the_loads_planes() {
         assert!(err.contains(key), "{key}: {err}");
     }
 }
+
+/// The locked forced response to static plus couple unbalance, against the
+/// closed form: with symmetric supports (k1 = k2 = k, l1 = l2 = l)
+/// translation and tilt decouple, and a synchronous forward whirl answers
+/// the static part S = U1 + U2 with X = S ω²/(2k − M ω² + 2ibω) and the
+/// moment I = z1 U1 + z2 U2 with W = I ω²/(2k l² − (A − C) ω² + 2ibl²ω)
+/// (the polar inertia C lightens the tilt); plane z moves by X + z W.
+#[test]
+fn the_locked_response_to_static_plus_couple_is_the_closed_form() {
+    use autobal::model::scene::Scene;
+    use autobal::study::couple::{SampledCouple, apply, plane_unbalances};
+    let base = crate::fixtures::long_rotor(vec![-1.0, 1.0]);
+    let (m, a, c, k, l, b) = (
+        base.mass,
+        base.transverse_inertia,
+        base.polar_inertia,
+        base.k1,
+        base.l1,
+        base.b1,
+    );
+    let couple = SampledCouple {
+        unbalance: 0.004,
+        fraction: 0.0,
+        direction_deg: 70.0,
+    };
+    let planes = plane_unbalances((0.01, 0.3), &couple);
+    let mut rotor = RotorModel::TwoSupport(base);
+    apply(&mut rotor, None, &planes);
+    let u: Vec<Complex64> = planes
+        .iter()
+        .map(|&(s, angle)| Complex64::from_polar(s, angle))
+        .collect();
+    let (s, i) = (u[0] + u[1], -u[0] + u[1]);
+    // Below ω1 = √2, between the criticals, above ω2 = √10.
+    for omega in [0.7, 2.0, 6.3] {
+        let scene = Scene {
+            rotor: rotor.clone(),
+            balancer: None,
+            balancers: Vec::new(),
+            // A scene needs weights: one of 1e-15 kg (its mass enters A_ref at 1e-15).
+            cargo: vec![autobal::model::cargo::Cargo::point(1e-15, 1.0, 0.0, 1.4)],
+            speed: autobal::model::speed::SpeedLaw::Constant { omega },
+            effects: Default::default(),
+        };
+        let system = scene.build().unwrap();
+        let w2 = omega * omega;
+        let x = s * w2 / Complex64::new(2.0 * k - m * w2, 2.0 * b * omega);
+        let w = i * w2 / Complex64::new(2.0 * k * l * l - (a - c) * w2, 2.0 * b * l * l * omega);
+        let closed = [-1.0, 1.0]
+            .iter()
+            .map(|z| (x + *z * w).norm())
+            .fold(0.0, f64::max);
+        let model = autobal::metrics::reference::a_ref(&system, omega);
+        assert!(
+            (model / closed - 1.0).abs() < 1e-10,
+            "ω = {omega}: A_ref {model} against the closed form {closed}"
+        );
+    }
+}
