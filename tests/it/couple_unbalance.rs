@@ -381,3 +381,37 @@ fn the_locked_response_to_static_plus_couple_is_the_closed_form() {
         );
     }
 }
+
+/// Seed 003's criterion over a speed sweep, with couple unbalance drawn:
+/// two balancers balance the load only above ω₂ (below ω₁ and between the
+/// criticals they cannot), one balancer never does. The speeds come from
+/// the criterion (`design::criterion`), the shares from the simulations.
+#[test]
+fn a_speed_sweep_with_couple_unbalance_follows_seed_003s_criterion() {
+    use autobal::design::criterion::resonances;
+    let r = resonances(&crate::fixtures::long_rotor(vec![-1.0, 1.0]).criterion_params()).unwrap();
+    let (w1, w2) = (r.omega1, r.omega2.expect("a second critical speed"));
+    let settled = |single: bool, omega: f64| {
+        let text = drum(single).replace("omega = 6.3", &format!("omega = {omega}"));
+        let p = plan(&text);
+        (0..p.total_runs())
+            .filter(|&id| run_one(&p, id).metrics.settled)
+            .count()
+    };
+    for (omega, two_at_least, two_at_most) in [
+        (0.6 * w1, 0, 1),
+        (0.5 * (w1 + w2), 0, 1),
+        (2.0 * w2, 10, 12),
+    ] {
+        let two = settled(false, omega);
+        assert!(
+            (two_at_least..=two_at_most).contains(&two),
+            "ω = {omega:.3} (ω1 {w1:.3}, ω2 {w2:.3}): two balancers settled {two} of 12"
+        );
+        assert_eq!(
+            settled(true, omega),
+            0,
+            "ω = {omega:.3}: one balancer settled"
+        );
+    }
+}
