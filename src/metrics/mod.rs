@@ -125,7 +125,7 @@ impl Outcome {
 }
 
 /// Every metric of one run (the fields of `study simulate --json`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Clone, PartialEq, Serialize)]
 pub struct RunMetrics {
     /// True when the settling rule on r was met.
     pub settled: bool,
@@ -192,6 +192,57 @@ pub struct RunMetrics {
     /// ones (`None` without it, at variable speed, or with no balanced state
     /// near).
     pub balance_angle_error_deg: Option<f64>,
+    /// A_ref of each watched plane (m; rotors with several planes: the
+    /// balancer planes, then the load's planes; docs/metrics.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane_a_ref: Option<Vec<f64>>,
+    /// The residual of each watched plane: the RMS of its whirl over the
+    /// last hold window (m), in the order of `plane_a_ref`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane_residual_abs: Option<Vec<f64>>,
+}
+
+/// As derived, but the per-plane fields are shown only for rotors with
+/// several planes: the golden files print metrics with `{:?}`, and a plane
+/// rotor's run must print exactly what it printed before they existed.
+impl std::fmt::Debug for RunMetrics {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("RunMetrics");
+        s.field("settled", &self.settled);
+        s.field("settling_time", &self.settling_time);
+        s.field("settling_revs", &self.settling_revs);
+        s.field("settling_time_err", &self.settling_time_err);
+        s.field("settling_time_eps", &self.settling_time_eps);
+        s.field("hold_complete", &self.hold_complete);
+        s.field("hold_certified", &self.hold_certified);
+        s.field("residual_abs", &self.residual_abs);
+        s.field("residual_rel", &self.residual_rel);
+        s.field("a_ref", &self.a_ref);
+        s.field("balancing_error", &self.balancing_error);
+        s.field("peak_r", &self.peak_r);
+        s.field("final_rel_angles_deg", &self.final_rel_angles_deg);
+        s.field("p_final", &self.p_final);
+        s.field("outcome", &self.outcome);
+        s.field("reason", &self.reason);
+        s.field("t_final", &self.t_final);
+        s.field("steps", &self.steps);
+        s.field("rhs_calls", &self.rhs_calls);
+        s.field("method", &self.method);
+        s.field("fidelity", &self.fidelity);
+        s.field("min_gap_rad", &self.min_gap_rad);
+        s.field("final_min_gap_rad", &self.final_min_gap_rad);
+        s.field("censoring_revs", &self.censoring_revs);
+        s.field("operating_time", &self.operating_time);
+        s.field("final_spin_rate", &self.final_spin_rate);
+        s.field("balance_angle_error_deg", &self.balance_angle_error_deg);
+        if let Some(a) = &self.plane_a_ref {
+            s.field("plane_a_ref", a);
+        }
+        if let Some(r) = &self.plane_residual_abs {
+            s.field("plane_residual_abs", r);
+        }
+        s.finish()
+    }
 }
 
 impl RunMetrics {
@@ -227,6 +278,8 @@ impl RunMetrics {
             operating_time: None,
             final_spin_rate: None,
             balance_angle_error_deg: None,
+            plane_a_ref: None,
+            plane_residual_abs: None,
         }
     }
 }

@@ -5,7 +5,9 @@ use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, Tracked, 
 use super::never_settles::{
     Criteria, FIRST_REVS, LAG, NeverSettles, RepeatWatch, Stroboscope, WINDOW,
 };
-use super::reference::{a_ref, balancing_error, reference_unbalance, vibration};
+use super::reference::{
+    a_ref, balancing_error, plane_a_refs, plane_whirls, reference_unbalance, vibration,
+};
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
 use crate::integrate::{Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
@@ -182,11 +184,22 @@ pub struct SettlingObserver<'a> {
     certified: Option<(f64, Vec<f64>)>,
     /// The rest of the window as the tracked flow predicts it.
     plan: Option<TailPlan>,
+    /// Per watched plane, for rotors with several: A_ref and r² over the window.
+    planes: Option<PlaneWatch>,
     /// Watches the state once per revolution for a repeat outside the band.
     repeats: Option<RepeatWatch>,
     /// The certificate that ended the run as never settling, the boundary
     /// time and the state there.
     never: Option<(NeverSettles, f64, Vec<f64>)>,
+}
+
+/// Each watched plane's A_ref, its whirl at the latest sample and r² over
+/// the last hold window (rotors with several planes).
+#[derive(Debug)]
+struct PlaneWatch {
+    a_ref: Vec<f64>,
+    r: Vec<f64>,
+    rings: Vec<SquareRing>,
 }
 
 /// The samples first..=last of a hold window predicted on a tracked flow:
@@ -362,6 +375,14 @@ impl<'a> SettlingObserver<'a> {
             plan: None,
             repeats: None,
             never: None,
+            planes: (!is_plane_translation(system) && system.watch_maps().len() > 1).then(|| {
+                let n = system.watch_maps().len();
+                PlaneWatch {
+                    a_ref: plane_a_refs(system, omega),
+                    r: vec![0.0; n],
+                    rings: vec![SquareRing::new(ring_len); n],
+                }
+            }),
             options,
         }
     }
@@ -482,6 +503,12 @@ impl<'a> SettlingObserver<'a> {
             self.merged = self.coincident().map(|(i, j)| (i, j, t));
         }
         self.ring.push(r * r);
+        if let Some(pw) = &mut self.planes {
+            plane_whirls(self.system, &self.scratch, &mut pw.r);
+            for (ring, r) in pw.rings.iter_mut().zip(&pw.r) {
+                ring.push(r * r);
+            }
+        }
         self.r_hold
             .update(t, operating && r <= self.band, self.window);
         self.eps_hold
@@ -940,6 +967,11 @@ impl<'a> SettlingObserver<'a> {
             operating_time: self.operating_since,
             final_spin_rate: Some(self.system.spin(t_final, y_final).1),
             balance_angle_error_deg: None,
+            plane_a_ref: self.planes.as_ref().map(|p| p.a_ref.clone()),
+            plane_residual_abs: self
+                .planes
+                .as_ref()
+                .map(|p| p.rings.iter().map(SquareRing::rms).collect()),
         };
         (metrics, self.series)
     }

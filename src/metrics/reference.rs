@@ -41,6 +41,37 @@ pub fn a_ref(system: &RotorSystem, omega: f64) -> f64 {
     }
 }
 
+/// A_ref of each watched plane (balancer planes, then the rotor's own
+/// unbalance planes; [`RotorSystem::watch_maps`]): its orbit radius in the
+/// locked response of [`a_ref`], whose largest it is.
+pub fn plane_a_refs(system: &RotorSystem, omega: f64) -> Vec<f64> {
+    let rotor = system.rotor();
+    let (mut fc, mut fs) = unbalance_forcing(system, &[], true);
+    if rotor.own_unbalance() == 0.0 {
+        let u = reference_unbalance(system);
+        let [gu, gv] = rotor.plane_map(0);
+        for i in 0..MAX_DOF {
+            fc[i] = u * gu[i];
+            fs[i] = u * gv[i];
+        }
+    }
+    let maps = system.watch_maps();
+    match harmonic_response(system, &fc, &fs, omega) {
+        Some(h) => maps.iter().map(|map| plane_orbit_radius(&h, map)).collect(),
+        None => vec![f64::INFINITY; maps.len()],
+    }
+}
+
+/// The displacement |(u_p, v_p)| of every watched plane at positions q, into `out`.
+pub fn plane_whirls(system: &RotorSystem, q: &[f64], out: &mut [f64]) {
+    let k = system.rotor().dof();
+    for (r, &[gu, gv]) in out.iter_mut().zip(system.watch_maps()) {
+        let u: f64 = (0..k).map(|i| gu[i] * q[i]).sum();
+        let v: f64 = (0..k).map(|i| gv[i] * q[i]).sum();
+        *r = planar_norm(u, v);
+    }
+}
+
 /// A_ref = U ω² / |k_x − M_Σ ω² + i b_x ω| for the plane rotor.
 fn plane_a_ref(system: &RotorSystem, omega: f64) -> f64 {
     let rotor = system.rotor();

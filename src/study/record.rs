@@ -108,6 +108,10 @@ pub const COUPLE_COLUMNS: [&str; 5] = [
     "plane_directions_deg",
 ];
 
+/// Columns of each watched plane's A_ref and residual (m), for rotors with
+/// several planes (balancer planes, then the load's planes), in plane order.
+pub const PLANE_COLUMNS: [&str; 2] = ["plane_a_ref", "plane_residual_abs"];
+
 /// Columns of the race centre's offset (m) and direction (degrees), written
 /// with the weight columns; null when neither sampled nor set by the scene.
 pub const RACE_COLUMNS: [&str; 2] = ["race_offset", "race_angle_deg"];
@@ -207,6 +211,20 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         let [offset, angle] = RACE_COLUMNS;
         columns.push(Column::new(offset.into(), race(|r| r.0)));
         columns.push(Column::new(angle.into(), race(|r| r.1)));
+    }
+    // Every row of a study has the same rotor: per-plane values or none.
+    if rows.iter().any(|r| r.metrics.plane_a_ref.is_some()) {
+        let [a, res] = PLANE_COLUMNS;
+        columns.push(list_column(
+            a,
+            rows.iter()
+                .map(|r| r.metrics.plane_a_ref.clone().unwrap_or_default()),
+        ));
+        columns.push(list_column(
+            res,
+            rows.iter()
+                .map(|r| r.metrics.plane_residual_abs.clone().unwrap_or_default()),
+        ));
     }
     // All rows of a study sample a couple or none do.
     if rows.iter().any(|r| r.couple.is_some()) {
@@ -387,6 +405,15 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
         optional("final_spin_rate")?,
     );
     let angle_error = optional("balance_angle_error_deg")?;
+    // Written only by rotors with several planes.
+    let optional_lists = |name: &str| -> PolarsResult<Option<Vec<Vec<f64>>>> {
+        match df.column(name) {
+            Ok(_) => lists(name).map(Some),
+            Err(_) => Ok(None),
+        }
+    };
+    let plane_a_ref = optional_lists(PLANE_COLUMNS[0])?;
+    let plane_residual = optional_lists(PLANE_COLUMNS[1])?;
     let couple: Option<Vec<SampledCouple>> = if df.column(COUPLE_COLUMNS[0]).is_ok() {
         let (u, fraction, direction) = (
             f64s(COUPLE_COLUMNS[0])?,
@@ -450,6 +477,15 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 operating_time: t_op[i],
                 final_spin_rate: spin[i],
                 balance_angle_error_deg: angle_error[i],
+                // An empty list: a run with no per-plane values (not integrated).
+                plane_a_ref: plane_a_ref
+                    .as_ref()
+                    .map(|v| v[i].clone())
+                    .filter(|v| !v.is_empty()),
+                plane_residual_abs: plane_residual
+                    .as_ref()
+                    .map(|v| v[i].clone())
+                    .filter(|v| !v.is_empty()),
             },
             contact: contact[i],
             method: method[i].clone(),

@@ -415,3 +415,45 @@ fn a_speed_sweep_with_couple_unbalance_follows_seed_003s_criterion() {
         );
     }
 }
+
+/// Per-plane results: with one balancer at z = 1 against a static and
+/// couple load at ±1, its own plane calms and the far plane keeps whirling;
+/// with two, both calm. runs.parquet carries each plane's A_ref and residual.
+#[test]
+fn each_plane_reports_its_residual_and_the_far_end_of_a_single_balancer_whirls() {
+    let (two, one) = (plan(&drum(false)), plan(&drum(true)));
+    for id in 0..4 {
+        let a = run_one(&two, id).metrics;
+        let b = run_one(&one, id).metrics;
+        // Watched planes: two's balancers at −1 and 1; one's balancer at 1, then the load's −1.
+        let (ra, rb) = (a.plane_residual_abs.unwrap(), b.plane_residual_abs.unwrap());
+        let (aa, ab) = (a.plane_a_ref.unwrap(), b.plane_a_ref.unwrap());
+        assert_eq!((ra.len(), rb.len(), aa.len(), ab.len()), (2, 2, 2, 2));
+        // The overall A_ref is the largest plane's; the overall residual at least each plane's.
+        assert_eq!(a.a_ref, aa.iter().copied().fold(0.0, f64::max));
+        for (r, ar) in rb.iter().zip(&ab) {
+            assert!(*r <= b.residual_abs * (1.0 + 1e-12) && *ar > 0.0);
+        }
+        let rel = |r: &[f64], a: &[f64], p: usize| r[p] / a[p];
+        assert!(
+            rel(&rb, &ab, 0) < 0.5 * rel(&rb, &ab, 1),
+            "run {id}: the balancer's plane {} against the far plane {}",
+            rel(&rb, &ab, 0),
+            rel(&rb, &ab, 1)
+        );
+        // Settled: every plane inside the one band δ·A_ref (A_ref the largest plane's).
+        if a.settled {
+            assert!(
+                ra.iter().all(|r| *r < 0.05 * a.a_ref),
+                "run {id}: {ra:?} {aa:?}"
+            );
+        }
+    }
+    let rows: Vec<_> = (0..2).map(|id| run_one(&one, id)).collect();
+    let df = autobal::study::record::to_dataframe(&rows).unwrap();
+    let back = from_dataframe(&df).unwrap();
+    for (x, y) in rows.iter().zip(&back) {
+        assert_eq!(x.metrics.plane_residual_abs, y.metrics.plane_residual_abs);
+        assert_eq!(x.metrics.plane_a_ref, y.metrics.plane_a_ref);
+    }
+}

@@ -283,6 +283,8 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     operating_time: Some(0.0),
                     final_spin_rate: None,
                     balance_angle_error_deg: None,
+                    plane_a_ref: None,
+                    plane_residual_abs: None,
                 },
                 method: "dp5".into(),
                 contact: true,

@@ -236,6 +236,8 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         operating_time: Some(0.0),
         final_spin_rate: None,
         balance_angle_error_deg: None,
+        plane_a_ref: None,
+        plane_residual_abs: None,
     }
 }
 

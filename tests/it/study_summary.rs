@@ -78,6 +78,8 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             operating_time: Some(0.0),
             final_spin_rate: None,
             balance_angle_error_deg: None,
+            plane_a_ref: None,
+            plane_residual_abs: None,
         },
         method: "dp5".into(),
         contact: true,
