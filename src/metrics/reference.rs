@@ -21,24 +21,7 @@ pub fn a_ref(system: &RotorSystem, omega: f64) -> f64 {
     if is_plane_translation(system) {
         return plane_a_ref(system, omega);
     }
-    let rotor = system.rotor();
-    let (mut fc, mut fs) = unbalance_forcing(system, &[], true);
-    if rotor.own_unbalance() == 0.0 {
-        let u = reference_unbalance(system);
-        let [gu, gv] = rotor.plane_map(0);
-        for i in 0..MAX_DOF {
-            fc[i] = u * gu[i];
-            fs[i] = u * gv[i];
-        }
-    }
-    match harmonic_response(system, &fc, &fs, omega) {
-        Some(h) => system
-            .watch_maps()
-            .iter()
-            .map(|map| plane_orbit_radius(&h, map))
-            .fold(0.0, f64::max),
-        None => f64::INFINITY,
-    }
+    plane_a_refs(system, omega).into_iter().fold(0.0, f64::max)
 }
 
 /// A_ref of each watched plane (balancer planes, then the rotor's own
