@@ -188,6 +188,9 @@ pub struct SettlingObserver<'a> {
     planes: Option<PlaneWatch>,
     /// Watches the state once per revolution for a repeat outside the band.
     repeats: Option<RepeatWatch>,
+    /// The sample index of the next revolution boundary the watch sees
+    /// (the first [`FIRST_REVS`] revolutions in).
+    next_watch: u64,
     /// The certificate that ended the run as never settling, the boundary
     /// time and the state there.
     never: Option<(NeverSettles, f64, Vec<f64>)>,
@@ -374,6 +377,7 @@ impl<'a> SettlingObserver<'a> {
             certified: None,
             plan: None,
             repeats: None,
+            next_watch: FIRST_REVS * u64::from(samples),
             never: None,
             planes: (!is_plane_translation(system) && system.watch_maps().len() > 1).then(|| {
                 let n = system.watch_maps().len();
@@ -537,13 +541,16 @@ impl<'a> SettlingObserver<'a> {
         // A run that settled (and goes on, `stop_when_settled = false`) has
         // its answer; identical weights that coincided end as `merged` or
         // not at all.
-        if self.repeats.is_some()
-            && self.r_hold.met_at.is_none()
-            && self.merged.is_none()
-            && self.revolution_boundary(t)
-        {
+        // Revolution boundaries are counted, not computed: a compare per sample.
+        let boundary = self.repeats.is_some() && self.next_index - 1 == self.next_watch;
+        if boundary {
+            self.next_watch += self.per_rev();
+        }
+        if boundary && self.r_hold.met_at.is_none() && self.merged.is_none() && self.watch_open(t) {
             let state = self.stroboscope(t);
-            let criteria = self.repeat_criteria(t, operating);
+            // The stroboscope's last entry is the spin rate over ω.
+            let spin_ratio = state.smooth.last().copied().unwrap_or(1.0);
+            let criteria = self.repeat_criteria(t, operating, spin_ratio);
             if let Some(watch) = &mut self.repeats
                 && let Some(never) = watch.observe(state, criteria)
                 && self.eps_at_horizon(t).is_some()
@@ -581,15 +588,11 @@ impl<'a> SettlingObserver<'a> {
         u64::from(self.options.samples_per_rev.max(32))
     }
 
-    /// Whether sample time t ends a revolution (at least [`FIRST_REVS`]
-    /// into the run) and the horizon is more than a hold window away.
-    fn revolution_boundary(&self, t: f64) -> bool {
-        let index = ((t - self.t0) / self.dt).round() as u64;
-        let per = self.per_rev();
-        let rev = self.dt * per as f64;
-        index.is_multiple_of(per)
-            && index >= FIRST_REVS * per
-            && t + self.window < self.t0 + self.options.t_end_revs * rev
+    /// Whether, at revolution boundary t, the horizon is more than a hold
+    /// window away (a later hold could still complete before it).
+    fn watch_open(&self, t: f64) -> bool {
+        let rev = self.dt * self.per_rev() as f64;
+        t + self.window < self.t0 + self.options.t_end_revs * rev
     }
 
     /// The scratch state at a revolution boundary, as the watch compares
@@ -602,9 +605,10 @@ impl<'a> SettlingObserver<'a> {
         let y = &self.scratch;
         // The rotating frame already holds body-frame (u, v); inertial (x, y)
         // are turned back by the spin angle.
+        let (angle, rate) = self.system.spin(t, y);
         let (s, c) = match self.frame {
             Some(_) => (0.0, 1.0),
-            None => (-self.system.spin(t, y).0).sin_cos(),
+            None => (-angle).sin_cos(),
         };
         let turn = |a: f64, b: f64| (a * c - b * s, a * s + b * c);
         let (u, v) = turn(y[0], y[1]);
@@ -612,7 +616,7 @@ impl<'a> SettlingObserver<'a> {
         let (a, w) = (self.a_ref, self.omega);
         let mut smooth = vec![u / a, v / a, ud / (a * w), vd / (a * w)];
         smooth.extend(y[nq + lay.head()..2 * nq].iter().map(|rate| rate / w));
-        smooth.push(self.system.spin(t, y).1 / w);
+        smooth.push(rate / w);
         let (older, newer) = self.ring.latest(LAG * self.per_rev() as usize);
         Stroboscope {
             smooth,
@@ -643,12 +647,12 @@ impl<'a> SettlingObserver<'a> {
     }
 
     /// The band, the speed and the revolutions left, at boundary time t.
-    fn repeat_criteria(&self, t: f64, operating: bool) -> Criteria {
+    fn repeat_criteria(&self, t: f64, operating: bool, spin_ratio: f64) -> Criteria {
         let rev = self.dt * self.per_rev() as f64;
         Criteria {
             delta: self.options.delta,
             operating,
-            spin_ratio: self.system.spin(t, &self.scratch).1 / self.omega,
+            spin_ratio,
             remaining_revs: (self.t0 + self.options.t_end_revs * rev - t) / rev,
         }
     }
@@ -999,7 +1003,7 @@ impl StepObserver for SettlingObserver<'_> {
                 (Some(c), Some(since)) => c.needs_full_state(t, since),
                 _ => false,
             };
-            let watching = self.repeats.is_some() && self.revolution_boundary(t);
+            let watching = self.repeats.is_some() && self.next_index == self.next_watch;
             let needed = if certifying
                 || watching
                 || (self.t_op.is_none() && self.operating_since.is_none())

@@ -10,9 +10,9 @@ use autobal::study::record::{COUPLE_COLUMNS, from_dataframe};
 use autobal::study::run::{run_one, sample_simulation};
 use num_complex::Complex64;
 
-fn study(sampling_extra: &str, rotor_model: &str) -> String {
-    let rotor = if rotor_model == "two_support" {
-        r#"model = "two_support"
+/// The long rotor of `fixtures::long_rotor` (ω1 = √2, ω2 = √10) as a
+/// study's `[scene.rotor]`, without its `planes` key.
+const LONG_ROTOR: &str = r#"model = "two_support"
 mass = 1.0
 transverse_inertia = 1.0
 polar_inertia = 0.2
@@ -21,10 +21,13 @@ l1 = 2.0
 k2 = 1.0
 l2 = 2.0
 b1 = 0.05
-b2 = 0.05
-planes = [-1.0, 1.0]"#
+b2 = 0.05"#;
+
+fn study(sampling_extra: &str, rotor_model: &str) -> String {
+    let rotor = if rotor_model == "two_support" {
+        format!("{LONG_ROTOR}\nplanes = [-1.0, 1.0]")
     } else {
-        "mass = 1.0\nkx = 1.0\nky = 1.0\nbx = 0.1\nby = 0.1"
+        "mass = 1.0\nkx = 1.0\nky = 1.0\nbx = 0.1\nby = 0.1".to_string()
     };
     format!(
         r#"name = "couple"
@@ -240,16 +243,7 @@ fn drum(single: bool) -> String {
     format!(
         r#"name = "drum"
 [scene.rotor]
-model = "two_support"
-mass = 1.0
-transverse_inertia = 1.0
-polar_inertia = 0.2
-k1 = 1.0
-l1 = 2.0
-k2 = 1.0
-l2 = 2.0
-b1 = 0.05
-b2 = 0.05
+{LONG_ROTOR}
 planes = {planes}
 [scene.speed]
 mode = "constant"
