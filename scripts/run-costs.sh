@@ -5,6 +5,10 @@
 #
 # Usage: scripts/run-costs.sh [THREADS] [STUDY ...]   (default 2 threads, every studies/*.toml but regression)
 #
+# Without STUDY arguments it then prints the second table of issue 31, the
+# peer design against the lean DP5 (bench/lean/peer.sh, PEER_ROUNDS rounds of
+# PEER_SAMPLES runs, default 3 and 1000; PEER_ROUNDS=0 skips it).
+#
 # Each study runs once as shipped, with `study run --threads THREADS`, into a
 # fresh folder; the table is read from its runs.parquet (pyarrow, bench/lean's
 # virtual environment). ms per run is the mean of the runs' own `wall_time_s`
@@ -20,7 +24,9 @@ shift || true
 # shellcheck source=bench-setup.sh
 source "$root/scripts/bench-setup.sh" costs
 
+peer_too=no
 if [ "$#" -eq 0 ]; then
+    peer_too=yes
     set -- $(cd "$root/studies" && ls ./*.toml | sed 's|^\./||; s|\.toml$||' | grep -v '^regression$')
 fi
 for name in "$@"; do
@@ -50,3 +56,8 @@ for name in names:
     mix = ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
     print(f"{name:>20} {n:>6} {ms:>11.2f} {rhs:>18.0f} {censored:>9} {certified:>10}  {mix}")
 EOF
+
+if [ "$peer_too" = yes ] && [ "${PEER_ROUNDS:-3}" -gt 0 ]; then
+    echo
+    "$root/bench/lean/peer.sh" "${PEER_ROUNDS:-3}" "${PEER_SAMPLES:-1000}"
+fi

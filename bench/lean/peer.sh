@@ -7,6 +7,8 @@
 # round counts on each side (runs/s per core = runs / Σ per-run times).
 #
 # Usage: bench/lean/peer.sh [ROUNDS] [SAMPLES]   (default 3 rounds, 1000 samples)
+#        PROFILE=release bench/lean/peer.sh ...  (autobal's release build; default
+#        the dev build the README's commands use)
 # Not part of the tests or CI.
 set -euo pipefail
 
@@ -19,12 +21,17 @@ source "$here/../venv.sh"
 
 (cd "$here" && export CARGO_TARGET_DIR="$here/target" && cargo build --quiet --release)
 lean=$here/target/release/autobal-lean
-(cd "$root" && cargo build --quiet --bin study)
-study=${CARGO_TARGET_DIR:-$root/target}/debug/study
+profile=${PROFILE:-debug}
+case "$profile" in
+    debug) (cd "$root" && cargo build --quiet --bin study) ;;
+    release) (cd "$root" && cargo build --quiet --release --bin study) ;;
+    *) echo "PROFILE must be debug or release, not '$profile'" >&2; exit 2 ;;
+esac
+study=${CARGO_TARGET_DIR:-$root/target}/$profile/study
 
 out=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/autobal-peer.XXXXXX")}
 mkdir -p "$out"
-echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown))" >&2
+echo "results: $out   (autobal $profile build; load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown))" >&2
 for contact in on off; do
     enabled=true
     [ "$contact" = off ] && enabled=false
