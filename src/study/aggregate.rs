@@ -234,7 +234,9 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.spin_median
             .push(quantile_sorted(&spin, 0.5, Interpolation::Linear));
     }
-    rows.into_dataframe()
+    let mut summary = rows.into_dataframe()?;
+    super::plane_designs::append_columns(&mut summary, &plan.designs)?;
+    Ok(summary)
 }
 
 /// Column buffers of the summary table.

@@ -214,6 +214,10 @@ pub struct DesignGrid {
     /// replaces `scene.speed.stall_torque` (needs `mode = "motor"`).
     #[serde(default)]
     pub stall_torque: Option<OneOrMany<f64>>,
+    /// Balancer planes 1, 2, … with axes of their own (rotors with several
+    /// balancer planes; docs/study-file.md, "A design per plane").
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub per_plane: Vec<super::plane_designs::PlaneAxes>,
 }
 
 fn steel() -> f64 {
@@ -471,8 +475,16 @@ pub struct Design {
     /// Track radius l = R − r (m).
     pub track_radius: f64,
     /// Balancing capacity (kg·m): S_AB of seed 000 for balls and rollers
-    /// (weights pressed together), n m l for pendulums (they can pass each other).
+    /// (weights pressed together), n m l for pendulums (they can pass each
+    /// other); with a design per plane, its weakest plane's.
     pub capacity: f64,
+    /// Plane 0's own capacity (kg·m): `capacity` unless planes differ.
+    #[serde(skip)]
+    pub plane_zero_capacity: f64,
+    /// The balancers of planes 1, 2, … when they have designs of their own
+    /// (`[[designs.per_plane]]`); empty: `spec` in every plane.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub plane_designs: Vec<Design>,
     /// The motor's stall torque M_s (N·m) when the grid sweeps it
     /// (`designs.stall_torque`); `None`: the scene's own speed law.
     pub stall_torque: Option<f64>,
@@ -504,15 +516,24 @@ impl StudyPlan {
         let mut rotor = t.rotor.clone();
         rotor.set_unbalance(unbalance, direction);
         let planes = rotor.as_rotor().planes();
-        Scene {
-            rotor,
-            balancer: Some(design.spec.clone()),
-            balancers: (1..planes)
+        let balancers = if design.plane_designs.is_empty() {
+            (1..planes)
                 .map(|plane| DesignSpec {
                     plane,
                     ..design.spec.clone()
                 })
-                .collect(),
+                .collect()
+        } else {
+            design
+                .plane_designs
+                .iter()
+                .map(|p| p.spec.clone())
+                .collect()
+        };
+        Scene {
+            rotor,
+            balancer: Some(design.spec.clone()),
+            balancers,
             cargo: Vec::new(),
             speed: design.speed(&t.speed),
             effects: t.effects.clone(),
@@ -724,6 +745,25 @@ impl StudyFile {
                 ),
             ));
         }
+        super::plane_designs::validate(
+            &self.designs.per_plane,
+            self.scene.rotor.as_rotor().planes(),
+        )
+        .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+        if !self.designs.per_plane.is_empty() {
+            // Both build every weight from plane 0's design today.
+            let other = [
+                ("sampling.tolerances", s.tolerances.is_some()),
+                ("optimize", self.optimize.is_some()),
+            ];
+            if let Some((key, _)) = other.iter().find(|(_, given)| *given) {
+                return Err(invalid(
+                    key,
+                    "given".into(),
+                    "cannot yet be combined with designs.per_plane (a design per plane): run the planes' designs as a grid, or give every plane the same design",
+                ));
+            }
+        }
         let designs = self
             .resolve_designs()
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;
@@ -753,13 +793,11 @@ impl StudyFile {
                     "sampling.unbalance.max",
                     upper.to_string(),
                     &format!(
-                        "the largest unbalance drawn, {:.4e} kg·m, plus the {demand:.4e} kg·m the weights must add to centre the off-centre race (effects.race_eccentricity: e_r·|M − (k + ibω)/ω²|) exceeds the capacity {:.4e} kg·m of design {} ({} n = {} ρ = {:.4}); lower it or set require_balanceable = false",
+                        "the largest unbalance drawn, {:.4e} kg·m, plus the {demand:.4e} kg·m the weights must add to centre the off-centre race (effects.race_eccentricity: e_r·|M − (k + ibω)/ω²|) exceeds the capacity {:.4e} kg·m of design {} ({}); lower it or set require_balanceable = false",
                         drawn(d),
                         d.capacity,
                         d.id,
-                        d.spec.kind,
-                        d.spec.n,
-                        d.rho
+                        super::plane_designs::describe(d)
                     ),
                 ));
             }
@@ -796,8 +834,10 @@ impl StudyFile {
                     key,
                     format!("{:.4e} kg·m in the worse plane", worst(d)),
                     &format!(
-                        "the largest static plus couple unbalance a plane can take exceeds the capacity {:.4e} kg·m of design {} ({} n = {} ρ = {:.4}); lower them or set require_balanceable = false",
-                        d.capacity, d.id, d.spec.kind, d.spec.n, d.rho
+                        "the largest static plus couple unbalance a plane can take exceeds the capacity {:.4e} kg·m of design {} ({}); lower them or set require_balanceable = false",
+                        d.capacity,
+                        d.id,
+                        super::plane_designs::describe(d)
                     ),
                 ));
             }
@@ -809,8 +849,10 @@ impl StudyFile {
                     "sampling.unbalance.max",
                     upper.to_string(),
                     &format!(
-                        "exceeds the capacity {:.4e} kg·m of design {} ({} n = {} ρ = {:.4}); lower it or set require_balanceable = false",
-                        d.capacity, d.id, d.spec.kind, d.spec.n, d.rho
+                        "exceeds the capacity {:.4e} kg·m of design {} ({}); lower it or set require_balanceable = false",
+                        d.capacity,
+                        d.id,
+                        super::plane_designs::describe(d)
                     ),
                 ));
             }
@@ -908,8 +950,27 @@ impl StudyFile {
             weight_mass: cargo.mass,
             track_radius: cargo.track_radius,
             capacity,
+            plane_zero_capacity: capacity,
+            plane_designs: Vec::new(),
             stall_torque: None,
         })
+    }
+
+    /// A balancer of plane 1, 2, … checked as plane 0's are, its errors named
+    /// by its `[[designs.per_plane]]` entry.
+    fn resolve_plane_design(&self, spec: DesignSpec) -> Result<Design, (String, String, String)> {
+        let plane = spec.plane;
+        self.resolve_design(0, spec)
+            .map_err(|(key, value, reason)| {
+                let entry = self.designs.per_plane.iter().position(|a| a.plane == plane);
+                let key = match (entry, key.strip_prefix("designs.")) {
+                    (Some(i), Some(rest)) if ["n", "rho", "kind", "drag"].contains(&rest) => {
+                        format!("designs.per_plane[{i}].{rest}")
+                    }
+                    _ => key,
+                };
+                (key, value, format!("{reason} (plane {plane})"))
+            })
     }
 
     fn resolve_designs(&self) -> Result<Vec<Design>, (String, String, String)> {
@@ -947,11 +1008,30 @@ impl StudyFile {
                                 drag,
                                 plane: 0,
                             };
-                            let design = self.resolve_design(designs.len() as u32, spec)?;
-                            designs.push(Design {
-                                stall_torque,
-                                ..design
-                            });
+                            let planes = self.scene.rotor.as_rotor().planes();
+                            let others = if g.per_plane.is_empty() {
+                                vec![Vec::new()]
+                            } else {
+                                super::plane_designs::combinations(&g.per_plane, planes, &spec)
+                            };
+                            for other in others {
+                                let design =
+                                    self.resolve_design(designs.len() as u32, spec.clone())?;
+                                let plane_designs = other
+                                    .into_iter()
+                                    .map(|s| self.resolve_plane_design(s))
+                                    .collect::<Result<Vec<_>, _>>()?;
+                                let capacity = plane_designs
+                                    .iter()
+                                    .map(|p| p.capacity)
+                                    .fold(design.capacity, f64::min);
+                                designs.push(Design {
+                                    stall_torque,
+                                    capacity,
+                                    plane_designs,
+                                    ..design
+                                });
+                            }
                         }
                     }
                 }

@@ -33,6 +33,7 @@ pub mod io;
 pub mod lock;
 pub mod merge;
 pub mod optimize_spec;
+pub mod plane_designs;
 pub mod record;
 pub mod run;
 pub mod runs_file;

@@ -265,10 +265,11 @@ pub fn sample_simulation(
 ) -> (Sample, Simulation) {
     let mut sample = draw_sample(plan, design, sample_id);
     let mut scene = plan.scene(design, sample.unbalance, sample.direction);
-    // The design sits in every balancer plane, and so do its start angles
-    // (the sampled unbalance is placed in every plane at one direction too).
+    // Without designs of their own, the design sits in every balancer plane,
+    // and so do its start angles (the sampled unbalance is placed in every
+    // plane at one direction too).
     let planes = plan.file.scene.rotor.as_rotor().planes().max(1);
-    if planes > 1 {
+    if planes > 1 && design.plane_designs.is_empty() {
         sample.initial_angles = sample.initial_angles.repeat(planes);
     }
     if let Some(couple) = &sample.couple {
@@ -615,6 +616,7 @@ fn execute(
             }
             buffer.sort_by_key(|r| r.run_id);
             let mut df = to_dataframe(buffer)?;
+            super::plane_designs::append_columns(&mut df, &plan.designs)?;
             write_chunk(
                 &chunks.join(format!("chunk-{next_chunk:06}.arrow")),
                 &mut df,

@@ -123,9 +123,38 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         DirectionSpec::Uniform => 2.0 * PI * rng.random::<f64>(),
         DirectionSpec::Fixed(deg) => deg.to_radians(),
     };
-    let mut rng = stream(seed, shared, sample, Purpose::Initial);
+    // Planes with designs of their own start as plane 0 does (the same
+    // draws: clustered around the same direction), each with its weights.
+    let initial_angles = std::iter::once(design)
+        .chain(&design.plane_designs)
+        .flat_map(|d| {
+            let mut rng = stream(seed, shared, sample, Purpose::Initial);
+            initial_angles(&s.initial, d, &mut rng, unbalance, direction)
+        })
+        .collect();
+    Sample {
+        unbalance,
+        fraction,
+        direction,
+        initial_angles,
+        weights: None,
+        couple: s.couple.as_ref().map(|spec| {
+            super::couple::draw(spec, seed, shared, design, sample, (unbalance, direction))
+        }),
+    }
+}
+
+/// The start angles of one balancer's weights (`design`'s plane), from the
+/// run's stream of initial positions.
+fn initial_angles(
+    initial: &InitialSpec,
+    design: &Design,
+    rng: &mut Xoshiro256PlusPlus,
+    unbalance: f64,
+    direction: f64,
+) -> Vec<f64> {
     let n = design.spec.n as usize;
-    let initial_angles = match s.initial {
+    match *initial {
         InitialSpec::Clustered => {
             let centre = 2.0 * PI * rng.random::<f64>();
             cluster(design, centre)
@@ -136,7 +165,7 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
                 .map(|j| start + 2.0 * PI * j as f64 / n as f64)
                 .collect()
         }
-        InitialSpec::Uniform => uniform_without_overlap(design, &mut rng),
+        InitialSpec::Uniform => uniform_without_overlap(design, rng),
         InitialSpec::BalancedForShift(shift) => {
             let old = direction - shift.to_radians();
             balanced_fan(n, design.weight_mass * design.track_radius, unbalance, old)
@@ -146,16 +175,6 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
                 // Beyond what the cargoes can cancel: press them together opposite.
                 .unwrap_or_else(|| cluster(design, old + PI))
         }
-    };
-    Sample {
-        unbalance,
-        fraction,
-        direction,
-        initial_angles,
-        weights: None,
-        couple: s.couple.as_ref().map(|spec| {
-            super::couple::draw(spec, seed, shared, design, sample, (unbalance, direction))
-        }),
     }
 }
 

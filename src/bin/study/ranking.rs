@@ -85,6 +85,60 @@ fn order_by_rank(summary: &DataFrame) -> Result<Vec<usize>, UserError> {
     Ok(order)
 }
 
+/// The kind, n, ρ and β cells of a study whose planes have designs of their
+/// own (`kind_plane0`, … columns): each plane's value, joined by "/", or the
+/// one value when every plane has it.
+struct PlaneCells {
+    /// Per plane: kinds, counts, ρ, β, one entry per summary row.
+    planes: Vec<[Vec<String>; 4]>,
+}
+
+impl PlaneCells {
+    /// `None` when the summary has no per-plane columns.
+    fn read(summary: &DataFrame) -> Result<Option<PlaneCells>, UserError> {
+        let mut planes = Vec::new();
+        while summary.column(&format!("n_plane{}", planes.len())).is_ok() {
+            let p = planes.len();
+            let sum = Summary(summary);
+            let kind = sum.s(&format!("kind_plane{p}"))?;
+            let n: Vec<Option<u32>> = summary
+                .column(&format!("n_plane{p}"))?
+                .u32()?
+                .iter()
+                .collect();
+            let (rho, drag) = (
+                sum.f(&format!("rho_plane{p}"))?,
+                sum.f(&format!("drag_plane{p}"))?,
+            );
+            planes.push([
+                kind.into_iter().map(Option::unwrap_or_default).collect(),
+                n.iter()
+                    .map(|v| v.map_or("–".into(), |v| v.to_string()))
+                    .collect(),
+                rho.iter().map(|&v| num(v, 4)).collect(),
+                drag.iter().map(|&v| num(v, 3)).collect(),
+            ]);
+        }
+        Ok((!planes.is_empty()).then_some(PlaneCells { planes }))
+    }
+
+    /// The four cells of summary row i.
+    fn row(&self, i: usize) -> [String; 4] {
+        std::array::from_fn(|k| {
+            let values: Vec<&String> = self.planes.iter().map(|p| &p[k][i]).collect();
+            if values.iter().all(|v| *v == values[0]) {
+                values[0].clone()
+            } else {
+                values
+                    .iter()
+                    .map(|v| v.as_str())
+                    .collect::<Vec<_>>()
+                    .join("/")
+            }
+        })
+    }
+}
+
 /// The ranking, verdicts, disagreements and recommendation of a summary.
 pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     let sum = Summary(summary);
@@ -99,6 +153,7 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     let kind = sum.s("kind")?;
     let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
     let (rho, drag, frac) = (sum.f("rho")?, sum.f("drag")?, sum.f("settled_fraction")?);
+    let planes = PlaneCells::read(summary)?;
     let (median, median_lo, median_hi) = (
         sum.f("settling_revs_median_km")?,
         sum.f("settling_revs_median_km_lo")?,
@@ -151,15 +206,17 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
                 ),
                 Some(_) => format!("p {}", p_text(p_holm[i])),
             };
-            let mut row = vec![
-                (r + 1).to_string(),
-                ids[i].to_string(),
-                kind[i].clone().unwrap_or_default(),
-                n[i].map_or("–".into(), |v| v.to_string()),
-                num(rho[i], 4),
-                num(drag[i], 3),
-                num(frac[i].map(|f| 100.0 * f), 1),
-            ];
+            let plane_cells = planes.as_ref().map(|p| p.row(i));
+            let mut row = vec![(r + 1).to_string(), ids[i].to_string()];
+            row.extend(plane_cells.unwrap_or_else(|| {
+                [
+                    kind[i].clone().unwrap_or_default(),
+                    n[i].map_or("–".into(), |v| v.to_string()),
+                    num(rho[i], 4),
+                    num(drag[i], 3),
+                ]
+            }));
+            row.push(num(frac[i].map(|f| 100.0 * f), 1));
             // The ranking criterion's own column carries its interval.
             row.push(match (median[i], criterion) {
                 (Some(m), Criterion::Median) => {
@@ -280,8 +337,15 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             0
         )
     );
+    let plane_note = planes.as_ref().map_or(String::new(), |p| {
+        format!(
+            "(kind, n, ρ, β: each balancer plane's, plane 0 to {} joined by “/”, one value where every plane has it; the planes' designs are columns kind_plane0 … of summary.parquet and runs.parquet)\n",
+            p.planes.len() - 1
+        )
+    });
     Ok(text_table(&header, &rows)
         + &legend
+        + &plane_note
         + &verdict_line(&sum, &order, criterion)?
         + &disagreement_line(&sum, &order, criterion)?
         + &recommendation_line(&sum, &order, criterion)?
