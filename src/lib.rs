@@ -32,6 +32,7 @@ pub mod build_info;
 pub mod check;
 pub mod claims;
 pub mod design;
+pub mod input_file;
 pub mod integrate;
 pub mod metrics;
 pub mod model;

@@ -97,7 +97,7 @@ impl SceneFile {
     /// Read and parse a file.
     pub fn read(path: &std::path::Path) -> Result<Self, SceneFileError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
+        let text = crate::input_file::read_text(path).map_err(|source| SceneFileError::Io {
             path: shown.clone(),
             source,
         })?;

@@ -1101,7 +1101,7 @@ fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static 
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err((k.to_string(), v.to_string(), "must be positive and finite"))
+            Err((k.to_string(), shown(v), "must be positive and finite"))
         }
     };
     match *d {
@@ -1110,7 +1110,7 @@ fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static 
             pos("min", min)?;
             pos("max", max)?;
             if max < min {
-                return Err(("max".into(), max.to_string(), "must not be below min"));
+                return Err(("max".into(), shown(max), "must not be below min"));
             }
             Ok(())
         }
@@ -1123,18 +1123,30 @@ fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static 
             pos("std", std)?;
             pos("min", min)?;
             pos("max", max)?;
-            if max < min {
-                return Err(("max".into(), max.to_string(), "must not be below min"));
+            if max <= min {
+                return Err((
+                    "max".into(),
+                    shown(max),
+                    "must be above min (a single value is `distribution = \"fixed\"`)",
+                ));
             }
             if !mean.is_finite() {
-                return Err(("mean".into(), mean.to_string(), "must be finite"));
+                return Err(("mean".into(), shown(mean), "must be finite"));
             }
             // Rejection sampling needs a reasonable acceptance rate.
             if (min - mean) / std > 5.0 || (mean - max) / std > 5.0 {
                 return Err((
                     "mean".into(),
-                    mean.to_string(),
+                    shown(mean),
                     "lies more than 5 std outside [min, max]",
+                ));
+            }
+            let mass = super::truncated::accepted_mass(mean, std, min, max);
+            if mass < super::truncated::MIN_ACCEPTED_MASS {
+                return Err((
+                    "std".into(),
+                    shown(std),
+                    "leaves less than 0.1 % of the normal inside [min, max]: each draw would need over 1 000 tries; narrow std or widen [min, max]",
                 ));
             }
             Ok(())
@@ -1142,10 +1154,20 @@ fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static 
     }
 }
 
+/// A number as the user would write it: plain in the everyday range,
+/// scientific beyond (1e300, not three hundred digits).
+fn shown(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Read, parse and validate a study file.
 pub fn load(path: &std::path::Path) -> Result<StudyPlan, StudyError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+    let text = crate::input_file::read_text(path).map_err(|source| StudyError::Io {
         path: shown.clone(),
         source,
     })?;

@@ -41,4 +41,5 @@ pub mod sample;
 pub mod stability_map;
 pub mod sweep;
 pub mod tolerance;
+pub mod truncated;
 pub mod verdict;

@@ -12,7 +12,7 @@ use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
 use crate::model::start::balanced_fan;
 use rand::{RngExt, SeedableRng};
-use rand_distr::{Distribution as _, Exp1, Normal};
+use rand_distr::{Distribution as _, Exp1};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::f64::consts::PI;
 
@@ -92,15 +92,7 @@ fn draw(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
             std,
             min,
             max,
-        } => {
-            let normal = Normal::new(mean, std).expect("std validated positive");
-            loop {
-                let v = normal.sample(rng);
-                if (min..=max).contains(&v) {
-                    return v;
-                }
-            }
-        }
+        } => super::truncated::draw(rng, mean, std, min, max),
     }
 }
 

@@ -36,7 +36,6 @@ use crate::model::cargo::Cargo;
 use crate::model::effect::SceneFacts;
 use crate::model::effect::race_eccentricity::RaceEccentricity;
 use crate::model::scene::Scene;
-use rand_distr::{Distribution as _, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -73,7 +72,7 @@ pub struct Tolerance {
     #[serde(default)]
     pub relative: bool,
     /// Truncation in standard deviations: draws beyond ±limit·σ are redrawn
-    /// (default 3, in (0, 10]).
+    /// (default 3, in [0.01, 10]).
     #[serde(default = "default_limit")]
     pub limit: f64,
 }
@@ -213,7 +212,9 @@ pub fn validate(
     Ok(())
 }
 
-/// σ finite and ≥ 0, the truncation in (0, 10] standard deviations.
+/// σ finite and ≥ 0, the truncation in [0.01, 10] standard deviations (at
+/// 0.01 σ, 0.8 % of draws are kept: narrower would leave the redraws
+/// under the floor of `truncated::MIN_ACCEPTED_MASS`'s order).
 fn check_spread(name: &str, tol: &Tolerance) -> Result<(), ToleranceError> {
     if !(tol.sigma.is_finite() && tol.sigma >= 0.0) {
         return Err((
@@ -222,11 +223,11 @@ fn check_spread(name: &str, tol: &Tolerance) -> Result<(), ToleranceError> {
             "a standard deviation: finite and ≥ 0".into(),
         ));
     }
-    if !(tol.limit > 0.0 && tol.limit <= 10.0) {
+    if !(tol.limit >= 0.01 && tol.limit <= 10.0) {
         return Err((
             format!("{name}.limit"),
             tol.limit.to_string(),
-            "a truncation in standard deviations, in (0, 10]".into(),
+            "a truncation in standard deviations, in [0.01, 10] (narrower keeps too few draws to end)".into(),
         ));
     }
     Ok(())
@@ -254,12 +255,8 @@ fn nominal_geometry(d: &Design) -> Result<Geometry, String> {
 
 /// A standard normal draw truncated to [−limit, limit] (redrawn beyond).
 fn truncated(rng: &mut Xoshiro256PlusPlus, limit: f64) -> f64 {
-    loop {
-        let z: f64 = StandardNormal.sample(rng);
-        if z.abs() <= limit {
-            return z;
-        }
-    }
+    // Normal(0, 1) draws the same bits as the standard normal (0 + 1·z).
+    super::truncated::draw(rng, 0.0, 1.0, -limit, limit)
 }
 
 /// Draw this run's weights and put them into `scene` as explicit cargoes

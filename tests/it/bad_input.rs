@@ -73,6 +73,23 @@ pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
         "[summary]\npareto = []\n[sampling]",
         "summary.pareto",
     ),
+    // Rejection sampling that would never end (issue 33): a point interval,
+    // and a spread that leaves almost nothing inside.
+    (
+        "distribution = \"uniform\", min = 0.2, max = 0.8",
+        "distribution = \"normal_truncated\", mean = 0.5, std = 0.1, min = 0.4, max = 0.4",
+        "sampling.unbalance.max = 0.4: must be above min",
+    ),
+    (
+        "distribution = \"uniform\", min = 0.2, max = 0.8",
+        "distribution = \"normal_truncated\", mean = 0.5, std = 1e300, min = 0.4, max = 0.6",
+        "sampling.unbalance.std = 1e300: leaves less than 0.1 %",
+    ),
+    (
+        "[sampling]",
+        "[sampling.tolerances]\nmass = { sigma = 0.01, relative = true, limit = 1e-300 }\n[sampling]",
+        "sampling.tolerances.mass.limit",
+    ),
     // An off-centre race asks the weights for e_r·|M − k/ω² − ibω/ω²| more:
     // 1 mm here needs 8.9e-3 kg·m, beyond 20 % of the capacity left.
     (

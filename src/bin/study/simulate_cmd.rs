@@ -38,7 +38,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     }
     let result = simulation.run(args.series.is_some())?;
     if let (Some(path), Some(series)) = (&args.series, &result.series) {
-        let text = std::fs::read_to_string(&args.scene)?;
+        let text = autobal::input_file::read_text(&args.scene)?;
         let provenance = Provenance::new(&text, 0, "single run");
         write_series(path, series, &provenance).map_err(|e| UserError::internal(e.to_string()))?;
     }
