@@ -200,6 +200,12 @@ pub struct RunMetrics {
     /// last hold window (m), in the order of `plane_a_ref`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plane_residual_abs: Option<Vec<f64>>,
+    /// When each watched plane's whirl entered its own band δ·A_ref of the
+    /// plane for good (revolutions from t₀, the hold met), in the order of
+    /// `plane_a_ref`; `None` for a plane that did not settle. The run
+    /// settles only when every plane has.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane_settling_revs: Option<Vec<Option<f64>>>,
 }
 
 /// As derived, but the per-plane fields are shown only for rotors with
@@ -241,6 +247,9 @@ impl std::fmt::Debug for RunMetrics {
         if let Some(r) = &self.plane_residual_abs {
             s.field("plane_residual_abs", r);
         }
+        if let Some(r) = &self.plane_settling_revs {
+            s.field("plane_settling_revs", r);
+        }
         s.finish()
     }
 }
@@ -280,6 +289,7 @@ impl RunMetrics {
             balance_angle_error_deg: None,
             plane_a_ref: None,
             plane_residual_abs: None,
+            plane_settling_revs: None,
         }
     }
 }

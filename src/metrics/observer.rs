@@ -203,6 +203,9 @@ struct PlaneWatch {
     a_ref: Vec<f64>,
     r: Vec<f64>,
     rings: Vec<SquareRing>,
+    /// Each plane's "r ≤ δ·A_ref of the plane" hold: the run settles only
+    /// when every plane has.
+    holds: Vec<Hold>,
 }
 
 /// The samples first..=last of a hold window predicted on a tracked flow:
@@ -385,6 +388,7 @@ impl<'a> SettlingObserver<'a> {
                     a_ref: plane_a_refs(system, omega),
                     r: vec![0.0; n],
                     rings: vec![SquareRing::new(ring_len); n],
+                    holds: vec![Hold::default(); n],
                 }
             }),
             options,
@@ -507,14 +511,24 @@ impl<'a> SettlingObserver<'a> {
             self.merged = self.coincident().map(|(i, j)| (i, j, t));
         }
         self.ring.push(r * r);
+        let mut planes_inside = true;
         if let Some(pw) = &mut self.planes {
             plane_whirls(self.system, &self.scratch, &mut pw.r);
-            for (ring, r) in pw.rings.iter_mut().zip(&pw.r) {
+            for (((ring, r), hold), a_ref) in pw
+                .rings
+                .iter_mut()
+                .zip(&pw.r)
+                .zip(&mut pw.holds)
+                .zip(&pw.a_ref)
+            {
                 ring.push(r * r);
+                let inside = *r <= self.options.delta * a_ref;
+                hold.update(t, operating && inside, self.window);
+                planes_inside &= inside;
             }
         }
         self.r_hold
-            .update(t, operating && r <= self.band, self.window);
+            .update(t, operating && r <= self.band && planes_inside, self.window);
         self.eps_hold
             .update(t, operating && eps_inside, self.window);
         if let Some(series) = &mut self.series {
@@ -976,6 +990,12 @@ impl<'a> SettlingObserver<'a> {
                 .planes
                 .as_ref()
                 .map(|p| p.rings.iter().map(SquareRing::rms).collect()),
+            plane_settling_revs: self.planes.as_ref().map(|p| {
+                p.holds
+                    .iter()
+                    .map(|h| h.met_at.map(|t| (t - self.t0) / rev))
+                    .collect()
+            }),
         };
         (metrics, self.series)
     }

@@ -236,6 +236,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
     }
     let mut summary = rows.into_dataframe()?;
     super::plane_designs::append_columns(&mut summary, &plan.designs)?;
+    super::plane_summary::append_columns(&mut summary, df, plan, scale.tau, clock)?;
     Ok(summary)
 }
 

@@ -34,6 +34,7 @@ pub mod lock;
 pub mod merge;
 pub mod optimize_spec;
 pub mod plane_designs;
+pub mod plane_summary;
 pub mod record;
 pub mod run;
 pub mod runs_file;

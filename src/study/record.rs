@@ -108,9 +108,10 @@ pub const COUPLE_COLUMNS: [&str; 5] = [
     "plane_directions_deg",
 ];
 
-/// Columns of each watched plane's A_ref and residual (m), for rotors with
+/// Columns of each watched plane's A_ref and residual (m) and settling time
+/// (revolutions, null for a plane that did not settle), for rotors with
 /// several planes (balancer planes, then the load's planes), in plane order.
-pub const PLANE_COLUMNS: [&str; 2] = ["plane_a_ref", "plane_residual_abs"];
+pub const PLANE_COLUMNS: [&str; 3] = ["plane_a_ref", "plane_residual_abs", "plane_settling_revs"];
 
 /// Columns of the race centre's offset (m) and direction (degrees), written
 /// with the weight columns; null when neither sampled nor set by the scene.
@@ -214,7 +215,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
     }
     // Every row of a study has the same rotor: per-plane values or none.
     if rows.iter().any(|r| r.metrics.plane_a_ref.is_some()) {
-        let [a, res] = PLANE_COLUMNS;
+        let [a, res, settling] = PLANE_COLUMNS;
         columns.push(list_column(
             a,
             rows.iter()
@@ -225,6 +226,14 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             rows.iter()
                 .map(|r| r.metrics.plane_residual_abs.clone().unwrap_or_default()),
         ));
+        let per_run: Vec<Series> = rows
+            .iter()
+            .map(|r| {
+                let v = r.metrics.plane_settling_revs.clone().unwrap_or_default();
+                Series::new(PlSmallStr::EMPTY, v)
+            })
+            .collect();
+        columns.push(Column::new(settling.into(), per_run));
     }
     // All rows of a study sample a couple or none do.
     if rows.iter().any(|r| r.couple.is_some()) {
@@ -414,6 +423,21 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     };
     let plane_a_ref = optional_lists(PLANE_COLUMNS[0])?;
     let plane_residual = optional_lists(PLANE_COLUMNS[1])?;
+    // Nulls inside: a plane that did not settle.
+    let plane_settling: Option<Vec<Vec<Option<f64>>>> = match df.column(PLANE_COLUMNS[2]) {
+        Ok(c) => {
+            let list = c.list()?;
+            Some(
+                (0..list.len())
+                    .map(|i| match list.get_as_series(i) {
+                        Some(s) => Ok(s.f64()?.iter().collect()),
+                        None => Ok(Vec::new()),
+                    })
+                    .collect::<PolarsResult<_>>()?,
+            )
+        }
+        Err(_) => None,
+    };
     let couple: Option<Vec<SampledCouple>> = if df.column(COUPLE_COLUMNS[0]).is_ok() {
         let (u, fraction, direction) = (
             f64s(COUPLE_COLUMNS[0])?,
@@ -483,6 +507,10 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                     .map(|v| v[i].clone())
                     .filter(|v| !v.is_empty()),
                 plane_residual_abs: plane_residual
+                    .as_ref()
+                    .map(|v| v[i].clone())
+                    .filter(|v| !v.is_empty()),
+                plane_settling_revs: plane_settling
                     .as_ref()
                     .map(|v| v[i].clone())
                     .filter(|v| !v.is_empty()),

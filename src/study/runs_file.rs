@@ -211,9 +211,26 @@ fn window_rows(pieces: &[Piece], from: u64, to: u64) -> PolarsResult<Option<Data
     Ok(Some(window))
 }
 
+/// Per-plane columns the summary reads when a file has them (rotors with
+/// several planes).
+pub const PLANE_SUMMARY_COLUMNS: [&str; 2] = ["plane_settling_revs", "plane_residual_abs"];
+
+/// The summary's projection of the file at `path`: [`SUMMARY_COLUMNS`], and
+/// [`PLANE_SUMMARY_COLUMNS`] where the file has them.
+fn summary_projection(path: &Path) -> PolarsResult<Vec<&'static str>> {
+    let schema = if is_ipc(path) {
+        IpcReader::new(File::open(path)?).schema()?
+    } else {
+        ParquetReader::new(File::open(path)?).schema()?
+    };
+    let mut columns = SUMMARY_COLUMNS.to_vec();
+    columns.extend(PLANE_SUMMARY_COLUMNS.iter().filter(|c| schema.contains(c)));
+    Ok(columns)
+}
+
 /// The slim projection of `runs.parquet` the summary needs (about 40 bytes a run).
 pub fn read_summary_columns(path: &Path) -> PolarsResult<DataFrame> {
-    read_file(path, Some(&SUMMARY_COLUMNS))
+    read_file(path, Some(&summary_projection(path)?))
 }
 
 /// The slim projection of several pieces, stacked (for decisions taken
@@ -221,7 +238,7 @@ pub fn read_summary_columns(path: &Path) -> PolarsResult<DataFrame> {
 pub fn read_pieces_summary_columns(pieces: &[Piece]) -> PolarsResult<DataFrame> {
     let mut out: Option<DataFrame> = None;
     for piece in pieces {
-        let df = read_file(piece.path(), Some(&SUMMARY_COLUMNS))?;
+        let df = read_file(piece.path(), Some(&summary_projection(piece.path())?))?;
         match out.as_mut() {
             Some(all) => {
                 all.vstack_mut(&df)?;

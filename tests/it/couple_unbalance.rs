@@ -435,13 +435,24 @@ fn each_plane_reports_its_residual_and_the_far_end_of_a_single_balancer_whirls()
             rel(&rb, &ab, 0),
             rel(&rb, &ab, 1)
         );
-        // Settled: every plane inside the one band δ·A_ref (A_ref the largest plane's).
+        // Settled: every plane settled into its own band δ·A_ref of the
+        // plane, no later than the run (a plane's hold is met within the
+        // run's); its residual inside that band.
+        let (sa, sb) = (
+            a.plane_settling_revs.clone().unwrap(),
+            b.plane_settling_revs.clone().unwrap(),
+        );
+        assert_eq!((sa.len(), sb.len()), (2, 2));
         if a.settled {
-            assert!(
-                ra.iter().all(|r| *r < 0.05 * a.a_ref),
-                "run {id}: {ra:?} {aa:?}"
-            );
+            let run = a.settling_revs.unwrap();
+            for ((s, r), ar) in sa.iter().zip(&ra).zip(&aa) {
+                let s = s.unwrap_or_else(|| panic!("run {id}: settled with a plane unsettled"));
+                assert!(s <= run + 1e-9, "run {id}: plane at {s}, run at {run}");
+                assert!(*r < 0.05 * ar, "run {id}: {ra:?} {aa:?}");
+            }
         }
+        // The single balancer's far plane never settles.
+        assert!(!b.settled && sb[1].is_none(), "run {id}: {sb:?}");
     }
     let rows: Vec<_> = (0..2).map(|id| run_one(&one, id)).collect();
     let df = autobal::study::record::to_dataframe(&rows).unwrap();
@@ -449,5 +460,6 @@ fn each_plane_reports_its_residual_and_the_far_end_of_a_single_balancer_whirls()
     for (x, y) in rows.iter().zip(&back) {
         assert_eq!(x.metrics.plane_residual_abs, y.metrics.plane_residual_abs);
         assert_eq!(x.metrics.plane_a_ref, y.metrics.plane_a_ref);
+        assert_eq!(x.metrics.plane_settling_revs, y.metrics.plane_settling_revs);
     }
 }

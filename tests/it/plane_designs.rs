@@ -170,6 +170,29 @@ fn runs_and_summary_name_every_planes_design() {
         let cap1 = df.column("capacity_plane1").unwrap().f64().unwrap().get(0);
         assert!(cap1.is_some_and(|c| c > 0.0), "{file}");
     }
+    // Per-plane statistics: a plane's settled share is at least the run's
+    // (a run settles only when every plane has).
+    let summary = read_parquet(&out.dir.join("summary.parquet")).unwrap();
+    let overall = summary
+        .column("settled_fraction")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .clone();
+    for p in 0..2 {
+        for name in autobal::study::plane_summary::column_names(p) {
+            assert!(summary.column(&name).is_ok(), "{name}");
+        }
+        let plane = summary
+            .column(&format!("settled_fraction_plane{p}"))
+            .unwrap()
+            .f64()
+            .unwrap()
+            .clone();
+        for (o, q) in overall.iter().zip(plane.iter()) {
+            assert!(q.unwrap() >= o.unwrap(), "plane {p}: {q:?} < {o:?}");
+        }
+    }
     // A study without the table keeps its schema.
     let plain_dir = tempfile::tempdir().unwrap();
     let plain = plan(&study(plain_dir.path(), "")).unwrap();

@@ -285,6 +285,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     balance_angle_error_deg: None,
                     plane_a_ref: None,
                     plane_residual_abs: None,
+                    plane_settling_revs: None,
                 },
                 method: "dp5".into(),
                 contact: true,

@@ -238,6 +238,7 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         balance_angle_error_deg: None,
         plane_a_ref: None,
         plane_residual_abs: None,
+        plane_settling_revs: None,
     }
 }
 

@@ -80,6 +80,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             balance_angle_error_deg: None,
             plane_a_ref: None,
             plane_residual_abs: None,
+            plane_settling_revs: None,
         },
         method: "dp5".into(),
         contact: true,
