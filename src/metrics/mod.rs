@@ -206,6 +206,11 @@ pub struct RunMetrics {
     /// settles only when every plane has.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plane_settling_revs: Option<Vec<Option<f64>>>,
+    /// ε per balancer plane at the end of the run: the unbalance left, as
+    /// equivalent unbalances in each balancer plane, over U (two balancer
+    /// planes on two supports; `None` elsewhere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane_balancing_error: Option<Vec<f64>>,
 }
 
 /// As derived, but the per-plane fields are shown only for rotors with
@@ -250,6 +255,9 @@ impl std::fmt::Debug for RunMetrics {
         if let Some(r) = &self.plane_settling_revs {
             s.field("plane_settling_revs", r);
         }
+        if let Some(e) = &self.plane_balancing_error {
+            s.field("plane_balancing_error", e);
+        }
         s.finish()
     }
 }
@@ -290,6 +298,7 @@ impl RunMetrics {
             plane_a_ref: None,
             plane_residual_abs: None,
             plane_settling_revs: None,
+            plane_balancing_error: None,
         }
     }
 }

@@ -6,7 +6,8 @@ use super::never_settles::{
     Criteria, FIRST_REVS, LAG, NeverSettles, RepeatWatch, Stroboscope, WINDOW,
 };
 use super::reference::{
-    a_ref, balancing_error, plane_a_refs, plane_whirls, reference_unbalance, vibration,
+    a_ref, balancing_error, plane_a_refs, plane_balancing_errors, plane_whirls,
+    reference_unbalance, vibration,
 };
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
@@ -990,6 +991,10 @@ impl<'a> SettlingObserver<'a> {
                 .planes
                 .as_ref()
                 .map(|p| p.rings.iter().map(SquareRing::rms).collect()),
+            plane_balancing_error: self
+                .planes
+                .as_ref()
+                .and_then(|_| plane_balancing_errors(self.system, psi, self.u_ref)),
             plane_settling_revs: self.planes.as_ref().map(|p| {
                 p.holds
                     .iter()

@@ -9,7 +9,7 @@ use crate::model::system::RotorSystem;
 // The unbalance measures are model quantities (the linear analysis needs
 // them too); they are defined there and named here with the other scales.
 use crate::model::unbalance::planar_norm;
-pub use crate::model::unbalance::{balancing_error, reference_unbalance};
+pub use crate::model::unbalance::{balancing_error, plane_balancing_errors, reference_unbalance};
 
 /// A_ref at speed ω: the largest orbit radius over the watched planes
 /// (balancer planes, and the rotor's own unbalance planes) of the locked

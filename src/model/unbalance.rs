@@ -31,6 +31,20 @@ pub fn balancing_error(system: &RotorSystem, psi: &[f64], unbalance_ref: f64) ->
     system.rotor().unbalance_size(&fc) / unbalance_ref
 }
 
+/// ε per balancer plane: the unbalance of rotor and cargoes (at angles ψ)
+/// as equivalent unbalances in each balancer plane, over U; `None` where the
+/// rotor model does not define them (see
+/// [`crate::model::rotor::Rotor::plane_unbalance_sizes`]).
+pub fn plane_balancing_errors(
+    system: &RotorSystem,
+    psi: &[f64],
+    unbalance_ref: f64,
+) -> Option<Vec<f64>> {
+    let (fc, _) = unbalance_forcing(system, psi, true);
+    let sizes = system.rotor().plane_unbalance_sizes(&fc)?;
+    Some(sizes.into_iter().map(|u| u / unbalance_ref).collect())
+}
+
 /// [`balancing_error`] for repeated use on one system: what does not depend
 /// on the angles (the rotor's unbalance vector, each cargo's m l, which
 /// formula applies) is worked out once. Gives the same bits.

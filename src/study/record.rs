@@ -111,7 +111,12 @@ pub const COUPLE_COLUMNS: [&str; 5] = [
 /// Columns of each watched plane's A_ref and residual (m) and settling time
 /// (revolutions, null for a plane that did not settle), for rotors with
 /// several planes (balancer planes, then the load's planes), in plane order.
-pub const PLANE_COLUMNS: [&str; 3] = ["plane_a_ref", "plane_residual_abs", "plane_settling_revs"];
+pub const PLANE_COLUMNS: [&str; 4] = [
+    "plane_a_ref",
+    "plane_residual_abs",
+    "plane_settling_revs",
+    "plane_balancing_error",
+];
 
 /// Columns of the race centre's offset (m) and direction (degrees), written
 /// with the weight columns; null when neither sampled nor set by the scene.
@@ -215,7 +220,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
     }
     // Every row of a study has the same rotor: per-plane values or none.
     if rows.iter().any(|r| r.metrics.plane_a_ref.is_some()) {
-        let [a, res, settling] = PLANE_COLUMNS;
+        let [a, res, settling, eps] = PLANE_COLUMNS;
         columns.push(list_column(
             a,
             rows.iter()
@@ -234,6 +239,12 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             })
             .collect();
         columns.push(Column::new(settling.into(), per_run));
+        // Empty where the model defines no per-plane ε (one balancer plane).
+        columns.push(list_column(
+            eps,
+            rows.iter()
+                .map(|r| r.metrics.plane_balancing_error.clone().unwrap_or_default()),
+        ));
     }
     // All rows of a study sample a couple or none do.
     if rows.iter().any(|r| r.couple.is_some()) {
@@ -423,6 +434,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     };
     let plane_a_ref = optional_lists(PLANE_COLUMNS[0])?;
     let plane_residual = optional_lists(PLANE_COLUMNS[1])?;
+    let plane_eps = optional_lists(PLANE_COLUMNS[3])?;
     // Nulls inside: a plane that did not settle.
     let plane_settling: Option<Vec<Vec<Option<f64>>>> = match df.column(PLANE_COLUMNS[2]) {
         Ok(c) => {
@@ -511,6 +523,10 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                     .map(|v| v[i].clone())
                     .filter(|v| !v.is_empty()),
                 plane_settling_revs: plane_settling
+                    .as_ref()
+                    .map(|v| v[i].clone())
+                    .filter(|v| !v.is_empty()),
+                plane_balancing_error: plane_eps
                     .as_ref()
                     .map(|v| v[i].clone())
                     .filter(|v| !v.is_empty()),

@@ -97,6 +97,14 @@ fn each_plane_takes_the_static_part_plus_or_minus_the_couple() {
             assert_eq!(planes.len(), 2);
             assert!((planes[0] - (st + cp)).norm() <= 1e-15 * st.norm());
             assert!((planes[1] - (st - cp)).norm() <= 1e-15 * st.norm());
+            // The per-plane equivalents of the rotor's unbalance (what ε per
+            // plane measures) are these two, recovered from S and I.
+            let rotor = sim.scene.rotor.as_rotor();
+            let mut f = [0.0; autobal::model::rotor::MAX_DOF];
+            rotor.unbalance_forces(0.0, 1.0, &mut f);
+            let sizes = rotor.plane_unbalance_sizes(&f).expect("two planes");
+            assert!((sizes[0] - (st + cp).norm()).abs() <= 1e-12 * st.norm());
+            assert!((sizes[1] - (st - cp).norm()).abs() <= 1e-12 * st.norm());
             // Without the table every plane takes U_s, as before.
             for p in rotor_planes(&sim0.scene) {
                 assert!((p - st).norm() <= 1e-15 * st.norm());
@@ -453,6 +461,17 @@ fn each_plane_reports_its_residual_and_the_far_end_of_a_single_balancer_whirls()
         }
         // The single balancer's far plane never settles.
         assert!(!b.settled && sb[1].is_none(), "run {id}: {sb:?}");
+        // ε per balancer plane: two planes on two supports, small in both
+        // where they settled; one balancer plane has no such split.
+        let ea = a
+            .plane_balancing_error
+            .clone()
+            .expect("two balancer planes");
+        assert_eq!(ea.len(), 2);
+        if a.settled {
+            assert!(ea.iter().all(|e| *e < 0.05), "run {id}: {ea:?}");
+        }
+        assert!(b.plane_balancing_error.is_none());
     }
     let rows: Vec<_> = (0..2).map(|id| run_one(&one, id)).collect();
     let df = autobal::study::record::to_dataframe(&rows).unwrap();
@@ -461,5 +480,9 @@ fn each_plane_reports_its_residual_and_the_far_end_of_a_single_balancer_whirls()
         assert_eq!(x.metrics.plane_residual_abs, y.metrics.plane_residual_abs);
         assert_eq!(x.metrics.plane_a_ref, y.metrics.plane_a_ref);
         assert_eq!(x.metrics.plane_settling_revs, y.metrics.plane_settling_revs);
+        assert_eq!(
+            x.metrics.plane_balancing_error,
+            y.metrics.plane_balancing_error
+        );
     }
 }

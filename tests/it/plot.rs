@@ -286,6 +286,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     plane_a_ref: None,
                     plane_residual_abs: None,
                     plane_settling_revs: None,
+                    plane_balancing_error: None,
                 },
                 method: "dp5".into(),
                 contact: true,

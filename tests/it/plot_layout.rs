@@ -239,6 +239,7 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         plane_a_ref: None,
         plane_residual_abs: None,
         plane_settling_revs: None,
+        plane_balancing_error: None,
     }
 }
 

@@ -81,6 +81,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             plane_a_ref: None,
             plane_residual_abs: None,
             plane_settling_revs: None,
+            plane_balancing_error: None,
         },
         method: "dp5".into(),
         contact: true,

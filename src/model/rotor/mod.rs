@@ -88,6 +88,13 @@ pub trait Rotor: Any + Send + Sync + std::fmt::Debug {
     /// φ̇² on the rotor coordinates at φ = 0: |U| for the plane rotor, the
     /// largest bearing-equivalent unbalance for a rotor on two supports.
     fn unbalance_size(&self, f: &DofVec) -> f64;
+    /// The same unbalance as equivalent unbalances (kg·m) in each balancer
+    /// plane, where its planes determine them (two planes on two supports:
+    /// a static and a couple part fix one unbalance per plane); `None`
+    /// elsewhere.
+    fn plane_unbalance_sizes(&self, _f: &DofVec) -> Option<Vec<f64>> {
+        None
+    }
 }
 
 /// What a registered model adds to its equations: its parameters, as a file

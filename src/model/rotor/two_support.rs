@@ -237,6 +237,20 @@ impl Rotor for TwoSupportRotor {
         let (u1, u2) = self.bearing_unbalances(s, i);
         u1.norm().max(u2.norm())
     }
+
+    fn plane_unbalance_sizes(&self, f: &DofVec) -> Option<Vec<f64>> {
+        let &[z1, z2] = self.planes.as_slice() else {
+            return None;
+        };
+        // U1 + U2 = S and z1 U1 + z2 U2 = I, as for the bearings.
+        let s = Complex64::new(f[0], f[1]);
+        let i = Complex64::new(f[3], -f[2]);
+        let span = z2 - z1;
+        Some(vec![
+            ((z2 * s - i) / span).norm(),
+            ((i - z1 * s) / span).norm(),
+        ])
+    }
 }
 
 impl RotorParams for TwoSupportRotor {
