@@ -55,6 +55,9 @@ pub struct Side {
     pub clock: SettlingClock,
     /// The criterion its study ranks by (`[summary] rank_by`).
     pub default_criterion: Criterion,
+    /// Each watched plane's statistics (rotors with several planes; empty
+    /// otherwise).
+    pub plane_stats: Vec<super::plane_summary::PlaneStats>,
     /// Sampled unbalance (fraction of capacity) and direction of each run.
     draws: Vec<(Option<f64>, Option<f64>)>,
 }
@@ -94,17 +97,19 @@ impl Side {
             .into_iter()
             .next()
             .ok_or_else(|| CompareError::NotAStudy(format!("{shown} (design {id} has no runs)")))?;
+        let rows: Vec<usize> = (0..mine.height()).collect();
+        let plane_stats = match super::plane_summary::PlaneRuns::read(&mine)? {
+            Some(planes) => (0..planes.planes)
+                .map(|p| planes.stats(&rows, p, horizon, clock))
+                .collect(),
+            None => Vec::new(),
+        };
         let fraction = mine.column("unbalance_fraction")?.f64()?;
         let direction = mine.column("direction_deg")?.f64()?;
         Ok(Side {
             dir: dir.to_path_buf(),
-            label: format!(
-                "{} n={} ρ={:.4} β={}",
-                d.spec.kind.name(),
-                d.spec.n,
-                d.rho,
-                d.spec.drag
-            ),
+            label: super::plane_designs::short_label(d),
+            plane_stats,
             runs,
             horizon,
             scale,

@@ -244,3 +244,24 @@ pub fn describe(d: &Design) -> String {
         .collect::<Vec<_>>()
         .join("; ")
 }
+
+/// A design in one short line, "ball n=8 ρ=0.0400 β=0.05", each value
+/// joined by "/" over the planes where they differ ("n=2/3").
+pub fn short_label(d: &Design) -> String {
+    let planes: Vec<&Design> = std::iter::once(d).chain(&d.plane_designs).collect();
+    let joined = |f: &dyn Fn(&Design) -> String| {
+        let values: Vec<String> = planes.iter().map(|p| f(p)).collect();
+        if values.iter().all(|v| *v == values[0]) {
+            values[0].clone()
+        } else {
+            values.join("/")
+        }
+    };
+    format!(
+        "{} n={} ρ={} β={}",
+        joined(&|p| p.spec.kind.name().to_string()),
+        joined(&|p| p.spec.n.to_string()),
+        joined(&|p| format!("{:.4}", p.rho)),
+        joined(&|p| p.spec.drag.to_string())
+    )
+}

@@ -32,11 +32,93 @@ fn lists(runs: &DataFrame, name: &str) -> PolarsResult<Vec<Vec<Option<f64>>>> {
         .collect()
 }
 
+/// One plane's statistics over a set of runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneStats {
+    /// Share of the runs in which the plane settled.
+    pub settled_fraction: Option<f64>,
+    /// Kaplan–Meier median of when it settled (revolutions, as the clock counts).
+    pub settling_median_km: Option<f64>,
+    /// 95th percentile of its absolute residual (m).
+    pub residual_abs_p95: Option<f64>,
+}
+
+/// The per-plane columns of a runs table (summary projection or whole).
+pub struct PlaneRuns {
+    settling: Vec<Vec<Option<f64>>>,
+    residual: Vec<Vec<Option<f64>>>,
+    censoring: Vec<Option<f64>>,
+    operating: Vec<Option<f64>>,
+    /// Watched planes.
+    pub planes: usize,
+}
+
+impl PlaneRuns {
+    /// The per-plane columns of `runs`; `None` when it has none.
+    pub fn read(runs: &DataFrame) -> PolarsResult<Option<PlaneRuns>> {
+        if runs.column("plane_settling_revs").is_err() {
+            return Ok(None);
+        }
+        let settling = lists(runs, "plane_settling_revs")?;
+        let planes = settling.iter().map(Vec::len).max().unwrap_or(0);
+        if planes == 0 {
+            return Ok(None);
+        }
+        Ok(Some(PlaneRuns {
+            residual: lists(runs, "plane_residual_abs")?,
+            settling,
+            censoring: runs.column("censoring_revs")?.f64()?.iter().collect(),
+            operating: runs.column("operating_time_s")?.f64()?.iter().collect(),
+            planes,
+        }))
+    }
+
+    /// Plane p's statistics over the runs at `rows`, times counted by
+    /// `clock`; a plane that did not settle is censored where its run was
+    /// (or at `tau`).
+    pub fn stats(&self, rows: &[usize], p: usize, tau: f64, clock: SettlingClock) -> PlaneStats {
+        let mut observations = Vec::with_capacity(rows.len());
+        let mut residuals = Vec::new();
+        for &i in rows {
+            let offset = match clock {
+                SettlingClock::FromStart => 0.0,
+                SettlingClock::FromOperatingSpeed(rev) => {
+                    self.operating[i].map_or(0.0, |t| t / rev)
+                }
+            };
+            observations.push(match self.settling[i].get(p).copied().flatten() {
+                Some(t) => Observation {
+                    time: (t - offset).max(0.0),
+                    settled: true,
+                },
+                None => Observation {
+                    time: (self.censoring[i].unwrap_or(tau) - offset).max(0.0),
+                    settled: false,
+                },
+            });
+            if let Some(r) = self.residual[i]
+                .get(p)
+                .copied()
+                .flatten()
+                .filter(|r| r.is_finite())
+            {
+                residuals.push(r);
+            }
+        }
+        let settled = observations.iter().filter(|o| o.settled).count();
+        residuals.sort_by(f64::total_cmp);
+        PlaneStats {
+            settled_fraction: (!rows.is_empty()).then(|| settled as f64 / rows.len() as f64),
+            settling_median_km: KaplanMeier::fit(&observations).and_then(|km| km.median()),
+            residual_abs_p95: quantile_sorted(&residuals, 0.95, Interpolation::Linear),
+        }
+    }
+}
+
 /// Append the per-plane columns to `summary` (one row per design of `plan`,
 /// in plan order) from `runs` (the summary's projection of the runs
 /// table); nothing when the runs carry no per-plane settling times. Times
-/// are counted as the design-level ones are (`clock`); a plane that did not
-/// settle is censored where its run was (or at `tau`).
+/// are counted as the design-level ones are (`clock`).
 pub fn append_columns(
     summary: &mut DataFrame,
     runs: &DataFrame,
@@ -44,57 +126,20 @@ pub fn append_columns(
     tau: f64,
     clock: SettlingClock,
 ) -> PolarsResult<()> {
-    if runs.column("plane_settling_revs").is_err() {
+    let Some(planes) = PlaneRuns::read(runs)? else {
         return Ok(());
-    }
-    let settling = lists(runs, "plane_settling_revs")?;
-    let residual = lists(runs, "plane_residual_abs")?;
-    let planes = settling.iter().map(Vec::len).max().unwrap_or(0);
-    if planes == 0 {
-        return Ok(());
-    }
+    };
     let design = runs.column("design_id")?.u32()?;
-    let censoring = runs.column("censoring_revs")?.f64()?;
-    let operating = runs.column("operating_time_s")?.f64()?;
-    let mut columns: Vec<[Vec<Option<f64>>; 3]> = vec![Default::default(); planes];
+    let mut columns: Vec<[Vec<Option<f64>>; 3]> = vec![Default::default(); planes.planes];
     for d in &plan.designs {
         let rows: Vec<usize> = (0..runs.height())
             .filter(|&i| design.get(i) == Some(d.id))
             .collect();
         for (p, out) in columns.iter_mut().enumerate() {
-            let mut observations = Vec::with_capacity(rows.len());
-            let mut residuals = Vec::new();
-            for &i in &rows {
-                let offset = match clock {
-                    SettlingClock::FromStart => 0.0,
-                    SettlingClock::FromOperatingSpeed(rev) => {
-                        operating.get(i).map_or(0.0, |t| t / rev)
-                    }
-                };
-                observations.push(match settling[i].get(p).copied().flatten() {
-                    Some(t) => Observation {
-                        time: (t - offset).max(0.0),
-                        settled: true,
-                    },
-                    None => Observation {
-                        time: (censoring.get(i).unwrap_or(tau) - offset).max(0.0),
-                        settled: false,
-                    },
-                });
-                if let Some(r) = residual[i]
-                    .get(p)
-                    .copied()
-                    .flatten()
-                    .filter(|r| r.is_finite())
-                {
-                    residuals.push(r);
-                }
-            }
-            let settled = observations.iter().filter(|o| o.settled).count();
-            out[0].push((!rows.is_empty()).then(|| settled as f64 / rows.len() as f64));
-            out[1].push(KaplanMeier::fit(&observations).and_then(|km| km.median()));
-            residuals.sort_by(f64::total_cmp);
-            out[2].push(quantile_sorted(&residuals, 0.95, Interpolation::Linear));
+            let s = planes.stats(&rows, p, tau, clock);
+            out[0].push(s.settled_fraction);
+            out[1].push(s.settling_median_km);
+            out[2].push(s.residual_abs_p95);
         }
     }
     for (p, values) in columns.into_iter().enumerate() {

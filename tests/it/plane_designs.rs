@@ -193,6 +193,21 @@ fn runs_and_summary_name_every_planes_design() {
             assert!(q.unwrap() >= o.unwrap(), "plane {p}: {q:?} < {o:?}");
         }
     }
+    // `study compare` names each plane's design and reports every plane.
+    let shown = std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["compare", out.dir.to_str().unwrap(), "--designs", "0,1"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&shown.stdout);
+    assert!(shown.status.success(), "{text}");
+    for needed in [
+        "n=2/3",
+        "n=2/4",
+        "plane 0: settled",
+        "plane 1: residual p95 (µm)",
+    ] {
+        assert!(text.contains(needed), "{needed}: {text}");
+    }
     // A study without the table keeps its schema.
     let plain_dir = tempfile::tempdir().unwrap();
     let plain = plan(&study(plain_dir.path(), "")).unwrap();

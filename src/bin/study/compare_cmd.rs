@@ -8,6 +8,7 @@ use autobal::plot::km::{KmCurve, plot_kaplan_meier};
 use autobal::stats::holm::holm_adjust;
 use autobal::study::compare_designs::{Side, common_scale, compare_sides, median_with_interval};
 use autobal::study::criterion::Criterion;
+use autobal::study::plane_summary::PlaneStats;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -145,11 +146,15 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         "residual/A_ref, p95",
         "folder",
     ];
-    let rows: Vec<Vec<String>> = names
+    let mut rows: Vec<Vec<String>> = names
         .iter()
         .enumerate()
         .map(|(i, n)| vec![n.to_string(), ca[i].clone(), cb[i].clone()])
         .collect();
+    // Before the folder row, which closes the table.
+    let folder = rows.pop();
+    rows.extend(plane_rows(&a, &b));
+    rows.extend(folder);
     print!("{}", text_table(&["", "A", "B"], &rows));
     println!(
         "(settling times counted {}; a run that did not settle counts as censored; restricted mean and p90 up to τ = {:.1} rev, the earlier horizon of the two)",
@@ -294,6 +299,42 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
 }
 
 /// Draw the Kaplan–Meier curves of both sides into `path`.
+/// Each watched plane's settled share, median settling time and residual
+/// p95 for sides on rotors with several planes (a side without them shows "–").
+fn plane_rows(a: &Side, b: &Side) -> Vec<Vec<String>> {
+    let planes = a.plane_stats.len().max(b.plane_stats.len());
+    let cell = |side: &Side, p: usize, f: &dyn Fn(&PlaneStats) -> Option<String>| {
+        side.plane_stats
+            .get(p)
+            .and_then(f)
+            .unwrap_or_else(|| "–".into())
+    };
+    let mut rows = Vec::new();
+    for p in 0..planes {
+        let named: [(String, &dyn Fn(&PlaneStats) -> Option<String>); 3] = [
+            (format!("plane {p}: settled"), &|s| {
+                s.settled_fraction.map(|f| format!("{f:.3}"))
+            }),
+            (
+                format!("plane {p}: t_s median, Kaplan–Meier (rev)"),
+                &|s| {
+                    Some(
+                        s.settling_median_km
+                            .map_or("beyond the run".into(), |m| format!("{m:.1}")),
+                    )
+                },
+            ),
+            (format!("plane {p}: residual p95 (µm)"), &|s| {
+                s.residual_abs_p95.map(|r| format!("{:.1}", r * 1e6))
+            }),
+        ];
+        for (name, f) in named {
+            rows.push(vec![name, cell(a, p, f), cell(b, p, f)]);
+        }
+    }
+    rows
+}
+
 fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
     let curve = |name: &str, side: &Side| KmCurve {
         label: format!("{name}: {}", side.label),
