@@ -299,11 +299,14 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
 }
 
 /// Draw the Kaplan–Meier curves of both sides into `path`.
+/// How one plane statistic is shown ("–" where it is missing).
+type PlaneCell = dyn Fn(&PlaneStats) -> Option<String>;
+
 /// Each watched plane's settled share, median settling time and residual
 /// p95 for sides on rotors with several planes (a side without them shows "–").
 fn plane_rows(a: &Side, b: &Side) -> Vec<Vec<String>> {
     let planes = a.plane_stats.len().max(b.plane_stats.len());
-    let cell = |side: &Side, p: usize, f: &dyn Fn(&PlaneStats) -> Option<String>| {
+    let cell = |side: &Side, p: usize, f: &PlaneCell| {
         side.plane_stats
             .get(p)
             .and_then(f)
@@ -311,7 +314,7 @@ fn plane_rows(a: &Side, b: &Side) -> Vec<Vec<String>> {
     };
     let mut rows = Vec::new();
     for p in 0..planes {
-        let named: [(String, &dyn Fn(&PlaneStats) -> Option<String>); 3] = [
+        let named: [(String, &PlaneCell); 3] = [
             (format!("plane {p}: settled"), &|s| {
                 s.settled_fraction.map(|f| format!("{f:.3}"))
             }),
