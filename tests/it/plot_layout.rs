@@ -293,6 +293,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                 settled_fraction: p,
                 settled_lo: (p - 0.12).max(0.0),
                 settled_hi: (p + 0.06).min(1.0),
+                planes: Vec::new(),
             });
         }
     }

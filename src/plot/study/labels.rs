@@ -19,9 +19,25 @@ pub(super) fn labels(designs: &[DesignStats]) -> Labels {
         let first = f(&designs[0]);
         designs.iter().any(|d| f(d) != first)
     };
-    let weights = |d: &DesignStats| weight_count(d.n, &d.kind);
-    let rho = |d: &DesignStats| format!("ρ = {}", short(d.rho));
-    let drag = |d: &DesignStats| format!("β = {} N·s/m", short(d.drag));
+    let weights = |d: &DesignStats| match per_plane(d, |p| p.n.to_string()) {
+        Some(ns) => format!(
+            "{ns} {}s",
+            per_plane(d, |p| p.kind.clone()).unwrap_or_default()
+        ),
+        None => weight_count(d.n, &d.kind),
+    };
+    let rho = |d: &DesignStats| {
+        format!(
+            "ρ = {}",
+            per_plane(d, |p| short(p.rho)).unwrap_or_else(|| short(d.rho))
+        )
+    };
+    let drag = |d: &DesignStats| {
+        format!(
+            "β = {} N·s/m",
+            per_plane(d, |p| short(p.drag)).unwrap_or_else(|| short(d.drag))
+        )
+    };
     let parts: [&dyn Fn(&DesignStats) -> String; 3] = [&weights, &rho, &drag];
     let (vary, fixed): (Vec<_>, Vec<_>) = parts.iter().partition(|f| varies(**f));
     let per_design = designs
@@ -45,6 +61,19 @@ pub(super) fn labels(designs: &[DesignStats]) -> Labels {
     Labels { per_design, common }
 }
 
+/// A value over a design's balancer planes: one value where every plane
+/// has it, else each plane's joined by "/" ("2/3"); `None` without
+/// designs per plane.
+fn per_plane(d: &DesignStats, f: impl Fn(&super::PlaneDesignStats) -> String) -> Option<String> {
+    let values: Vec<String> = d.planes.iter().map(f).collect();
+    let first = values.first()?;
+    Some(if values.iter().all(|v| v == first) {
+        first.clone()
+    } else {
+        values.join("/")
+    })
+}
+
 /// "3 balls", "1 roller".
 pub(super) fn weight_count(n: u32, kind: &str) -> String {
     if n == 1 {
@@ -56,11 +85,15 @@ pub(super) fn weight_count(n: u32, kind: &str) -> String {
 
 /// Index of each design's geometry (kind, n, ρ): designs sharing it share a colour or panel.
 pub(super) fn geometries(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
-    let mut keys: Vec<(String, u32, f64)> = Vec::new();
+    let mut keys: Vec<(String, String, String)> = Vec::new();
     let index = designs
         .iter()
         .map(|d| {
-            let key = (d.kind.clone(), d.n, d.rho);
+            let key = (
+                per_plane(d, |p| p.kind.clone()).unwrap_or_else(|| d.kind.clone()),
+                per_plane(d, |p| p.n.to_string()).unwrap_or_else(|| d.n.to_string()),
+                per_plane(d, |p| short(p.rho)).unwrap_or_else(|| short(d.rho)),
+            );
             match keys.iter().position(|k| *k == key) {
                 Some(i) => i,
                 None => {
@@ -72,7 +105,13 @@ pub(super) fn geometries(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
         .collect();
     let names = keys
         .iter()
-        .map(|(kind, n, rho)| format!("{}, ρ = {}", weight_count(*n, kind), short(*rho)))
+        .map(|(kind, n, rho)| {
+            let weights = match n.parse::<u32>() {
+                Ok(n) => weight_count(n, kind),
+                Err(_) => format!("{n} {kind}s"),
+            };
+            format!("{weights}, ρ = {rho}")
+        })
         .collect();
     (index, names)
 }
@@ -121,9 +160,39 @@ mod tests {
             settled_fraction: 1.0,
             settled_lo: 0.7,
             settled_hi: 1.0,
+            planes: Vec::new(),
         };
         let l = labels(&[d(0, 0.25, 2.0), d(1, 0.25, 5.0)]);
         assert_eq!(l.per_design, vec!["β = 2 N·s/m", "β = 5 N·s/m"]);
         assert_eq!(l.common, "3 balls, ρ = 0.25");
+    }
+
+    #[test]
+    fn designs_per_plane_name_each_planes_count() {
+        let plane = |n| super::super::PlaneDesignStats {
+            kind: "ball".into(),
+            n,
+            rho: 0.1,
+            drag: 0.5,
+        };
+        let d = |id, n1| DesignStats {
+            design_id: id,
+            kind: "ball".into(),
+            n: 2,
+            rho: 0.1,
+            drag: 0.5,
+            runs: 10,
+            settled_fraction: 1.0,
+            settled_lo: 0.7,
+            settled_hi: 1.0,
+            planes: vec![plane(2), plane(n1)],
+        };
+        let designs = [d(0, 3), d(1, 4)];
+        let l = labels(&designs);
+        assert_eq!(l.per_design, vec!["2/3 balls", "2/4 balls"]);
+        assert_eq!(l.common, "ρ = 0.1, β = 0.5 N·s/m");
+        let (index, names) = geometries(&designs);
+        assert_eq!(index, vec![0, 1]);
+        assert_eq!(names, vec!["2/3 balls, ρ = 0.1", "2/4 balls, ρ = 0.1"]);
     }
 }

@@ -43,6 +43,44 @@ pub struct DesignStats {
     pub settled_lo: f64,
     /// Upper end of its Wilson 95 % interval.
     pub settled_hi: f64,
+    /// Every balancer plane's (kind, n, ρ, β) when the planes have designs
+    /// of their own (`kind_plane0`, … columns of the summary); empty otherwise.
+    pub planes: Vec<PlaneDesignStats>,
+}
+
+/// One balancer plane's design as the summary names it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneDesignStats {
+    /// Balancer kind.
+    pub kind: String,
+    /// Number of weights.
+    pub n: u32,
+    /// Radius ratio ρ.
+    pub rho: f64,
+    /// Drag coefficient β (N·s/m).
+    pub drag: f64,
+}
+
+/// Each row's per-plane designs, from the `kind_plane{p}` … columns.
+fn plane_designs(summary: &DataFrame) -> Result<Vec<Vec<PlaneDesignStats>>, PlotError> {
+    let mut rows = vec![Vec::new(); summary.height()];
+    let mut p = 0;
+    while summary.column(&format!("n_plane{p}")).is_ok() {
+        let kinds = summary.column(&format!("kind_plane{p}"))?.str()?.clone();
+        let ns = summary.column(&format!("n_plane{p}"))?.u32()?.clone();
+        let rho = summary.column(&format!("rho_plane{p}"))?.f64()?.clone();
+        let drag = summary.column(&format!("drag_plane{p}"))?.f64()?.clone();
+        for (i, row) in rows.iter_mut().enumerate() {
+            row.push(PlaneDesignStats {
+                kind: kinds.get(i).unwrap_or_default().to_string(),
+                n: ns.get(i).unwrap_or_default(),
+                rho: rho.get(i).unwrap_or(f64::NAN),
+                drag: drag.get(i).unwrap_or(f64::NAN),
+            });
+        }
+        p += 1;
+    }
+    Ok(rows)
 }
 
 /// The rows of a summary DataFrame written by `study run`.
@@ -65,6 +103,7 @@ pub fn design_stats(summary: &DataFrame) -> Result<Vec<DesignStats>, PlotError> 
         f64s("settled_fraction_hi")?,
     );
     let (ids, ns, runs) = (ids.u32()?, ns.u32()?, runs.u64()?);
+    let mut planes = plane_designs(summary)?.into_iter();
     (0..summary.height())
         .map(|i| {
             Ok(DesignStats {
@@ -79,6 +118,7 @@ pub fn design_stats(summary: &DataFrame) -> Result<Vec<DesignStats>, PlotError> 
                 settled_fraction: frac[i],
                 settled_lo: lo[i],
                 settled_hi: hi[i],
+                planes: planes.next().unwrap_or_default(),
             })
         })
         .collect()
