@@ -9,7 +9,7 @@
 //!
 //! Both Parquet files carry the usual provenance metadata as well.
 
-use super::samples::{COLUMNS, DesignSample, design_samples};
+use super::samples::{DesignSample, columns_of, design_samples};
 use crate::study::aggregate::summarize;
 use crate::study::config::StudyPlan;
 use crate::study::io::{Provenance, read_metadata, read_parquet, write_parquet, write_text};
@@ -125,7 +125,8 @@ pub fn write_baseline(
         std::fs::remove_file(&manifest_path)?;
     }
     let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
-    let mut df = to_dataframe(runs)?.select(COLUMNS)?;
+    let all = to_dataframe(runs)?;
+    let mut df = all.select(columns_of(&all))?;
     write_parquet(&dir.join("runs.parquet"), &mut df, &provenance)?;
     let mut summary = summarize(plan, runs)?;
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;

@@ -26,23 +26,29 @@ pub enum Metric {
     SettledFraction,
     /// Median residual vibration (relative to A_ref): Mood's median test.
     ResidualMedian,
+    /// When watched plane p settled, in the runs where it did: two-sample KS.
+    PlaneSettlingTime(u32),
+    /// Fraction of runs in which watched plane p settled: Fisher's exact test.
+    PlaneSettledFraction(u32),
 }
 
 impl Metric {
     /// Short name used in tables.
-    pub fn name(self) -> &'static str {
+    pub fn name(self) -> String {
         match self {
-            Metric::SettlingTime => "settling_revs",
-            Metric::SettledFraction => "settled_fraction",
-            Metric::ResidualMedian => "residual_rel",
+            Metric::SettlingTime => "settling_revs".into(),
+            Metric::SettledFraction => "settled_fraction".into(),
+            Metric::ResidualMedian => "residual_rel".into(),
+            Metric::PlaneSettlingTime(p) => format!("settling_revs_plane{p}"),
+            Metric::PlaneSettledFraction(p) => format!("settled_fraction_plane{p}"),
         }
     }
 
     /// The test applied.
     pub fn test(self) -> &'static str {
         match self {
-            Metric::SettlingTime => "KS",
-            Metric::SettledFraction => "Fisher",
+            Metric::SettlingTime | Metric::PlaneSettlingTime(_) => "KS",
+            Metric::SettledFraction | Metric::PlaneSettledFraction(_) => "Fisher",
             Metric::ResidualMedian => "Mood",
         }
     }
@@ -214,6 +220,31 @@ pub fn compare(
             (b.residual_rel.len() as u64, n.residual_rel.len() as u64),
             mood.map(|m| m.p_value),
         ));
+        // Watched planes: tested where both sides have them.
+        for (p, (bp, np)) in b.planes.iter().zip(&n.planes).enumerate() {
+            let p = p as u32;
+            let (mb, mn) = (median(&bp.settling_revs), median(&np.settling_revs));
+            let ks = ks_two_sample(&bp.settling_revs, &np.settling_revs);
+            rows.push(row(
+                Metric::PlaneSettlingTime(p),
+                mb,
+                mn,
+                relative(mb, mn),
+                ks.map(|k| k.statistic),
+                (bp.settling_revs.len() as u64, np.settling_revs.len() as u64),
+                ks.map(|k| k.p_value),
+            ));
+            let fraction = fisher_two_proportions(bp.settled, b.runs, np.settled, n.runs);
+            rows.push(row(
+                Metric::PlaneSettledFraction(p),
+                fraction.map(|f| f.a),
+                fraction.map(|f| f.b),
+                fraction.map(|f| f.difference),
+                None,
+                (b.runs, n.runs),
+                fraction.map(|f| f.p_value),
+            ));
+        }
     }
     let tested: Vec<usize> = (0..rows.len())
         .filter(|&i| rows[i].p_value.is_some())
@@ -239,6 +270,7 @@ pub fn compare(
                 && b.settled == n.settled
                 && b.settling_revs == n.settling_revs
                 && b.residual_rel == n.residual_rel
+                && b.planes == n.planes
         }),
     })
 }

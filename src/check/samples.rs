@@ -22,6 +22,27 @@ pub const COLUMNS: [&str; 11] = [
     "residual_rel",
 ];
 
+/// Per-plane column a check also reads when a runs table has it (rotors
+/// with several planes; a baseline keeps it).
+pub const PLANE_COLUMNS: [&str; 1] = ["plane_settling_revs"];
+
+/// The columns a check reads from `df`: [`COLUMNS`], and [`PLANE_COLUMNS`]
+/// where `df` has them.
+pub fn columns_of(df: &DataFrame) -> Vec<&'static str> {
+    let mut columns = COLUMNS.to_vec();
+    columns.extend(PLANE_COLUMNS.iter().filter(|c| df.column(c).is_ok()));
+    columns
+}
+
+/// One watched plane's runs of a design, reduced to what the tests compare.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlaneSample {
+    /// Runs in which the plane settled.
+    pub settled: u64,
+    /// When it settled (revolutions), in run order.
+    pub settling_revs: Vec<f64>,
+}
+
 /// One design's runs, reduced to what the tests compare.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DesignSample {
@@ -37,6 +58,8 @@ pub struct DesignSample {
     pub settling_revs: Vec<f64>,
     /// residual_rel of the runs simulated to the end, in run order.
     pub residual_rel: Vec<f64>,
+    /// Each watched plane's runs (rotors with several planes; empty otherwise).
+    pub planes: Vec<PlaneSample>,
 }
 
 /// Split a runs table into one sample per design, in design order.
@@ -50,6 +73,20 @@ pub fn design_samples(df: &DataFrame) -> PolarsResult<Vec<DesignSample>> {
     let settled = df.column("settled")?.bool()?.clone();
     let revs = df.column("settling_revs")?.f64()?.clone();
     let residual = df.column("residual_rel")?.f64()?.clone();
+    let plane_settling: Option<Vec<Vec<Option<f64>>>> = match df.column(PLANE_COLUMNS[0]) {
+        Ok(c) => {
+            let list = c.list()?;
+            Some(
+                (0..list.len())
+                    .map(|i| match list.get_as_series(i) {
+                        Some(s) => Ok(s.f64()?.iter().collect()),
+                        None => Ok(Vec::new()),
+                    })
+                    .collect::<PolarsResult<_>>()?,
+            )
+        }
+        Err(_) => None,
+    };
     let mut out: Vec<DesignSample> = Vec::new();
     let mut order: Vec<usize> = (0..df.height()).collect();
     order.sort_by_key(|&i| design[i]);
@@ -68,10 +105,22 @@ pub fn design_samples(df: &DataFrame) -> PolarsResult<Vec<DesignSample>> {
                 settled: 0,
                 settling_revs: Vec::new(),
                 residual_rel: Vec::new(),
+                planes: Vec::new(),
             });
         }
         let s = out.last_mut().expect("pushed above");
         s.runs += 1;
+        if let Some(per_run) = plane_settling.as_ref().map(|v| &v[i]) {
+            if s.planes.len() < per_run.len() {
+                s.planes.resize(per_run.len(), PlaneSample::default());
+            }
+            for (plane, t) in s.planes.iter_mut().zip(per_run) {
+                if let Some(t) = t {
+                    plane.settled += 1;
+                    plane.settling_revs.push(*t);
+                }
+            }
+        }
         if settled.get(i) == Some(true) {
             s.settled += 1;
             if let Some(t) = revs.get(i) {

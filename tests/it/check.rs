@@ -416,6 +416,7 @@ fn planted_changes_do_what_they_say() {
         settled: 4,
         settling_revs: vec![10.0, 40.0, 95.0, 20.0],
         residual_rel: vec![0.01; 10],
+        planes: Vec::new(),
     };
     let slower = &plant(std::slice::from_ref(&s), Planted::SettlingTime(0.1), 100.0)[0];
     assert_eq!(slower.settling_revs, vec![11.0, 44.0, 22.0]);

@@ -258,3 +258,50 @@ fn a_bad_per_plane_entry_is_refused_naming_its_key() {
     let err = plan(&one_plane).expect_err("one plane");
     assert!(err.contains("designs.per_plane"), "{err}");
 }
+
+#[test]
+fn check_tests_every_plane_against_a_baseline() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("planes.toml");
+    std::fs::write(&file, study(dir.path(), PLANE_ONE)).unwrap();
+    let study_cmd = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let base = dir.path().join("base");
+    let made = study_cmd(&[
+        "baseline",
+        file.to_str().unwrap(),
+        "--out",
+        base.to_str().unwrap(),
+    ]);
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let checked = study_cmd(&[
+        "check",
+        file.to_str().unwrap(),
+        "--baseline",
+        base.to_str().unwrap(),
+        "--json",
+    ]);
+    let text = String::from_utf8_lossy(&checked.stdout);
+    assert!(checked.status.success(), "{text}");
+    let report: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let metrics: Vec<String> = report["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["metric"].to_string())
+        .collect();
+    // Both watched planes of every design are tested, beside the design's own metrics.
+    for needed in ["plane_settled_fraction", "plane_settling_time"] {
+        let count = metrics.iter().filter(|m| m.contains(needed)).count();
+        assert_eq!(count, 2 * 4, "{needed}: {metrics:?}");
+    }
+    assert_eq!(report["identical"], true, "{text}");
+}

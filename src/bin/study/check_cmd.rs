@@ -172,8 +172,8 @@ fn short(commit: &str) -> &str {
 fn verdict_table(report: &CheckReport) -> String {
     let value = |metric: Metric, v: Option<f64>| match (metric, v) {
         (_, None) => "–".to_string(),
-        (Metric::SettlingTime, Some(x)) => format!("{x:.1}"),
-        (Metric::SettledFraction, Some(x)) => format!("{x:.3}"),
+        (Metric::SettlingTime | Metric::PlaneSettlingTime(_), Some(x)) => format!("{x:.1}"),
+        (Metric::SettledFraction | Metric::PlaneSettledFraction(_), Some(x)) => format!("{x:.3}"),
         (Metric::ResidualMedian, Some(x)) => format!("{x:.3e}"),
     };
     let p = |v: Option<f64>| match v {
@@ -187,7 +187,9 @@ fn verdict_table(report: &CheckReport) -> String {
         .map(|r| {
             let effect = match (r.metric, r.effect) {
                 (_, None) => "–".to_string(),
-                (Metric::SettledFraction, Some(e)) => format!("{:+.1} pp", 100.0 * e),
+                (Metric::SettledFraction | Metric::PlaneSettledFraction(_), Some(e)) => {
+                    format!("{:+.1} pp", 100.0 * e)
+                }
                 (_, Some(e)) => format!("{:+.1} %", 100.0 * e),
             };
             let effect = match r.statistic {
