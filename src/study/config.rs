@@ -751,11 +751,8 @@ impl StudyFile {
         )
         .map_err(|(k, v, r)| invalid(&k, v, &r))?;
         if !self.designs.per_plane.is_empty() {
-            // Both build every weight from plane 0's design today.
-            let other = [
-                ("sampling.tolerances", s.tolerances.is_some()),
-                ("optimize", self.optimize.is_some()),
-            ];
+            // The optimiser builds its candidates from plane 0's axes.
+            let other = [("optimize", self.optimize.is_some())];
             if let Some((key, _)) = other.iter().find(|(_, given)| *given) {
                 return Err(invalid(
                     key,
@@ -1019,7 +1016,10 @@ impl StudyFile {
                                     self.resolve_design(designs.len() as u32, spec.clone())?;
                                 let plane_designs = other
                                     .into_iter()
-                                    .map(|s| self.resolve_plane_design(s))
+                                    .map(|s| {
+                                        self.resolve_plane_design(s)
+                                            .map(|p| Design { id: design.id, ..p })
+                                    })
                                     .collect::<Result<Vec<_>, _>>()?;
                                 let capacity = plane_designs
                                     .iter()

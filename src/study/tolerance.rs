@@ -163,7 +163,11 @@ pub fn validate(
                 ),
             ));
         }
-        for d in designs {
+        // Every plane's balancer, where planes have designs of their own.
+        for d in designs
+            .iter()
+            .flat_map(|d| std::iter::once(d).chain(&d.plane_designs))
+        {
             let nominal = match name {
                 "mass" => lightest_mass(t, d),
                 _ => d.spec.race_radius * d.rho,
@@ -277,7 +281,12 @@ pub fn apply(
     };
     // Plan validation built these for every design and every reachable radius.
     let nominal = scene.cargoes().expect("the plan validated the design");
-    let geometry = nominal_geometry(design).expect("the plan validated the design");
+    // The design of the plane a weight runs in (plane 0's unless planes
+    // have designs of their own).
+    let design_of = |plane: usize| match plane {
+        0 => design,
+        p => design.plane_designs.get(p - 1).unwrap_or(design),
+    };
     let seed = plan.file.seed;
     let mut mass_rng = stream(seed, shared, sample, Purpose::MassTolerance);
     let mut radius_rng = stream(seed, shared, sample, Purpose::RadiusTolerance);
@@ -285,13 +294,15 @@ pub fn apply(
     for c in nominal {
         let mut c = match &t.radius {
             Some(tol) => {
+                let own = design_of(c.plane);
+                let geometry = nominal_geometry(own).expect("the plan validated the design");
                 let z = truncated(&mut radius_rng, tol.limit);
                 let r = tol.apply(geometry.weight_radius(), z);
                 let rebuilt = Geometry {
                     rho: r / geometry.race_radius,
                     ..geometry
                 };
-                let mut w = design
+                let mut w = own
                     .spec
                     .kind
                     .model()

@@ -221,27 +221,39 @@ fn a_bad_per_plane_entry_is_refused_naming_its_key() {
     let dir = tempfile::tempdir().unwrap();
     let two = |entry: &str| study(dir.path(), entry);
     let cases = [
-        (two("[[designs.per_plane]]\nplane = 0\nn = 3"), "designs.per_plane[0].plane"),
-        (two("[[designs.per_plane]]\nplane = 2\nn = 3"), "designs.per_plane[0].plane"),
+        (
+            two("[[designs.per_plane]]\nplane = 0\nn = 3"),
+            "designs.per_plane[0].plane",
+        ),
+        (
+            two("[[designs.per_plane]]\nplane = 2\nn = 3"),
+            "designs.per_plane[0].plane",
+        ),
         (
             two("[[designs.per_plane]]\nplane = 1\nn = 3\n[[designs.per_plane]]\nplane = 1\nn = 4"),
             "designs.per_plane[1].plane",
         ),
-        (two("[[designs.per_plane]]\nplane = 1\nn = []"), "designs.per_plane[0].n"),
-        (two("[[designs.per_plane]]\nplane = 1\nn = 300"), "designs.per_plane[0].n"),
+        (
+            two("[[designs.per_plane]]\nplane = 1\nn = []"),
+            "designs.per_plane[0].n",
+        ),
+        (
+            two("[[designs.per_plane]]\nplane = 1\nn = 300"),
+            "designs.per_plane[0].n",
+        ),
         // Eight weights of ρ = 0.4 do not fit in the race.
         (
             two("[[designs.per_plane]]\nplane = 1\nn = 8\nrho = 0.4"),
             "designs.per_plane[0].rho",
         ),
         (two("[[designs.per_plane]]\nplane = 1\nsize = 3"), "size"),
-        // Not yet combined: both would build every weight from plane 0's design.
+        // Not yet combined: the optimiser's candidates come from plane 0's axes.
         (
             two("[[designs.per_plane]]\nplane = 1\nn = 3").replace(
-                "[sampling.couple]",
-                "[sampling.tolerances]\nmass = { sigma = 0.01, relative = true }\n[sampling.couple]",
+                "[sampling]",
+                "[optimize]\nobjective = \"capacity\"\n[sampling]",
             ),
-            "sampling.tolerances",
+            "optimize",
         ),
     ];
     for (text, key) in cases {
@@ -304,4 +316,25 @@ fn check_tests_every_plane_against_a_baseline() {
         assert_eq!(count, 2 * 4, "{needed}: {metrics:?}");
     }
     assert_eq!(report["identical"], true, "{text}");
+}
+
+#[test]
+fn tolerances_rebuild_each_planes_weights_from_its_own_design() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = study(dir.path(), PLANE_ONE).replace(
+        "[sampling.couple]",
+        "[sampling.tolerances]\nradius = { sigma = 0.01, relative = true }\n[sampling.couple]",
+    );
+    let p = plan(&text).unwrap();
+    for d in &p.designs {
+        let run = run_one(&p, d.id as u64 * 3);
+        let w = run.weights.expect("tolerances drawn");
+        let n1 = d.plane_designs[0].spec.n as usize;
+        assert_eq!(w.radii.len(), 2 + n1);
+        // Plane 0: ρ = 0.1 of R = 1; plane 1: ρ = 0.12; each within 3 σ (1 %).
+        for (j, r) in w.radii.iter().enumerate() {
+            let nominal = if j < 2 { 0.1 } else { 0.12 };
+            assert!((r / nominal - 1.0).abs() <= 0.03 + 1e-12, "weight {j}: {r}");
+        }
+    }
 }
