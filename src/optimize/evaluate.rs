@@ -42,14 +42,28 @@ pub fn share_below(metrics: &[crate::metrics::RunMetrics], spec: f64) -> f64 {
 /// A point of the design space.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
+    /// Balancer kind (plane 0's, with a design per plane).
+    pub kind: Kind,
+    /// Number of weights (plane 0's).
+    pub n: u32,
+    /// Radius ratio (plane 0's).
+    pub rho: f64,
+    /// Drag β (N·s/m), every plane's.
+    pub drag: f64,
+    /// Balancer plane 1's own design, when the study gives planes designs
+    /// of their own (`[[designs.per_plane]]`); `None`: plane 0's in every plane.
+    pub plane1: Option<PlaneChoice>,
+}
+
+/// Balancer plane 1's part of a [`Candidate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneChoice {
     /// Balancer kind.
     pub kind: Kind,
     /// Number of weights.
     pub n: u32,
     /// Radius ratio.
     pub rho: f64,
-    /// Drag β (N·s/m).
-    pub drag: f64,
 }
 
 /// One evaluated candidate, as written to `optimize.parquet`.
@@ -84,27 +98,35 @@ pub struct Evaluator<'a> {
 impl Evaluator<'_> {
     /// Build the candidate as a design, or say which constraint it breaks.
     fn design(&self, c: &Candidate) -> Result<Design, String> {
+        let rhos = std::iter::once(c.rho).chain(c.plane1.map(|p| p.rho));
         if let Some(h) = self.spec.housing_rho_max
-            && c.rho > h
+            && let Some(rho) = rhos.clone().find(|&r| r > h)
         {
-            return Err(format!("ρ = {:.4} exceeds the housing limit {h}", c.rho));
+            return Err(format!("ρ = {rho:.4} exceeds the housing limit {h}"));
         }
         let g = &self.plan.file.designs;
-        let spec = DesignSpec {
-            kind: c.kind,
-            n: c.n,
-            rho: RhoChoice::Value(c.rho),
+        let spec = |kind, n, rho, plane| DesignSpec {
+            kind,
+            n,
+            rho: RhoChoice::Value(rho),
             race_radius: g.race_radius,
             density: g.density,
             roller_height: g.roller_height,
             drag: c.drag,
-            plane: 0,
+            plane,
         };
-        let design = self
-            .plan
-            .file
-            .resolve_design(u32::MAX, spec)
-            .map_err(|(key, value, reason)| format!("{key} = {value}: {reason}"))?;
+        let resolve = |s: DesignSpec| {
+            self.plan
+                .file
+                .resolve_design(u32::MAX, s)
+                .map_err(|(key, value, reason)| format!("{key} = {value}: {reason}"))
+        };
+        let mut design = resolve(spec(c.kind, c.n, c.rho, 0))?;
+        if let Some(p) = c.plane1 {
+            let other = resolve(spec(p.kind, p.n, p.rho, 1))?;
+            design.capacity = design.capacity.min(other.capacity);
+            design.plane_designs = vec![other];
+        }
         if let (Some(sf), Some(u)) = (self.spec.safety_factor, self.spec.max_unbalance)
             && design.capacity < sf * u
         {
@@ -135,8 +157,13 @@ impl Evaluator<'_> {
         let (value, std_err) = match self.spec.objective {
             Objective::Capacity => (design.capacity, 0.0),
             Objective::ATilde => {
-                let shape = c.kind.model().shape();
-                (a_tilde(shape, c.n, c.rho).unwrap_or(0.0), 0.0)
+                // With a design per plane, the slower plane's ã.
+                let planes = std::iter::once((c.kind, c.n, c.rho))
+                    .chain(c.plane1.map(|p| (p.kind, p.n, p.rho)));
+                let value = planes
+                    .map(|(kind, n, rho)| a_tilde(kind.model().shape(), n, rho).unwrap_or(0.0))
+                    .fold(f64::INFINITY, f64::min);
+                (value, 0.0)
             }
             objective => self.simulate(&design, objective),
         };

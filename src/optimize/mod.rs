@@ -37,8 +37,9 @@ pub struct Best {
 pub struct OptimizeOutput {
     /// Every evaluated candidate, in (kind, n, evaluation) order.
     pub evaluations: Vec<Evaluation>,
-    /// Per (kind, n): why its search stopped.
-    pub terminations: Vec<(String, u32, String)>,
+    /// Per (kind, n) (and plane 1's, with a design per plane): its label
+    /// ("ball n = 3"), its scope ("ball_3") and why its search stopped.
+    pub terminations: Vec<(String, String, String)>,
     /// Best per (kind, n), then overall, then (capacity objective) the complete optimisation per kind.
     pub best: Vec<Best>,
     /// Folder of the files.
@@ -193,22 +194,72 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
             }
         }
     }
+    // With a design per plane, every (kind, n) of plane 1 for each of plane 0's.
+    let plane1 = g.per_plane.iter().find(|a| a.plane == 1);
+    let cells: Vec<evaluate::Candidate> = cells
+        .into_iter()
+        .flat_map(|(kind, n)| {
+            let base = evaluate::Candidate {
+                kind,
+                n,
+                rho: f64::NAN,
+                drag,
+                plane1: None,
+            };
+            match plane1 {
+                None => vec![base],
+                Some(a) => {
+                    let kinds = a.kind.as_ref().map_or(vec![kind], |k| k.values());
+                    let ns = a.n.as_ref().map_or(vec![n], |v| v.values());
+                    kinds
+                        .iter()
+                        .flat_map(|&k1| {
+                            ns.iter().map(move |&n1| evaluate::Candidate {
+                                plane1: Some(evaluate::PlaneChoice {
+                                    kind: k1,
+                                    n: n1,
+                                    rho: f64::NAN,
+                                }),
+                                ..base
+                            })
+                        })
+                        .collect()
+                }
+            }
+        })
+        .collect();
     let results: Vec<_> = cells
         .par_iter()
         .with_max_len(1) // one search per job, as runs (study::run)
-        .map(|&(kind, n)| (kind, n, search::search(&evaluator, kind, n, drag)))
+        .map(|&c| {
+            let r = match c.plane1 {
+                None => search::search(&evaluator, c.kind, c.n, drag),
+                Some(_) => search::search_planes(&evaluator, c),
+            };
+            (c, r)
+        })
         .collect();
     let mut evaluations = Vec::new();
     let mut terminations = Vec::new();
     let mut best = Vec::new();
-    for (kind, n, r) in &results {
+    for (c, r) in &results {
+        let (scope, label) = match c.plane1 {
+            None => (
+                format!("{}_{}", c.kind, c.n),
+                format!("{} n = {}", c.kind, c.n),
+            ),
+            Some(p) => (
+                format!("{}_{}_plane1_{}_{}", c.kind, c.n, p.kind, p.n),
+                format!("{} n = {}, plane 1: {} n = {}", c.kind, c.n, p.kind, p.n),
+            ),
+        };
         if let Some(b) = best_of(&r.evaluations, spec.objective) {
             best.push(Best {
-                scope: format!("{kind}_{n}"),
+                scope: scope.clone(),
                 evaluation: b,
             });
         }
-        terminations.push((kind.to_string(), *n, r.termination.clone()));
+        terminations.push((label, scope, r.termination.clone()));
         evaluations.extend(r.evaluations.iter().cloned());
     }
     if let Some(b) = best_of(
@@ -223,7 +274,8 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
             evaluation: b,
         });
     }
-    if spec.objective == Objective::Capacity {
+    // The paper's complete optimisation is of one balancer.
+    if spec.objective == Objective::Capacity && plane1.is_none() {
         best.extend(complete_rows(&evaluator, &spec));
     }
     let dir = crate::study::run::output_dir(&plan, None);
@@ -253,6 +305,7 @@ fn complete_rows(evaluator: &Evaluator<'_>, spec: &OptimizeSpec) -> Vec<Best> {
                     n: c.n,
                     rho: c.rho,
                     drag: g.drag.values()[0],
+                    plane1: None,
                 },
                 "complete",
             );
@@ -268,6 +321,7 @@ fn complete_rows(evaluator: &Evaluator<'_>, spec: &OptimizeSpec) -> Vec<Best> {
                     n,
                     rho,
                     drag: g.drag.values()[0],
+                    plane1: None,
                 },
                 "analytic",
             );
@@ -354,6 +408,28 @@ pub fn evaluations_frame(
                 .collect::<Vec<_>>(),
         ),
     ]);
+    // With a design per plane: plane 1's kind, n and ρ beside plane 0's.
+    if evals.iter().any(|e| e.candidate.plane1.is_some()) {
+        let p1 = |e: &Evaluation| e.candidate.plane1;
+        cols.push(Column::new(
+            "kind_plane1".into(),
+            evals
+                .iter()
+                .map(|e| p1(e).map(|p| p.kind.name().to_string()))
+                .collect::<Vec<_>>(),
+        ));
+        cols.push(Column::new(
+            "n_plane1".into(),
+            evals.iter().map(|e| p1(e).map(|p| p.n)).collect::<Vec<_>>(),
+        ));
+        cols.push(Column::new(
+            "rho_plane1".into(),
+            evals
+                .iter()
+                .map(|e| p1(e).map(|p| p.rho))
+                .collect::<Vec<_>>(),
+        ));
+    }
     DataFrame::new(evals.len(), cols)
 }
 
@@ -362,7 +438,7 @@ fn write_outputs(
     dir: &std::path::Path,
     evals: &[Evaluation],
     best: &[Best],
-    terminations: &[(String, u32, String)],
+    terminations: &[(String, String, String)],
 ) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(dir)?;
     let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
@@ -378,7 +454,7 @@ fn write_outputs(
         .map(|scope| {
             terminations
                 .iter()
-                .find(|(kind, n, _)| format!("{kind}_{n}") == *scope)
+                .find(|(_, s, _)| s == scope)
                 .map(|(_, _, why)| why.clone())
         })
         .collect();

@@ -22,21 +22,61 @@ const INFEASIBLE: f64 = 1e12;
 /// logging every evaluation.
 struct CandidateCost<'a> {
     evaluator: &'a Evaluator<'a>,
-    kind: Kind,
-    n: u32,
+    /// The candidate the search moves: its ρ in `slot` varies.
+    base: Candidate,
+    slot: Slot,
     drag: f64,
     phase: &'static str,
     log: Mutex<Vec<Evaluation>>,
 }
 
+/// Which radius ratio a search varies, with a design per plane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slot {
+    /// Plane 0's ρ (the only one without a design per plane).
+    Plane0,
+    /// Plane 1's ρ, plane 0's held.
+    Plane1,
+    /// One ρ for both planes.
+    Tied,
+}
+
+impl Slot {
+    /// The ρ this slot varies in candidate c.
+    fn rho_of(self, c: &Candidate) -> f64 {
+        match (self, c.plane1) {
+            (Slot::Plane1, Some(p)) => p.rho,
+            _ => c.rho,
+        }
+    }
+
+    /// The weight count whose fit bounds this slot's ρ (the larger count, tied).
+    fn n_of(self, c: &Candidate) -> u32 {
+        match (self, c.plane1) {
+            (Slot::Plane1, Some(p)) => p.n,
+            (Slot::Tied, Some(p)) => p.n.max(c.n),
+            _ => c.n,
+        }
+    }
+}
+
 impl CandidateCost<'_> {
     fn eval(&self, rho: f64, drag: f64) -> f64 {
-        let c = Candidate {
-            kind: self.kind,
-            n: self.n,
-            rho,
-            drag,
-        };
+        let mut c = Candidate { drag, ..self.base };
+        match self.slot {
+            Slot::Plane0 => c.rho = rho,
+            Slot::Plane1 => {
+                if let Some(p) = c.plane1.as_mut() {
+                    p.rho = rho;
+                }
+            }
+            Slot::Tied => {
+                c.rho = rho;
+                if let Some(p) = c.plane1.as_mut() {
+                    p.rho = rho;
+                }
+            }
+        }
         let e = self.evaluator.evaluate(c, self.phase);
         let cost = match e.value {
             // A p95 that reaches a run without a residual is +∞: as bad as
@@ -168,20 +208,22 @@ fn best_logged(cost: &CandidateCost<'_>) -> Option<Evaluation> {
 /// "; on the lower bound of …" when the optimum sits on a bound.
 fn bound_note(
     best: &Evaluation,
+    slot: Slot,
     rho: (f64, f64),
     drag: Option<(f64, f64)>,
     fit: f64,
 ) -> Option<String> {
     let at = |x: f64, b: f64| (x - b).abs() <= 1e-9 * b.abs().max(1e-12);
     let c = best.candidate;
+    let c_rho = slot.rho_of(&c);
     let mut notes = Vec::new();
-    if at(c.rho, rho.0) {
+    if at(c_rho, rho.0) {
         notes.push(format!(
             "ρ on its lower bound {:.4} (optimize.rho_bounds)",
             rho.0
         ));
     }
-    if at(c.rho, rho.1) {
+    if at(c_rho, rho.1) {
         let which = if at(rho.1, fit) {
             "the largest ρ whose weights fit the race"
         } else {
@@ -206,13 +248,27 @@ fn bound_note(
 
 /// Search the free variables for one kind and n.
 pub fn search(evaluator: &Evaluator<'_>, kind: Kind, n: u32, drag: f64) -> SearchResult {
+    let base = Candidate {
+        kind,
+        n,
+        rho: f64::NAN,
+        drag,
+        plane1: None,
+    };
+    search_slot(evaluator, base, Slot::Plane0)
+}
+
+/// Search one radius ratio (`slot`) of `base` (and the drag, when free).
+pub fn search_slot(evaluator: &Evaluator<'_>, base: Candidate, slot: Slot) -> SearchResult {
     let spec = evaluator.spec;
+    let drag = base.drag;
+    let n = slot.n_of(&base);
     let (lo, hi) = rho_interval(evaluator, n);
     let budget = spec.max_evaluations.max(4);
     let cost = CandidateCost {
         evaluator,
-        kind,
-        n,
+        base,
+        slot,
         drag,
         phase: "scan",
         log: Mutex::new(Vec::new()),
@@ -279,7 +335,8 @@ pub fn search(evaluator: &Evaluator<'_>, kind: Kind, n: u32, drag: f64) -> Searc
         };
         let (f0, se0) = (cost_of(&brent_cost, &opt), opt.std_err);
         let mut beaten = None;
-        for r in [opt.candidate.rho - h, opt.candidate.rho + h] {
+        let opt_rho = slot.rho_of(&opt.candidate);
+        for r in [opt_rho - h, opt_rho + h] {
             let r = r.clamp(lo, hi);
             if brent_cost.log.lock().expect("log lock").len() as u64 >= budget {
                 break;
@@ -306,6 +363,80 @@ pub fn search(evaluator: &Evaluator<'_>, kind: Kind, n: u32, drag: f64) -> Searc
     }
     let fit = rho_max(n).unwrap_or(1.0) * (1.0 - 1e-9);
     finish(&brent_cost, stop, how, budget, (lo, hi), None, fit)
+}
+
+/// Rounds of the coordinate search over the two planes' ρ at most.
+const PLANE_ROUNDS: usize = 4;
+
+/// Search plane 0's and plane 1's radius ratios of `base` (a design per
+/// plane): first one ρ for both planes, then, in rounds, plane 1's with plane
+/// 0's held at the best so far and plane 0's with plane 1's held, until a
+/// round improves the best by no more than its standard error (a weaker
+/// plane bounds the design: raising one plane can make the other the
+/// weaker, so one round is not enough). Each stage has its own
+/// `optimize.max_evaluations`; the stop is the last round's worst.
+pub fn search_planes(evaluator: &Evaluator<'_>, base: Candidate) -> SearchResult {
+    let objective = evaluator.spec.objective;
+    let key = |e: &Evaluation| match e.value {
+        Some(v) if v.is_finite() && e.feasible && objective.maximise() => -v,
+        Some(v) if v.is_finite() && e.feasible => v,
+        _ => INFEASIBLE,
+    };
+    let mut evaluations: Vec<Evaluation> = Vec::new();
+    let mut words = Vec::new();
+    let mut stops = Vec::new();
+    let mut start = base;
+    let mut previous: Option<(f64, f64)> = None;
+    let stages = std::iter::once((Slot::Tied, "one ρ for both planes")).chain(
+        (0..PLANE_ROUNDS)
+            .flat_map(|_| [(Slot::Plane1, "plane 1's ρ"), (Slot::Plane0, "plane 0's ρ")]),
+    );
+    for (k, (slot, name)) in stages.enumerate() {
+        let r = search_slot(evaluator, start, slot);
+        evaluations.extend(r.evaluations);
+        words.push(format!("{name}: {}", r.termination));
+        stops.push(r.stop);
+        let Some(best) = evaluations.iter().min_by(|a, b| key(a).total_cmp(&key(b))) else {
+            break;
+        };
+        if key(best) >= INFEASIBLE {
+            return SearchResult {
+                evaluations,
+                termination: words.join("; "),
+                stop: "infeasible",
+            };
+        }
+        start = best.candidate;
+        // After each round (plane 1, then plane 0): stop once it gained no
+        // more than the standard error.
+        if k % 2 == 0 && k > 0 {
+            let now = (key(best), best.std_err);
+            if let Some((before, _)) = previous
+                && before - now.0 <= now.1.max(1e-12 * now.0.abs())
+            {
+                break;
+            }
+            previous = Some(now);
+        }
+    }
+    // The worst of the two coordinate stages' stops.
+    let rank = |s: &str| match s {
+        "infeasible" => 0,
+        "budget" => 1,
+        "unconfirmed" => 2,
+        "bound" => 3,
+        _ => 4,
+    };
+    let stop = stops[stops.len().saturating_sub(2)..]
+        .iter()
+        .copied()
+        .min_by_key(|s| rank(s))
+        .unwrap_or("budget");
+    SearchResult {
+        evaluations,
+        termination: words.join("; "),
+        stop,
+    }
 }
 
 /// The cost of a logged evaluation as the solvers see it.
@@ -345,7 +476,10 @@ fn finish(
         ),
     };
     let mut stop = stop;
-    if let Some(note) = best.as_ref().and_then(|b| bound_note(b, rho, drag, fit)) {
+    if let Some(note) = best
+        .as_ref()
+        .and_then(|b| bound_note(b, cost.slot, rho, drag, fit))
+    {
         text = format!("bound: {note}: the optimum may lie beyond it; {text}");
         stop = "bound";
     }
@@ -497,7 +631,7 @@ fn nelder_mead(cost: &CandidateCost<'_>, lo: f64, hi: f64, budget: u64) -> Searc
             }
         }
     }
-    let fit = rho_max(cost.n).unwrap_or(1.0) * (1.0 - 1e-9);
+    let fit = rho_max(cost.slot.n_of(&cost.base)).unwrap_or(1.0) * (1.0 - 1e-9);
     let mut result = finish(cost, stop, how, budget, (lo, hi), Some((dlo, dhi)), fit);
     for e in &mut result.evaluations {
         e.phase = "nelder_mead";
@@ -516,6 +650,7 @@ mod tests {
                 n: 3,
                 rho,
                 drag,
+                plane1: None,
             },
             value: Some(1.0),
             std_err: 0.1,
@@ -530,10 +665,13 @@ mod tests {
     fn an_optimum_on_a_bound_names_the_bound() {
         let rho = (0.02, 0.4);
         let drag = Some((0.05, 20.0));
-        assert_eq!(bound_note(&at(0.2, 1.0), rho, drag, 0.5), None);
-        let low = bound_note(&at(0.2, 0.05), rho, drag, 0.5).unwrap();
+        assert_eq!(
+            bound_note(&at(0.2, 1.0), Slot::Plane0, rho, drag, 0.5),
+            None
+        );
+        let low = bound_note(&at(0.2, 0.05), Slot::Plane0, rho, drag, 0.5).unwrap();
         assert!(low.contains("β on its lower bound 0.05 N·s/m"), "{low}");
-        let fit = bound_note(&at(0.4, 1.0), rho, drag, 0.4).unwrap();
+        let fit = bound_note(&at(0.4, 1.0), Slot::Plane0, rho, drag, 0.4).unwrap();
         assert!(
             fit.contains("the largest ρ whose weights fit the race"),
             "{fit}"

@@ -750,16 +750,14 @@ impl StudyFile {
             self.scene.rotor.as_rotor().planes(),
         )
         .map_err(|(k, v, r)| invalid(&k, v, &r))?;
-        if !self.designs.per_plane.is_empty() {
-            // The optimiser builds its candidates from plane 0's axes.
-            let other = [("optimize", self.optimize.is_some())];
-            if let Some((key, _)) = other.iter().find(|(_, given)| *given) {
-                return Err(invalid(
-                    key,
-                    "given".into(),
-                    "cannot yet be combined with designs.per_plane (a design per plane): run the planes' designs as a grid, or give every plane the same design",
-                ));
-            }
+        let planes = self.scene.rotor.as_rotor().planes();
+        if !self.designs.per_plane.is_empty() && self.optimize.is_some() && planes != 2 {
+            // The optimiser searches plane 0's and plane 1's radius ratios.
+            return Err(invalid(
+                "optimize",
+                format!("{planes} balancer planes"),
+                "with designs.per_plane the optimiser searches two balancer planes' radius ratios; this rotor has another number: run the planes' designs as a grid",
+            ));
         }
         let designs = self
             .resolve_designs()

@@ -130,6 +130,7 @@ fn common_random_numbers_rank_the_better_design_first() {
                 n: 3,
                 rho: 0.36,
                 drag,
+                plane1: None,
             },
             "test",
         )
@@ -245,6 +246,7 @@ fn settling_objectives_equal_the_summarys_censoring_aware_statistics() {
             n: 3,
             rho: p.designs[0].rho,
             drag: 0.15,
+            plane1: None,
         };
         (ev.evaluate(c, "test").value.unwrap(), p)
     };
@@ -319,6 +321,7 @@ fn the_simplex_optimum_is_the_grids_best_within_its_standard_error() {
                     n: 3,
                     rho,
                     drag,
+                    plane1: None,
                 },
                 "grid",
             );

@@ -247,12 +247,18 @@ fn a_bad_per_plane_entry_is_refused_naming_its_key() {
             "designs.per_plane[0].rho",
         ),
         (two("[[designs.per_plane]]\nplane = 1\nsize = 3"), "size"),
-        // Not yet combined: the optimiser's candidates come from plane 0's axes.
+        // The optimiser searches two planes' radius ratios, not one's.
         (
-            two("[[designs.per_plane]]\nplane = 1\nn = 3").replace(
-                "[sampling]",
-                "[optimize]\nobjective = \"capacity\"\n[sampling]",
-            ),
+            two("[[designs.per_plane]]\nplane = 1\nn = 3")
+                .replace("planes = [-1.0, 1.0]", "planes = [-1.0, 0.0, 1.0]")
+                .replace(
+                    "[sampling.couple]\n",
+                    "[sampling.couple]\nat = [-1.0, 1.0]\n",
+                )
+                .replace(
+                    "[sampling]",
+                    "[optimize]\nobjective = \"capacity\"\n[sampling]",
+                ),
             "optimize",
         ),
     ];
@@ -337,4 +343,67 @@ fn tolerances_rebuild_each_planes_weights_from_its_own_design() {
             assert!((r / nominal - 1.0).abs() <= 0.03 + 1e-12, "weight {j}: {r}");
         }
     }
+}
+
+#[test]
+fn the_optimiser_treats_each_planes_count_and_radius_as_free() {
+    use autobal::design::optimum::optimal_rho;
+    use autobal::optimize::evaluate::{Candidate, Evaluator, PlaneChoice};
+    let dir = tempfile::tempdir().unwrap();
+    let text = study(dir.path(), "[[designs.per_plane]]\nplane = 1\nn = [3, 4]").replace(
+        "[sampling]",
+        "[optimize]\nobjective = \"capacity\"\nmax_evaluations = 40\n[sampling]",
+    );
+    let p = plan(&text).unwrap();
+    let out = autobal::optimize::optimize(&p).unwrap();
+    // One search per plane-1 count, each naming both planes.
+    let scopes: Vec<&str> = out.best.iter().map(|b| b.scope.as_str()).collect();
+    assert!(scopes.contains(&"ball_2_plane1_ball_3"), "{scopes:?}");
+    assert!(scopes.contains(&"ball_2_plane1_ball_4"), "{scopes:?}");
+    // The capacity of a design is its weaker plane's: the optimum is the
+    // smaller of each plane's capacity at its own Table-1 radius.
+    let spec = p.file.optimize.clone().unwrap();
+    let evaluator = Evaluator {
+        plan: &p,
+        spec: &spec,
+        samples: 1,
+    };
+    let at_optimum = |n: u32| {
+        let rho = optimal_rho(autobal::design::Shape::Ball, n).unwrap().rho;
+        (rho, n)
+    };
+    for n1 in [3, 4] {
+        let (rho0, _) = at_optimum(2);
+        let (rho1, _) = at_optimum(n1);
+        let best_possible = evaluator
+            .evaluate(
+                Candidate {
+                    kind: autobal::model::balancer::Kind::Ball,
+                    n: 2,
+                    rho: rho0,
+                    drag: 0.01,
+                    plane1: Some(PlaneChoice {
+                        kind: autobal::model::balancer::Kind::Ball,
+                        n: n1,
+                        rho: rho1,
+                    }),
+                },
+                "check",
+            )
+            .value
+            .unwrap();
+        let found = out
+            .best
+            .iter()
+            .find(|b| b.scope == format!("ball_2_plane1_ball_{n1}"))
+            .unwrap();
+        let value = found.evaluation.value.unwrap();
+        assert!(
+            (value / best_possible - 1.0).abs() < 1e-6,
+            "n1 = {n1}: {value} against {best_possible}"
+        );
+        assert_eq!(found.evaluation.candidate.plane1.unwrap().n, n1);
+    }
+    let optimum = read_parquet(&out.dir.join("optimum.parquet")).unwrap();
+    assert!(optimum.column("n_plane1").is_ok());
 }

@@ -212,6 +212,7 @@ fn robust_objectives_equal_an_independent_computation_on_the_study_runs() {
             n,
             rho: 0.3,
             drag: 10.0,
+            plane1: None,
         };
         for (objective, want) in [("residual_p95", p95), ("p_residual_below", below)] {
             let spec_table: OptimizeSpec = toml::from_str(&format!(

@@ -50,9 +50,20 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
             let e = &b.evaluation;
             vec![
                 b.scope.clone(),
-                e.candidate.kind.to_string(),
-                e.candidate.n.to_string(),
-                format!("{:.4}", e.candidate.rho),
+                match e.candidate.plane1 {
+                    Some(p) if p.kind != e.candidate.kind => {
+                        format!("{}/{}", e.candidate.kind, p.kind)
+                    }
+                    _ => e.candidate.kind.to_string(),
+                },
+                match e.candidate.plane1 {
+                    Some(p) => format!("{}/{}", e.candidate.n, p.n),
+                    None => e.candidate.n.to_string(),
+                },
+                match e.candidate.plane1 {
+                    Some(p) => format!("{:.4}/{:.4}", e.candidate.rho, p.rho),
+                    None => format!("{:.4}", e.candidate.rho),
+                },
                 format!("{:.3}", e.candidate.drag),
                 e.value.map_or("–".into(), shown),
                 shown(e.std_err),
@@ -82,8 +93,8 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
             &rows
         )
     );
-    for (kind, n, why) in &out.terminations {
-        eprintln!("{kind} n = {n}: {why}");
+    for (label, _, why) in &out.terminations {
+        eprintln!("{label}: {why}");
     }
     eprintln!(
         "{} candidates evaluated; wrote {}/optimize.parquet and optimum.parquet",
