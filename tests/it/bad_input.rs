@@ -287,6 +287,52 @@ fn flag_cases(study_path: &str, scene_path: &str) -> Vec<(Vec<String>, &'static 
         (s(&["frobnicate"]), "frobnicate"),
         (s(&["design", "--kind", "cube", "--n", "3"]), "cube"),
         (s(&["run", study_path, "--chunk-runs", "0"]), "--chunk-runs"),
+        // Issue 33: numbers beyond any sensible range panicked, aborted or
+        // were accepted; every verb now checks them while parsing, before
+        // anything is read or written.
+        (
+            s(&["run", study_path, "--progress-every", "1e300"]),
+            "--progress-every",
+        ),
+        (
+            s(&["run", study_path, "--chunk-runs", "18446744073709551615"]),
+            "--chunk-runs",
+        ),
+        (s(&["check", study_path, "--threads", "0"]), "--threads"),
+        (s(&["baseline", study_path, "--threads", "0"]), "--threads"),
+        (s(&["check", study_path, "--alpha", "0"]), "--alpha"),
+        (s(&["check", study_path, "--alpha", "nan"]), "--alpha"),
+        (
+            s(&[
+                "sweep",
+                scene_path,
+                "--omega",
+                "1..8",
+                "--points",
+                "18446744073709551615",
+            ]),
+            "--points",
+        ),
+        (
+            s(&[
+                "map",
+                scene_path,
+                "--omega",
+                "1..8",
+                "--unbalance",
+                "0.1..0.2",
+                "--points",
+                "100000x100000",
+            ]),
+            "--points",
+        ),
+        (s(&["design", "--n", "1..4294967295"]), "--n"),
+        (
+            s(&["plot", "design", "--n", "1..4294967295", "--out", "x.svg"]),
+            "--n",
+        ),
+        // A FIFO or a folder as the study file: refused at once, not read.
+        (s(&["run", "/"]), "not a text file"),
     ]
 }
 

@@ -44,13 +44,13 @@ pub struct CheckArgs {
     #[arg(long)]
     runs: Option<PathBuf>,
     /// Family-wise false-alarm level (Holm-corrected over every design and metric).
-    #[arg(long, default_value_t = DEFAULT_ALPHA)]
+    #[arg(long, default_value_t = DEFAULT_ALPHA, value_parser = crate::limits::alpha)]
     alpha: f64,
     /// Root folder of the fresh run (default: <output>/check).
     #[arg(long, conflicts_with = "runs")]
     out: Option<PathBuf>,
     /// Worker threads (default: all cores, or RAYON_NUM_THREADS).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::threads)]
     threads: Option<usize>,
     /// Print the verdict table as JSON.
     #[arg(long)]
@@ -66,7 +66,7 @@ pub struct BaselineArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Worker threads (default: all cores, or RAYON_NUM_THREADS).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::threads)]
     threads: Option<usize>,
 }
 

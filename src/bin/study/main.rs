@@ -9,6 +9,7 @@ mod claims_cmd;
 mod compare_cmd;
 mod criterion_cmd;
 mod design_cmd;
+mod limits;
 mod linear_cmd;
 mod map_cmd;
 mod meta_cmd;

@@ -65,6 +65,17 @@ pub fn run(args: &MapArgs) -> Result<(), UserError> {
     if nw < 2 || nu < 2 {
         return Err(bad());
     }
+    if nw.saturating_mul(nu) > crate::limits::MAX_MAP_POINTS {
+        return Err(UserError(
+            format!(
+                "--points {}: {} points, more than the {} a map may hold (each point is a whole run)",
+                args.points,
+                nw.saturating_mul(nu),
+                crate::limits::MAX_MAP_POINTS
+            ),
+            2,
+        ));
+    }
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
     let scene = file.simulation(&shown)?.scene;

@@ -41,16 +41,16 @@ pub struct RunArgs {
     #[arg(long, value_parser = Shard::parse)]
     shard: Option<Shard>,
     /// Worker threads (default: all cores, or RAYON_NUM_THREADS).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::threads)]
     threads: Option<usize>,
     /// No progress output (a bar on a terminal, else a line every --progress-every seconds).
     #[arg(long)]
     quiet: bool,
     /// Seconds between two progress lines when stderr is not a terminal (a batch log).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = crate::limits::progress_seconds)]
     progress_every: f64,
     /// Write finished runs to disk after this many, or every 2 s, whichever comes first.
-    #[arg(long, default_value_t = 4096)]
+    #[arg(long, default_value_t = 4096, value_parser = crate::limits::chunk_runs)]
     chunk_runs: usize,
     /// Rank designs by this criterion instead of the study's `[summary] rank_by`:
     /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
@@ -80,12 +80,6 @@ pub struct MergeArgs {
 /// Run `study run`.
 pub fn run(args: &RunArgs) -> Result<(), UserError> {
     let threads = match args.threads {
-        Some(0) => {
-            return Err(UserError(
-                "--threads 0: a study needs at least one worker thread".into(),
-                2,
-            ));
-        }
         Some(asked) => {
             let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
             if asked > cores {
@@ -97,12 +91,6 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         }
         None => None,
     };
-    if args.chunk_runs == 0 {
-        return Err(UserError(
-            "--chunk-runs 0: a chunk holds at least one run".into(),
-            2,
-        ));
-    }
     let mut plan = load(&args.study)?;
     if let Some(criterion) = args.rank_by {
         plan.file.summary.rank_by = criterion;
@@ -124,15 +112,6 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
         threads,
         ..RunOptions::default()
     };
-    if !(args.progress_every.is_finite() && args.progress_every > 0.0) {
-        return Err(UserError(
-            format!(
-                "--progress-every {}: seconds between progress lines, a positive number",
-                args.progress_every
-            ),
-            2,
-        ));
-    }
     let bar = RunProgress::new(args.quiet, Duration::from_secs_f64(args.progress_every));
     let output = run_study(&plan, &options, &bar).map_err(|e| {
         if matches!(e, RunError::Interrupted { .. }) {

@@ -22,7 +22,7 @@ pub struct SweepArgs {
     #[arg(long)]
     omega: String,
     /// Number of speeds, evenly spaced, ends included.
-    #[arg(long, default_value_t = 41)]
+    #[arg(long, default_value_t = 41, value_parser = crate::limits::sweep_points)]
     points: usize,
     /// Write one row per speed to this Parquet file.
     #[arg(long)]
@@ -54,9 +54,6 @@ fn parse_range(text: &str) -> Result<(f64, f64), UserError> {
 /// Run `study sweep`.
 pub fn run(args: &SweepArgs) -> Result<(), UserError> {
     let (lo, hi) = parse_range(&args.omega)?;
-    if args.points < 2 {
-        return Err(UserError("--points: need at least 2 speeds".into(), 2));
-    }
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
     let simulation = file.simulation(&shown)?;

@@ -1,0 +1,99 @@
+//! Command-line numbers with a range of their own, checked by clap while
+//! the options are parsed: before any file is read or written, the same
+//! rule on every verb, and the message names the flag, the value and the
+//! limit (exit code 2).
+
+/// Most worker threads a verb accepts (far above any machine here; a
+/// thread is a stack and a share of every chunk).
+pub const MAX_THREADS: usize = 4096;
+/// Most runs held in memory before a chunk is written (each run is a few
+/// hundred bytes to a few kilobytes, and twice this many may wait).
+pub const MAX_CHUNK_RUNS: usize = 1_000_000;
+/// Longest time between two progress lines (a year, in seconds).
+pub const MAX_PROGRESS_SECONDS: f64 = 365.0 * 86_400.0;
+/// Most points of a sweep or one axis of a map (each point is a whole run).
+pub const MAX_POINTS: usize = 100_000;
+/// Most points of a map (the product of its axes).
+pub const MAX_MAP_POINTS: usize = 1_000_000;
+
+/// A number in `lo..=hi` of a flag, or the reason it is not.
+fn whole_in(text: &str, what: &str, lo: usize, hi: usize) -> Result<usize, String> {
+    let n: usize = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a whole number ({what})"))?;
+    if n < lo || n > hi {
+        return Err(format!("{n} is outside {lo}..={hi} ({what})"));
+    }
+    Ok(n)
+}
+
+/// `--threads`: 1 ..= [`MAX_THREADS`].
+pub fn threads(text: &str) -> Result<usize, String> {
+    whole_in(text, "worker threads; at least one", 1, MAX_THREADS)
+}
+
+/// `--chunk-runs`: 1 ..= [`MAX_CHUNK_RUNS`].
+pub fn chunk_runs(text: &str) -> Result<usize, String> {
+    whole_in(
+        text,
+        "runs held before a chunk is written",
+        1,
+        MAX_CHUNK_RUNS,
+    )
+}
+
+/// `--points` of a sweep: 2 ..= [`MAX_POINTS`].
+pub fn sweep_points(text: &str) -> Result<usize, String> {
+    whole_in(text, "speeds of the sweep, ends included", 2, MAX_POINTS)
+}
+
+/// `--progress-every`: seconds in (0, [`MAX_PROGRESS_SECONDS`]].
+pub fn progress_seconds(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number of seconds"))?;
+    if !(v > 0.0 && v <= MAX_PROGRESS_SECONDS) {
+        return Err(format!(
+            "{text}: seconds between progress lines, above 0 and at most {MAX_PROGRESS_SECONDS:.0} (a year)"
+        ));
+    }
+    Ok(v)
+}
+
+/// A family-wise false-alarm level in (0, 1) (`study check`).
+pub fn alpha(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !(v > 0.0 && v < 1.0) {
+        return Err(format!(
+            "{text}: a false-alarm level strictly between 0 and 1, e.g. 0.01"
+        ));
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_range_refuses_its_extremes_and_names_the_limit() {
+        assert!(threads("0").unwrap_err().contains("1..=4096"));
+        assert_eq!(threads("2"), Ok(2));
+        assert!(chunk_runs("18446744073709551615").is_err());
+        assert!(
+            sweep_points("18446744073709551615")
+                .unwrap_err()
+                .contains("2..=100000")
+        );
+        assert!(progress_seconds("1e300").unwrap_err().contains("a year"));
+        assert!(progress_seconds("nan").is_err());
+        assert_eq!(progress_seconds("30"), Ok(30.0));
+        assert!(alpha("0").is_err() && alpha("nan").is_err() && alpha("1").is_err());
+        assert_eq!(alpha("0.01"), Ok(0.01));
+    }
+}
