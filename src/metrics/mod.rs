@@ -303,10 +303,17 @@ impl RunMetrics {
     }
 }
 
+/// Longest horizon a run may have (revolutions).
+pub const MAX_REVS: f64 = 1e7;
+/// Most samples of a hold window (the ring every run keeps).
+pub const MAX_WINDOW_SAMPLES: f64 = 1e7;
+
 impl MetricOptions {
     /// Check each definition's parameter; on failure the key, the value and the rule.
     pub fn validate(&self) -> Result<(), (&'static str, String, String)> {
-        let fail = |key, value: f64, rule: &str| Err((key, value.to_string(), rule.to_string()));
+        let fail = |key, value: f64, rule: &str| {
+            Err((key, crate::model::validate::shown(value), rule.to_string()))
+        };
         if !(self.delta > 0.0 && self.delta < 1.0) {
             return fail(
                 "metrics.delta",
@@ -340,6 +347,26 @@ impl MetricOptions {
                 "metrics.samples_per_rev",
                 f64::from(self.samples_per_rev),
                 "must lie in [32, 100000]: fewer samples cannot resolve the whirl, which turns once per revolution",
+            );
+        }
+        if self.t_end_revs > MAX_REVS {
+            return fail(
+                "metrics.t_end_revs",
+                self.t_end_revs,
+                &format!(
+                    "at most {MAX_REVS:e} revolutions: no run can take the steps a longer horizon needs (solver.max_steps)"
+                ),
+            );
+        }
+        // The hold window's samples are kept in memory, per run and thread.
+        let window = self.hold_revs * f64::from(self.samples_per_rev);
+        if window > MAX_WINDOW_SAMPLES {
+            return fail(
+                "metrics.hold_revs",
+                self.hold_revs,
+                &format!(
+                    "hold_revs × samples_per_rev = {window:e} samples, more than the {MAX_WINDOW_SAMPLES:e} a run keeps in memory (8 bytes each, per plane and thread); shorten the hold or sample less often"
+                ),
             );
         }
         Ok(())

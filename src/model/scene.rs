@@ -7,7 +7,7 @@ use super::effect::{Effects, SceneFacts};
 use super::rotor::{PlaneRotor, RotorModel};
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
-use super::validate::{invalid, non_negative, positive};
+use super::validate::{invalid, non_negative, positive, spin_rate};
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
 use schemars::JsonSchema;
@@ -141,14 +141,14 @@ impl Scene {
     pub fn validate(&self) -> Result<(), SceneError> {
         self.rotor.validate()?;
         match &self.speed {
-            SpeedLaw::Constant { omega } => positive("speed.omega", *omega)?,
+            SpeedLaw::Constant { omega } => spin_rate("speed.omega", *omega, false)?,
             SpeedLaw::Ramp {
                 omega_start,
                 omega_end,
                 duration,
             } => {
-                non_negative("speed.omega_start", *omega_start)?;
-                positive("speed.omega_end", *omega_end)?;
+                spin_rate("speed.omega_start", *omega_start, true)?;
+                spin_rate("speed.omega_end", *omega_end, false)?;
                 positive("speed.duration", *duration)?;
             }
             SpeedLaw::Motor {
@@ -157,10 +157,11 @@ impl Scene {
                 omega_start,
             } => {
                 positive("speed.stall_torque", *stall_torque)?;
-                positive("speed.omega_sync", *omega_sync)?;
-                non_negative("speed.omega_start", *omega_start)?;
+                spin_rate("speed.omega_sync", *omega_sync, false)?;
+                spin_rate("speed.omega_start", *omega_start, true)?;
             }
-            SpeedLaw::Free { omega_start } => non_negative("speed.omega_start", *omega_start)?,
+            // A free rotor coasts from its start: it must be spinning.
+            SpeedLaw::Free { omega_start } => spin_rate("speed.omega_start", *omega_start, false)?,
         }
         if self.rotor.as_rotor().tilt_map(0).is_some() && !self.speed.is_prescribed() {
             return Err(SceneError::Invalid {

@@ -27,8 +27,18 @@ pub enum SceneError {
 pub(crate) fn invalid(field: &str, value: f64, reason: &str) -> SceneError {
     SceneError::Invalid {
         field: field.to_string(),
-        value: value.to_string(),
+        value: shown(value),
         reason: reason.to_string(),
+    }
+}
+
+/// A number as a user would write it in a message: plain in the everyday
+/// range, scientific beyond it (`1e300`, not three hundred digits).
+pub fn shown(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
     }
 }
 
@@ -38,6 +48,30 @@ pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
         Ok(())
     } else {
         Err(invalid(field, value, "must be positive and finite"))
+    }
+}
+
+/// Slowest spin rate a scene may name (rad/s): a revolution of over an hour
+/// and three quarters; below it no run reaches a revolution boundary.
+pub const MIN_SPIN_RATE: f64 = 1e-3;
+/// Fastest spin rate a scene may name (rad/s): ten million rpm, far beyond
+/// any ultracentrifuge (about 16 000 rad/s); above it every run fails.
+pub const MAX_SPIN_RATE: f64 = 1e6;
+
+/// Require a spin rate (rad/s) in [`MIN_SPIN_RATE`, `MAX_SPIN_RATE`], or 0
+/// where `zero_allowed` (a start from rest).
+pub(crate) fn spin_rate(field: &str, value: f64, zero_allowed: bool) -> Result<(), SceneError> {
+    if (zero_allowed && value == 0.0) || (MIN_SPIN_RATE..=MAX_SPIN_RATE).contains(&value) {
+        Ok(())
+    } else {
+        Err(invalid(
+            field,
+            value,
+            &format!(
+                "must be a positive spin rate in [{MIN_SPIN_RATE:e}, {MAX_SPIN_RATE:e}] rad/s{} (outside it every run fails: no revolution completes, or the steps underflow)",
+                if zero_allowed { ", or 0" } else { "" }
+            ),
+        ))
     }
 }
 

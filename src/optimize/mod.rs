@@ -147,11 +147,27 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             ));
         }
     }
-    if spec.samples == Some(0) {
+    /// Most Monte Carlo samples per candidate (each a whole run, and the
+    /// runs' metrics are held together).
+    const MAX_SAMPLES: u32 = 1_000_000;
+    /// Most objective evaluations per (kind, n).
+    const MAX_EVALUATIONS: u64 = 100_000;
+    if let Some(n) = spec.samples
+        && !(1..=MAX_SAMPLES).contains(&n)
+    {
         return Err(bad(
             "samples",
-            "0".into(),
-            "need at least one sample per candidate",
+            n.to_string(),
+            &format!("samples per candidate: 1 to {MAX_SAMPLES}"),
+        ));
+    }
+    if !(4..=MAX_EVALUATIONS).contains(&spec.max_evaluations) {
+        return Err(bad(
+            "max_evaluations",
+            spec.max_evaluations.to_string(),
+            &format!(
+                "objective evaluations per (kind, n): 4 (the scan that brackets ρ takes 5, 4 at the least) to {MAX_EVALUATIONS}"
+            ),
         ));
     }
     let ns = plan.file.designs.n.values();

@@ -55,6 +55,8 @@ impl Simulation {
 
     /// Build, integrate and measure the run; `record` keeps the sampled series.
     pub fn run(&self, record: bool) -> Result<RunResult, SceneError> {
+        /// Most samples a recorded series may hold (each a few f64 per weight).
+        const MAX_SERIES_SAMPLES: f64 = 1e7;
         let system = self.scene.build()?;
         let n = system.cargo().len();
         if self.initial_angles.len() != n {
@@ -62,6 +64,24 @@ impl Simulation {
                 field: "start.angles_deg".into(),
                 value: format!("{} angles", self.initial_angles.len()),
                 reason: format!("the balancer has {n} cargoes"),
+            });
+        }
+        if let Some(bad) = self.initial_angles.iter().find(|a| !a.is_finite()) {
+            return Err(SceneError::Invalid {
+                field: "start.angles_deg".into(),
+                value: bad.to_string(),
+                reason: "every start angle must be a finite number of degrees".into(),
+            });
+        }
+        // A recorded series keeps every sample of the run in memory.
+        let samples = self.metrics.t_end_revs * f64::from(self.metrics.samples_per_rev);
+        if record && samples > MAX_SERIES_SAMPLES {
+            return Err(SceneError::Invalid {
+                field: "metrics.t_end_revs".into(),
+                value: self.metrics.t_end_revs.to_string(),
+                reason: format!(
+                    "a recorded series keeps every sample: t_end_revs × samples_per_rev = {samples:e}, more than {MAX_SERIES_SAMPLES:e}; shorten the run or sample less often"
+                ),
             });
         }
         let omega = self.scene.speed.nominal_speed();

@@ -14,6 +14,7 @@ use crate::model::rotor::RotorModel;
 use crate::model::scene::{DesignSpec, RhoChoice, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
+use crate::model::validate::shown;
 use crate::simulation::SolverSettings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -759,6 +760,41 @@ impl StudyFile {
                 "with designs.per_plane the optimiser searches two balancer planes' radius ratios; this rotor has another number: run the planes' designs as a grid",
             ));
         }
+        // The grid's size from its axes alone, before a design is built.
+        let g = &self.designs;
+        let mut grid = [
+            g.kind.values().len(),
+            g.n.values().len(),
+            g.rho.values().len(),
+            g.drag.values().len(),
+            g.stall_torque.as_ref().map_or(1, |t| t.values().len()),
+        ]
+        .iter()
+        .fold(1u64, |acc, &k| acc.saturating_mul(k as u64));
+        for a in &g.per_plane {
+            let axis = |len: Option<usize>| len.unwrap_or(1) as u64;
+            grid = grid
+                .saturating_mul(axis(a.kind.as_ref().map(|v| v.values().len())))
+                .saturating_mul(axis(a.n.as_ref().map(|v| v.values().len())))
+                .saturating_mul(axis(a.rho.as_ref().map(|v| v.values().len())))
+                .saturating_mul(axis(a.drag.as_ref().map(|v| v.values().len())));
+        }
+        if grid.saturating_mul(u64::from(s.samples)) > MAX_TOTAL_RUNS {
+            // The grid alone too large, or the samples on top of it.
+            let (key, value) = if grid > MAX_TOTAL_RUNS {
+                ("designs", format!("{grid} designs"))
+            } else {
+                ("sampling.samples", s.samples.to_string())
+            };
+            return Err(invalid(
+                key,
+                value,
+                &format!(
+                    "{grid} designs × {} samples is more than the {MAX_TOTAL_RUNS} runs one study may hold; split the grid into several studies or use fewer samples",
+                    s.samples
+                ),
+            ));
+        }
         let designs = self
             .resolve_designs()
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;
@@ -1149,16 +1185,6 @@ fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static 
             }
             Ok(())
         }
-    }
-}
-
-/// A number as the user would write it: plain in the everyday range,
-/// scientific beyond (1e300, not three hundred digits).
-fn shown(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
-        v.to_string()
-    } else {
-        format!("{v:e}")
     }
 }
 

@@ -73,6 +73,28 @@ pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
         "[summary]\npareto = []\n[sampling]",
         "summary.pareto",
     ),
+    // Out of any machine's range: every run would fail (issue 33).
+    (
+        "omega = 300.0",
+        "omega = 5e-324",
+        "scene.speed.omega = 5e-324",
+    ),
+    (
+        "omega = 300.0",
+        "omega = 1e308",
+        "scene.speed.omega = 1e308",
+    ),
+    // Sizes checked from the input alone, before anything is allocated.
+    (
+        "t_end_revs = 100",
+        "t_end_revs = 1e308",
+        "metrics.t_end_revs = 1e308",
+    ),
+    (
+        "hold_revs = 50\nt_end_revs = 100",
+        "samples_per_rev = 100000\nhold_revs = 1e5\nt_end_revs = 2e5",
+        "metrics.hold_revs",
+    ),
     // Rejection sampling that would never end (issue 33): a point interval,
     // and a spread that leaves almost nothing inside.
     (

@@ -86,7 +86,7 @@ pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
     let plan = load(&args.study)?;
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&plan));
     let run = RunOptions {
-        threads: args.threads,
+        threads: crate::limits::capped_threads(args.threads),
         ..RunOptions::default()
     };
     let manifest = record_baseline(&plan, &dir, &run, &NoProgress).map_err(|e| exit_code(e, 1))?;
@@ -112,7 +112,7 @@ pub fn check(args: &CheckArgs) -> Result<(), UserError> {
         runs: args.runs.clone(),
         output_root: args.out.clone(),
         run: RunOptions {
-            threads: args.threads,
+            threads: crate::limits::capped_threads(args.threads),
             ..RunOptions::default()
         },
     };

@@ -3,9 +3,6 @@
 //! rule on every verb, and the message names the flag, the value and the
 //! limit (exit code 2).
 
-/// Most worker threads a verb accepts (far above any machine here; a
-/// thread is a stack and a share of every chunk).
-pub const MAX_THREADS: usize = 4096;
 /// Most runs held in memory before a chunk is written (each run is a few
 /// hundred bytes to a few kilobytes, and twice this many may wait).
 pub const MAX_CHUNK_RUNS: usize = 1_000_000;
@@ -28,9 +25,24 @@ fn whole_in(text: &str, what: &str, lo: usize, hi: usize) -> Result<usize, Strin
     Ok(n)
 }
 
-/// `--threads`: 1 ..= [`MAX_THREADS`].
+/// `--threads`: at least 1 (more than the cores are capped by
+/// [`capped_threads`], with a warning).
 pub fn threads(text: &str) -> Result<usize, String> {
-    whole_in(text, "worker threads; at least one", 1, MAX_THREADS)
+    whole_in(text, "worker threads; at least one", 1, usize::MAX)
+        .map_err(|why| format!("--threads {}: {why}", text.trim()))
+}
+
+/// The worker threads to use for `--threads asked`: at most the logical
+/// cores here (a warning says so), `None` for rayon's default.
+pub fn capped_threads(asked: Option<usize>) -> Option<usize> {
+    let asked = asked?;
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    if asked > cores {
+        eprintln!(
+            "warning: --threads {asked} is more than the {cores} logical cores here; using {cores}"
+        );
+    }
+    Some(asked.min(cores))
 }
 
 /// `--chunk-runs`: 1 ..= [`MAX_CHUNK_RUNS`].
@@ -82,7 +94,7 @@ mod tests {
 
     #[test]
     fn each_range_refuses_its_extremes_and_names_the_limit() {
-        assert!(threads("0").unwrap_err().contains("1..=4096"));
+        assert!(threads("0").unwrap_err().contains("--threads 0"));
         assert_eq!(threads("2"), Ok(2));
         assert!(chunk_runs("18446744073709551615").is_err());
         assert!(

@@ -79,18 +79,7 @@ pub struct MergeArgs {
 
 /// Run `study run`.
 pub fn run(args: &RunArgs) -> Result<(), UserError> {
-    let threads = match args.threads {
-        Some(asked) => {
-            let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
-            if asked > cores {
-                eprintln!(
-                    "warning: --threads {asked} is more than the {cores} logical cores here; using {cores}"
-                );
-            }
-            Some(asked.min(cores))
-        }
-        None => None,
-    };
+    let threads = crate::limits::capped_threads(args.threads);
     let mut plan = load(&args.study)?;
     if let Some(criterion) = args.rank_by {
         plan.file.summary.rank_by = criterion;
