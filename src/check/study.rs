@@ -70,6 +70,70 @@ pub enum CheckError {
     /// Reading Parquet failed.
     #[error("parquet: {0}")]
     Polars(#[from] PolarsError),
+    /// The folder a check or a baseline would write holds something else.
+    #[error("{path}: {reason}")]
+    Occupied {
+        /// The folder.
+        path: String,
+        /// What is there and what to do.
+        reason: String,
+    },
+}
+
+/// Marks a folder as the scratch run of `study check` or `study baseline`:
+/// only a folder holding it (or none at all) is rewritten by them.
+pub const SCRATCH_MARK: &str = ".check-scratch";
+
+/// Whether `dir` may take a check's (or a baseline's) fresh run: it does
+/// not exist, is empty, or holds an earlier scratch run.
+fn scratch_free(dir: &Path) -> Result<(), CheckError> {
+    let occupied = |reason: &str| CheckError::Occupied {
+        path: dir.display().to_string(),
+        reason: reason.into(),
+    };
+    match std::fs::read_dir(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(occupied(&format!("cannot be read: {e}"))),
+        Ok(mut entries) => {
+            if dir.join(SCRATCH_MARK).exists() || entries.next().is_none() {
+                Ok(())
+            } else {
+                Err(occupied(
+                    "holds results that no check or baseline wrote (e.g. a study's own runs): they are never replaced by a check; give another --out",
+                ))
+            }
+        }
+    }
+}
+
+/// Run `fresh` into its scratch folder and mark the folder as scratch. A
+/// folder under the default root `<output>/check/` (`owned`) is the check's
+/// own; one under a root the user named must be empty or marked.
+fn run_scratch(
+    fresh: &StudyPlan,
+    run: &RunOptions,
+    progress: &dyn Progress,
+    owned: bool,
+) -> Result<crate::study::run::StudyOutput, CheckError> {
+    let dir = crate::study::run::output_dir(fresh, run.shard);
+    if !owned {
+        scratch_free(&dir)?;
+    }
+    // The scratch folder is rewritten by every check.
+    let run = RunOptions {
+        overwrite: true,
+        ..run.clone()
+    };
+    let out = run_study(fresh, &run, progress)?;
+    std::fs::write(
+        dir.join(SCRATCH_MARK),
+        "written by study check or study baseline\n",
+    )
+    .map_err(|e| CheckError::Occupied {
+        path: dir.display().to_string(),
+        reason: format!("cannot be marked as a check's folder: {e}"),
+    })?;
+    Ok(out)
 }
 
 impl CheckError {
@@ -77,27 +141,62 @@ impl CheckError {
     pub fn is_user_error(&self) -> bool {
         match self {
             CheckError::Baseline(e) => e.is_user_error(),
-            CheckError::BadRuns { .. } | CheckError::Compare(_) => true,
+            CheckError::BadRuns { .. } | CheckError::Compare(_) | CheckError::Occupied { .. } => {
+                true
+            }
             CheckError::Run(e) => e.is_user_error(),
             CheckError::Polars(_) => false,
         }
     }
 }
 
-/// Run `plan` as `study run` would and record its results as a baseline in `dir`.
+/// Whether a baseline may be written into `dir`: it does not exist, is
+/// empty, or holds a baseline and `overwrite` says to replace it. A folder
+/// holding anything else (a study's results) is never written into.
+fn baseline_target_free(dir: &Path, overwrite: bool) -> Result<(), CheckError> {
+    let occupied = |reason: &str| CheckError::Occupied {
+        path: dir.display().to_string(),
+        reason: reason.into(),
+    };
+    if dir.exists() && !dir.is_dir() {
+        return Err(occupied("is a file, not a folder: give a folder to --out"));
+    }
+    let Ok(mut entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    if entries.next().is_none() {
+        return Ok(());
+    }
+    if !dir.join(super::baseline::MANIFEST).exists() {
+        return Err(occupied(
+            "holds files that are not a baseline (e.g. the results of `study run`): a baseline is never written into it; give another --out",
+        ));
+    }
+    if !overwrite {
+        return Err(occupied(
+            "holds a baseline already: add --overwrite to replace it",
+        ));
+    }
+    Ok(())
+}
+
+/// Run `plan` as `study run` would and record its results as a baseline in
+/// `dir` (an existing baseline there is replaced only with `run.overwrite`).
 pub fn record_baseline(
     plan: &StudyPlan,
     dir: &Path,
     run: &RunOptions,
     progress: &dyn Progress,
 ) -> Result<Manifest, CheckError> {
-    // Recording a baseline reruns the study on purpose: its results folder
-    // is replaced, as the documentation of `study baseline` says.
-    let run = RunOptions {
-        overwrite: true,
-        ..run.clone()
-    };
-    let output = run_study(plan, &run, progress)?;
+    baseline_target_free(dir, run.overwrite)?;
+    // Recording a baseline reruns the study into the check's scratch folder
+    // (`<output>/check/<name>/`), never over the study's own results.
+    let mut fresh = plan.clone();
+    fresh.file.output = Path::new(&plan.file.output)
+        .join("check")
+        .display()
+        .to_string();
+    let output = run_scratch(&fresh, run, progress, true)?;
     Ok(write_baseline(dir, plan, &output.load_runs()?)?)
 }
 
@@ -123,12 +222,8 @@ pub fn check_study(
                 .clone()
                 .unwrap_or_else(|| Path::new(&plan.file.output).join("check"));
             fresh.file.output = root.display().to_string();
-            // The check's scratch folder is rewritten by every check.
-            let run = RunOptions {
-                overwrite: true,
-                ..options.run.clone()
-            };
-            let out = run_study(&fresh, &run, progress)?;
+            let owned = options.output_root.is_none();
+            let out = run_scratch(&fresh, &options.run, progress, owned)?;
             (
                 design_samples(&read_parquet(&out.dir.join("runs.parquet"))?)?,
                 fresh.file.seed,

@@ -311,6 +311,20 @@ fn a_baseline_of_another_study_is_refused() {
     let dir = tmp.path().join("baseline");
     let p = plan(&small_study(tmp.path(), 20.0));
     record_baseline(&p, &dir, &RunOptions::default(), &NoProgress).unwrap();
+    // The baseline's own run sits in the check's scratch folder; a refused
+    // check must leave it as it was.
+    let snapshot = || -> Vec<(std::path::PathBuf, std::time::SystemTime)> {
+        let mut files: Vec<_> = walk(&tmp.path().join("check"))
+            .into_iter()
+            .map(|f| {
+                let modified = std::fs::metadata(&f).unwrap().modified().unwrap();
+                (f, modified)
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let before = snapshot();
     let other = plan(&small_study(tmp.path(), 21.0));
     let err = check_study(&other, &dir, &options(None), &NoProgress).unwrap_err();
     assert!(matches!(
@@ -320,7 +334,25 @@ fn a_baseline_of_another_study_is_refused() {
     assert!(err.is_user_error());
     assert!(err.to_string().contains("different study file"), "{err}");
     // Nothing was run for the refused check.
-    assert!(!tmp.path().join("check").exists());
+    assert_eq!(snapshot(), before);
+}
+
+/// Every file under `dir` (none if it does not exist).
+fn walk(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    entries
+        .flatten()
+        .flat_map(|e| {
+            let path = e.path();
+            if path.is_dir() {
+                walk(&path)
+            } else {
+                vec![path]
+            }
+        })
+        .collect()
 }
 
 fn study_cli(args: &[&str]) -> std::process::Output {

@@ -62,9 +62,12 @@ pub struct CheckArgs {
 pub struct BaselineArgs {
     /// Study file (TOML).
     study: PathBuf,
-    /// Baseline folder (default: <output>/baselines/<name>/); replaced if it exists.
+    /// Baseline folder (default: <output>/baselines/<name>/); an existing baseline there is replaced only with --overwrite.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the baseline already in the folder.
+    #[arg(long)]
+    overwrite: bool,
     /// Worker threads (default: all cores, or RAYON_NUM_THREADS).
     #[arg(long, value_parser = crate::limits::threads)]
     threads: Option<usize>,
@@ -87,6 +90,7 @@ pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&plan));
     let run = RunOptions {
         threads: crate::limits::capped_threads(args.threads),
+        overwrite: args.overwrite,
         ..RunOptions::default()
     };
     let manifest = record_baseline(&plan, &dir, &run, &NoProgress).map_err(|e| exit_code(e, 1))?;
