@@ -188,27 +188,39 @@ pub fn compare(
                 p_holm: None,
                 verdict: Verdict::NotTested,
             };
-        let (mb, mn) = (median(&b.settling_revs), median(&n.settling_revs));
-        let ks = ks_two_sample(&b.settling_revs, &n.settling_revs);
-        rows.push(row(
+        // KS on settling times, Fisher on settled counts: the design's own
+        // and each watched plane's.
+        let settling = |metric, before: &[f64], now: &[f64]| {
+            let (mb, mn) = (median(before), median(now));
+            let ks = ks_two_sample(before, now);
+            row(
+                metric,
+                mb,
+                mn,
+                relative(mb, mn),
+                ks.map(|k| k.statistic),
+                (before.len() as u64, now.len() as u64),
+                ks.map(|k| k.p_value),
+            )
+        };
+        let share = |metric, before: u64, now: u64| {
+            let fraction = fisher_two_proportions(before, b.runs, now, n.runs);
+            row(
+                metric,
+                fraction.map(|f| f.a),
+                fraction.map(|f| f.b),
+                fraction.map(|f| f.difference),
+                None,
+                (b.runs, n.runs),
+                fraction.map(|f| f.p_value),
+            )
+        };
+        rows.push(settling(
             Metric::SettlingTime,
-            mb,
-            mn,
-            relative(mb, mn),
-            ks.map(|k| k.statistic),
-            (b.settling_revs.len() as u64, n.settling_revs.len() as u64),
-            ks.map(|k| k.p_value),
+            &b.settling_revs,
+            &n.settling_revs,
         ));
-        let fraction = fisher_two_proportions(b.settled, b.runs, n.settled, n.runs);
-        rows.push(row(
-            Metric::SettledFraction,
-            fraction.map(|f| f.a),
-            fraction.map(|f| f.b),
-            fraction.map(|f| f.difference),
-            None,
-            (b.runs, n.runs),
-            fraction.map(|f| f.p_value),
-        ));
+        rows.push(share(Metric::SettledFraction, b.settled, n.settled));
         let mood = mood_median_test(&b.residual_rel, &n.residual_rel);
         let (rb, rn) = (median(&b.residual_rel), median(&n.residual_rel));
         rows.push(row(
@@ -223,26 +235,15 @@ pub fn compare(
         // Watched planes: tested where both sides have them.
         for (p, (bp, np)) in b.planes.iter().zip(&n.planes).enumerate() {
             let p = p as u32;
-            let (mb, mn) = (median(&bp.settling_revs), median(&np.settling_revs));
-            let ks = ks_two_sample(&bp.settling_revs, &np.settling_revs);
-            rows.push(row(
+            rows.push(settling(
                 Metric::PlaneSettlingTime(p),
-                mb,
-                mn,
-                relative(mb, mn),
-                ks.map(|k| k.statistic),
-                (bp.settling_revs.len() as u64, np.settling_revs.len() as u64),
-                ks.map(|k| k.p_value),
+                &bp.settling_revs,
+                &np.settling_revs,
             ));
-            let fraction = fisher_two_proportions(bp.settled, b.runs, np.settled, n.runs);
-            rows.push(row(
+            rows.push(share(
                 Metric::PlaneSettledFraction(p),
-                fraction.map(|f| f.a),
-                fraction.map(|f| f.b),
-                fraction.map(|f| f.difference),
-                None,
-                (b.runs, n.runs),
-                fraction.map(|f| f.p_value),
+                bp.settled,
+                np.settled,
             ));
         }
     }

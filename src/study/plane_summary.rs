@@ -21,15 +21,11 @@ pub fn column_names(p: usize) -> [String; 3] {
     ]
 }
 
-/// A list column of `runs` as one vector per row (nulls kept).
+/// A list column of `runs` as one vector per row (nulls kept); empty rows
+/// when it is absent.
 fn lists(runs: &DataFrame, name: &str) -> PolarsResult<Vec<Vec<Option<f64>>>> {
-    let list = runs.column(name)?.list()?;
-    (0..list.len())
-        .map(|i| match list.get_as_series(i) {
-            Some(s) => Ok(s.f64()?.iter().collect()),
-            None => Ok(Vec::new()),
-        })
-        .collect()
+    Ok(super::record::nullable_lists(runs, name)?
+        .unwrap_or_else(|| vec![Vec::new(); runs.height()]))
 }
 
 /// One plane's statistics over a set of runs.

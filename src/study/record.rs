@@ -276,6 +276,22 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
     DataFrame::new(rows.len(), columns)
 }
 
+/// A list column of f64 as one vector per row, nulls kept (a plane that did
+/// not settle); `None` when `df` has no such column.
+pub fn nullable_lists(df: &DataFrame, name: &str) -> PolarsResult<Option<Vec<Vec<Option<f64>>>>> {
+    let Ok(column) = df.column(name) else {
+        return Ok(None);
+    };
+    let list = column.list()?;
+    (0..list.len())
+        .map(|i| match list.get_as_series(i) {
+            Some(s) => Ok(s.f64()?.iter().collect()),
+            None => Ok(Vec::new()),
+        })
+        .collect::<PolarsResult<_>>()
+        .map(Some)
+}
+
 /// Column names that hold nothing machine- or schedule-dependent (all but wall time).
 pub fn deterministic_columns(df: &DataFrame) -> Vec<String> {
     df.get_column_names()
@@ -436,20 +452,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let plane_residual = optional_lists(PLANE_COLUMNS[1])?;
     let plane_eps = optional_lists(PLANE_COLUMNS[3])?;
     // Nulls inside: a plane that did not settle.
-    let plane_settling: Option<Vec<Vec<Option<f64>>>> = match df.column(PLANE_COLUMNS[2]) {
-        Ok(c) => {
-            let list = c.list()?;
-            Some(
-                (0..list.len())
-                    .map(|i| match list.get_as_series(i) {
-                        Some(s) => Ok(s.f64()?.iter().collect()),
-                        None => Ok(Vec::new()),
-                    })
-                    .collect::<PolarsResult<_>>()?,
-            )
-        }
-        Err(_) => None,
-    };
+    let plane_settling = nullable_lists(df, PLANE_COLUMNS[2])?;
     let couple: Option<Vec<SampledCouple>> = if df.column(COUPLE_COLUMNS[0]).is_ok() {
         let (u, fraction, direction) = (
             f64s(COUPLE_COLUMNS[0])?,

@@ -12,7 +12,7 @@ use num_complex::Complex64;
 
 /// The long rotor of `fixtures::long_rotor` (ω1 = √2, ω2 = √10) as a
 /// study's `[scene.rotor]`, without its `planes` key.
-const LONG_ROTOR: &str = r#"model = "two_support"
+pub(crate) const LONG_ROTOR: &str = r#"model = "two_support"
 mass = 1.0
 transverse_inertia = 1.0
 polar_inertia = 0.2

@@ -5,6 +5,7 @@
 //! runs.parquet and summary.parquet name every plane's design, and a bad
 //! entry is refused naming its key.
 
+use crate::couple_unbalance::LONG_ROTOR;
 use autobal::study::config::StudyFile;
 use autobal::study::io::read_parquet;
 use autobal::study::plane_designs::column_names;
@@ -18,16 +19,7 @@ fn study(dir: &Path, per_plane: &str) -> String {
         r#"name = "planes"
 output = "{}"
 [scene.rotor]
-model = "two_support"
-mass = 1.0
-transverse_inertia = 1.0
-polar_inertia = 0.2
-k1 = 1.0
-l1 = 2.0
-k2 = 1.0
-l2 = 2.0
-b1 = 0.05
-b2 = 0.05
+{LONG_ROTOR}
 planes = [-1.0, 1.0]
 [scene.speed]
 mode = "constant"
