@@ -285,6 +285,17 @@ pub(crate) const SCENE_CASES: &[(&str, &str, &str)] = &[
         "[effects.contact]\nfrequency_ratio = 10.0\nstiff = true\n[start]",
         "stiff",
     ),
+    // Issue 33: a negative contact frequency burnt every run's step budget.
+    (
+        "[start]",
+        "[effects.contact]\nfrequency_ratio = -1.0\n[start]",
+        "effects.contact.frequency_ratio",
+    ),
+    (
+        "[start]",
+        "[effects.contact]\ndamping_ratio = nan\n[start]",
+        "effects.contact.damping_ratio",
+    ),
 ];
 
 /// Command lines (after `study`) that must be refused with exit code 2.

@@ -15,6 +15,7 @@
 use super::{Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
 use crate::model::race_ring::{MAX_RING, for_each_neighbour_pair};
+use crate::model::validate::{SceneError, invalid};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
@@ -62,6 +63,27 @@ impl Default for ContactSpec {
 }
 
 impl EffectSpec for ContactSpec {
+    fn validate(&self, key: &str) -> Result<(), SceneError> {
+        // Below 1 the contact is softer than the whirl it must stop (weights
+        // pass through each other); far above, every touch costs steps
+        // for no change in the result.
+        if !(1.0..=1e4).contains(&self.frequency_ratio) {
+            return Err(invalid(
+                &format!("{key}.frequency_ratio"),
+                self.frequency_ratio,
+                "contact frequency over the nominal speed: 1 to 10000 (default 20)",
+            ));
+        }
+        if !(0.0..=1e3).contains(&self.damping_ratio) {
+            return Err(invalid(
+                &format!("{key}.damping_ratio"),
+                self.damping_ratio,
+                "a damping ratio from 0 to 1000 (default 2: a dead impact)",
+            ));
+        }
+        Ok(())
+    }
+
     fn build(&self, cargo: &[Cargo], omega: f64) -> Option<Box<dyn Effect>> {
         Contact::new(self, cargo, omega).map(|c| Box::new(c) as Box<dyn Effect>)
     }
