@@ -37,6 +37,7 @@ pub mod integrate;
 pub mod metrics;
 pub mod model;
 pub mod optimize;
+pub mod output_file;
 pub mod plot;
 pub mod scene_file;
 pub mod schema;

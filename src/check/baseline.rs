@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// File name of the manifest.
-pub const MANIFEST: &str = "manifest.toml";
+pub use crate::study::study_folder::BASELINE_MANIFEST as MANIFEST;
 
 /// Version of the folder layout; bumped when it changes incompatibly.
 pub const FORMAT: u32 = 1;

@@ -80,9 +80,7 @@ pub enum CheckError {
     },
 }
 
-/// Marks a folder as the scratch run of `study check` or `study baseline`:
-/// only a folder holding it (or none at all) is rewritten by them.
-pub const SCRATCH_MARK: &str = ".check-scratch";
+pub use crate::study::study_folder::SCRATCH_MARK;
 
 /// Whether `dir` may take a check's (or a baseline's) fresh run: it does
 /// not exist, is empty, or holds an earlier scratch run.

@@ -19,6 +19,7 @@ use crate::model::start::StartMode;
 use crate::study::config::{Distribution, InitialSpec, Scale, StudyPlan, UnbalanceSpec};
 use crate::study::run::{Progress, RunError, RunOptions, run_study};
 use crate::study::runs_file::read_summary_columns;
+use crate::study::study_folder::CLAIMS_MARK;
 use crate::study::verdict::{DesignRuns, SettlingClock, design_runs, settling_horizon};
 use normalisation::{Normalisation, design_capacity, rho_for};
 use polars::prelude::*;
@@ -167,6 +168,21 @@ fn variant(
     })
 }
 
+/// A variant's folder may be (re)written only when it is new, empty, or
+/// marked as a claims variant: results of anything else are never replaced.
+fn owned_variant_folder(plan: &StudyPlan) -> Result<(), RunError> {
+    let dir = crate::study::run::output_dir(plan, None);
+    let foreign = std::fs::read_dir(&dir).is_ok_and(|mut entries| entries.next().is_some())
+        && !dir.join(CLAIMS_MARK).exists();
+    if foreign {
+        return Err(RunError::NotOwned {
+            path: dir.display().to_string(),
+            owner: "study claims",
+        });
+    }
+    Ok(())
+}
+
 /// Run a variant through the study runner and read its summary back.
 fn run_variant(
     plan: &StudyPlan,
@@ -180,6 +196,7 @@ fn run_variant(
         ..RunOptions::default()
     };
     let out = run_study(plan, &options, progress)?;
+    std::fs::write(out.dir.join(CLAIMS_MARK), "written by study claims\n")?;
     let summary = out.summary.expect("unsharded runs have a summary");
     let f = |c: &str| -> PolarsResult<Vec<Option<f64>>> {
         Ok(summary.column(c)?.f64()?.iter().collect())
@@ -253,6 +270,7 @@ pub fn run_claims(base: &StudyPlan, progress: &dyn Progress) -> Result<ClaimsOut
     let mut shift = Vec::new();
     let mut fastest = Vec::new();
     let shift_ns: Vec<u32> = ns.iter().copied().filter(|&n| n <= 5).collect();
+    let mut variants = Vec::new();
     for norm in Normalisation::ALL {
         // The shift starts from the locked steady state of the new unbalance with
         // the weights still at the old balanced position: a quiet rotor (the
@@ -266,7 +284,7 @@ pub fn run_claims(base: &StudyPlan, progress: &dyn Progress) -> Result<ClaimsOut
             StartMode::LockedSteady,
             InitialSpec::BalancedForShift(90.0),
         ) {
-            shift.extend(run_variant(&p, "shift_90", norm, progress)?);
+            variants.push((p, "shift_90", norm));
         }
         if let Some(p) = variant(
             base,
@@ -276,7 +294,19 @@ pub fn run_claims(base: &StudyPlan, progress: &dyn Progress) -> Result<ClaimsOut
             StartMode::LockedSteady,
             InitialSpec::Clustered,
         ) {
-            fastest.extend(run_variant(&p, "fastest", norm, progress)?);
+            variants.push((p, "fastest", norm));
+        }
+    }
+    // Every variant's folder is checked before the first one runs.
+    for (p, _, _) in &variants {
+        owned_variant_folder(p)?;
+    }
+    for (p, experiment, norm) in &variants {
+        let rows = run_variant(p, experiment, *norm, progress)?;
+        if *experiment == "shift_90" {
+            shift.extend(rows);
+        } else {
+            fastest.extend(rows);
         }
     }
     Ok(ClaimsOutput {

@@ -67,6 +67,18 @@ pub enum OptimizeError {
     Output(String),
 }
 
+/// The plan's `[optimize]` table, checked: refused (naming the key) before
+/// anything runs or is written.
+pub fn checked_spec(plan: &StudyPlan) -> Result<OptimizeSpec, OptimizeError> {
+    let spec = plan
+        .file
+        .optimize
+        .clone()
+        .ok_or_else(|| OptimizeError::NoSpec(plan.name.clone()))?;
+    validate(&spec, plan)?;
+    Ok(spec)
+}
+
 fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> {
     let bad = |key: &str, value: String, reason: &str| OptimizeError::Invalid {
         key: key.into(),
@@ -186,12 +198,7 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
 /// Run the optimisation of `plan`'s `[optimize]` table and write
 /// `optimize.parquet` and `optimum.parquet` under the study's output folder.
 pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
-    let spec = plan
-        .file
-        .optimize
-        .clone()
-        .ok_or_else(|| OptimizeError::NoSpec(plan.name.clone()))?;
-    validate(&spec, plan)?;
+    let spec = checked_spec(plan)?;
     // Common random numbers: every candidate meets the same sampled unbalances.
     let mut plan = plan.clone();
     plan.file.sampling.common_random_numbers = true;

@@ -68,15 +68,40 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// `e` (met while reading or writing `path`) with the path in front of its
+/// message: polars and the OS name neither the file nor the folder.
+pub fn about(path: &Path, e: PolarsError) -> PolarsError {
+    let text = e.to_string();
+    let text = if text.contains("out of specification") || text.contains("magic") {
+        format!("not a readable Parquet file ({text})")
+    } else {
+        text
+    };
+    let message = format!("{}: {text}", path.display());
+    match e {
+        PolarsError::IO { error, .. } => PolarsError::IO {
+            error,
+            msg: Some(message.into()),
+        },
+        _ => PolarsError::ComputeError(message.into()),
+    }
+}
+
 /// Write `df` to `path` atomically, with provenance in the key-value metadata.
 pub fn write_parquet(path: &Path, df: &mut DataFrame, provenance: &Provenance) -> PolarsResult<()> {
     let tmp = temp_path(path);
-    let file = File::create(&tmp)?;
-    ParquetWriter::new(file)
-        .with_key_value_metadata(Some(KeyValueMetadata::from_static(provenance.pairs())))
-        .finish(df)?;
-    std::fs::rename(&tmp, path)?;
-    Ok(())
+    let written = File::create(&tmp)
+        .map_err(PolarsError::from)
+        .and_then(|file| {
+            ParquetWriter::new(file)
+                .with_key_value_metadata(Some(KeyValueMetadata::from_static(provenance.pairs())))
+                .finish(df)
+        })
+        .and_then(|_| move_into_place(&tmp, path).map_err(PolarsError::from));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map(|_| ()).map_err(|e| about(path, e))
 }
 
 /// A study's chunk of finished runs, atomically, as an Arrow IPC file:
@@ -86,20 +111,28 @@ pub fn write_parquet(path: &Path, df: &mut DataFrame, provenance: &Provenance) -
 /// against 7 ms for IPC. The study's provenance is in `plan.sha256`.
 pub fn write_chunk(path: &Path, df: &mut DataFrame) -> PolarsResult<()> {
     let tmp = temp_path(path);
-    IpcWriter::new(File::create(&tmp)?).finish(df)?;
-    std::fs::rename(&tmp, path)?;
-    Ok(())
+    let written = File::create(&tmp)
+        .map_err(PolarsError::from)
+        .and_then(|file| IpcWriter::new(file).finish(df))
+        .and_then(|_| move_into_place(&tmp, path).map_err(PolarsError::from));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map_err(|e| about(path, e))
 }
 
 /// Read a Parquet file written by [`write_parquet`].
 pub fn read_parquet(path: &Path) -> PolarsResult<DataFrame> {
-    ParquetReader::new(File::open(path)?).finish()
+    File::open(path)
+        .map_err(PolarsError::from)
+        .and_then(|file| ParquetReader::new(file).finish())
+        .map_err(|e| about(path, e))
 }
 
 /// Read the key-value metadata of a Parquet file as (key, value) pairs.
 pub fn read_metadata(path: &Path) -> PolarsResult<Vec<(String, String)>> {
-    let mut reader = ParquetReader::new(File::open(path)?);
-    let meta = reader.get_metadata()?;
+    let mut reader = ParquetReader::new(File::open(path).map_err(|e| about(path, e.into()))?);
+    let meta = reader.get_metadata().map_err(|e| about(path, e))?;
     Ok(meta
         .key_value_metadata()
         .as_ref()
@@ -114,8 +147,11 @@ pub fn read_metadata(path: &Path) -> PolarsResult<Vec<(String, String)>> {
 /// Write a text file atomically.
 pub fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
     let tmp = temp_path(path);
-    std::fs::write(&tmp, text)?;
-    move_into_place(&tmp, path)
+    std::fs::write(&tmp, text)
+        .and_then(|_| move_into_place(&tmp, path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&tmp);
+        })
 }
 
 /// Rename a finished temporary file to `path`, removing it if that fails
@@ -153,8 +189,20 @@ pub fn write_series(
         return Ok(());
     }
     let tmp = temp_path(path);
+    let written = write_series_csv(&tmp, &df).and_then(|_| Ok(move_into_place(&tmp, path)?));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map_err(|e| format!("{}: {e}", path.display()).into())
+}
+
+/// The series' columns as CSV in `tmp`.
+fn write_series_csv(
+    tmp: &Path,
+    df: &DataFrame,
+) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
     {
-        let mut w = csv::Writer::from_path(&tmp)?;
+        let mut w = csv::Writer::from_path(tmp)?;
         let names: Vec<String> = df
             .get_column_names()
             .iter()
@@ -171,6 +219,5 @@ pub fn write_series(
         }
         w.flush()?;
     }
-    std::fs::rename(&tmp, path)?;
     Ok(())
 }

@@ -40,6 +40,22 @@ pub enum LockError {
 impl FolderLock {
     /// Take the lock of `folder` (which must exist), or say who holds it.
     pub fn acquire(folder: &Path) -> Result<Self, LockError> {
+        // A holder removes the file before it unlocks, so a lock taken on a
+        // file that is no longer at the path guards nothing: try again on
+        // the new file (bounded: each retry means another process finished).
+        for _ in 0..64 {
+            if let Some(lock) = Self::try_acquire(folder)? {
+                return Ok(lock);
+            }
+        }
+        Err(LockError::Io {
+            folder: folder.display().to_string(),
+            source: std::io::Error::other("the lock file kept being replaced"),
+        })
+    }
+
+    /// One attempt: `None` when the locked file was removed meanwhile.
+    fn try_acquire(folder: &Path) -> Result<Option<Self>, LockError> {
         let path = folder.join(".lock");
         let io = |source| LockError::Io {
             folder: folder.display().to_string(),
@@ -66,9 +82,13 @@ impl FolderLock {
             }
             Err(TryLockError::Error(e)) => return Err(io(e)),
         }
+        if !same_file(&file, &path) {
+            let _ = file.unlock();
+            return Ok(None);
+        }
         file.set_len(0).map_err(io)?;
         writeln!(file, "pid {} on {}", std::process::id(), host()).map_err(io)?;
-        Ok(FolderLock { file, path })
+        Ok(Some(FolderLock { file, path }))
     }
 }
 
@@ -78,6 +98,22 @@ impl Drop for FolderLock {
         let _ = std::fs::remove_file(&self.path);
         let _ = self.file.unlock();
     }
+}
+
+/// Whether the open `file` is still the one at `path`.
+#[cfg(unix)]
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Whether the open `file` is still the one at `path` (no inode numbers here).
+#[cfg(not(unix))]
+fn same_file(_file: &File, path: &Path) -> bool {
+    path.exists()
 }
 
 /// This machine's name, for the lock file.

@@ -16,6 +16,7 @@
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
 //! - [`compare_designs`]: two designs of one or two results folders (`study compare`).
 //! - [`merge`]: combining shard outputs.
+//! - [`study_folder`]: the study's folder as another verb's destination (tradeoff, optimize).
 //! - [`io`]: Parquet with provenance, atomic writes.
 //! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
 //! - [`stability_map`]: linear stability over (speed, unbalance).
@@ -40,6 +41,7 @@ pub mod run;
 pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
+pub mod study_folder;
 pub mod sweep;
 pub mod tolerance;
 pub mod truncated;

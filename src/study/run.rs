@@ -197,6 +197,16 @@ pub enum RunError {
     /// Another process is writing the folder.
     #[error(transparent)]
     Locked(#[from] LockError),
+    /// A verb that rewrites its own folders met one it did not write.
+    #[error(
+        "{path} holds results that {owner} did not write; nothing was replaced: give the study another `name` or `output`"
+    )]
+    NotOwned {
+        /// The folder.
+        path: String,
+        /// The verb that owns its folders.
+        owner: &'static str,
+    },
     /// Adaptive sampling decides on all designs' runs, which a shard lacks.
     #[error(
         "sampling.stop_when cannot be used with --shard: the stopping decision needs every run of a batch; run the study unsharded (or set a fixed sample count)"
@@ -213,11 +223,19 @@ pub enum RunError {
         saved: u64,
     },
     /// Reading or writing Parquet failed.
-    #[error("parquet: {0}")]
+    #[error("{0}")]
     Polars(#[from] PolarsError),
     /// Other I/O.
     #[error("i/o: {0}")]
     Io(#[from] std::io::Error),
+    /// I/O in the study's output folder.
+    #[error("{path}: {source}")]
+    FolderIo {
+        /// The folder.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
     /// The thread pool could not be built.
     #[error("thread pool: {0}")]
     Pool(String),
@@ -234,6 +252,7 @@ impl RunError {
                 | RunError::NoPlan { .. }
                 | RunError::PlanChanged { .. }
                 | RunError::Locked(_)
+                | RunError::NotOwned { .. }
                 | RunError::AdaptiveSharded
         )
     }
@@ -380,17 +399,38 @@ pub fn run_study(
     options: &RunOptions,
     progress: &dyn Progress,
 ) -> Result<StudyOutput, RunError> {
+    // Refused before the folder is made: nothing is written.
+    if plan.file.sampling.stop_when.is_some() && options.shard.is_some() {
+        return Err(RunError::AdaptiveSharded);
+    }
     let dir = output_dir(plan, options.shard);
+    run_in_folder(&dir, plan, options, progress).map_err(|e| match e {
+        RunError::Io(source) => RunError::FolderIo {
+            path: dir.display().to_string(),
+            source,
+        },
+        other => other,
+    })
+}
+
+/// [`run_study`] in its output folder `dir`.
+fn run_in_folder(
+    dir: &Path,
+    plan: &StudyPlan,
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<StudyOutput, RunError> {
+    let dir = dir.to_path_buf();
     let not_writable = |source| RunError::NotWritable {
         path: dir.display().to_string(),
         source,
     };
     std::fs::create_dir_all(&dir).map_err(not_writable)?;
-    let probe = dir.join(".write-probe");
-    std::fs::write(&probe, b"").map_err(not_writable)?;
-    std::fs::remove_file(&probe)?;
+    crate::output_file::probe_writable(&dir).map_err(not_writable)?;
 
     let _lock = FolderLock::acquire(&dir)?;
+    // A writer killed during an atomic write left its temporary file.
+    crate::output_file::remove_stale_temps(&dir, None);
 
     let manifest = dir.join("study.toml");
     let plan_file = dir.join(PLAN_ID_FILE);
@@ -459,9 +499,6 @@ pub fn run_study(
     mark_done(&chunk_pieces(&chunks)?, &mut done);
     let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
     let stop_when = plan.file.sampling.stop_when.as_ref();
-    if stop_when.is_some() && options.shard.is_some() {
-        return Err(RunError::AdaptiveSharded);
-    }
     let total = (0..total_ids).filter(in_slice).count() as u64;
     let already = done.iter().filter(|d| **d).count() as u64;
     progress.begin(total, already);

@@ -5,7 +5,7 @@
 //! runs. The window boundaries lie in run-id space, so the same runs give the
 //! same file however they were split into pieces (threads, resumes, shards).
 
-use super::io::{Provenance, temp_path};
+use super::io::{Provenance, about, temp_path};
 use polars::prelude::*;
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -48,15 +48,18 @@ fn is_ipc(path: &Path) -> bool {
 /// The file's rows, all columns or the projection `columns`.
 fn read_file(path: &Path, columns: Option<&[&str]>) -> PolarsResult<DataFrame> {
     let columns = columns.map(|c| c.iter().map(|c| c.to_string()).collect::<Vec<_>>());
-    if is_ipc(path) {
-        IpcReader::new(File::open(path)?)
-            .with_columns(columns)
-            .finish()
-    } else {
-        ParquetReader::new(File::open(path)?)
-            .with_columns(columns)
-            .finish()
-    }
+    let read = || -> PolarsResult<DataFrame> {
+        if is_ipc(path) {
+            IpcReader::new(File::open(path)?)
+                .with_columns(columns)
+                .finish()
+        } else {
+            ParquetReader::new(File::open(path)?)
+                .with_columns(columns)
+                .finish()
+        }
+    };
+    read().map_err(|e| about(path, e))
 }
 
 impl Piece {
@@ -106,10 +109,15 @@ impl Piece {
             // A chunk holds a few thousand runs: read whole, then sliced.
             return Ok(Some(read_file(&self.path, None)?.slice(lo as i64, hi - lo)));
         }
-        ParquetReader::new(File::open(&self.path)?)
-            .with_slice(Some((lo, hi - lo)))
-            .finish()
+        File::open(&self.path)
+            .map_err(PolarsError::from)
+            .and_then(|file| {
+                ParquetReader::new(file)
+                    .with_slice(Some((lo, hi - lo)))
+                    .finish()
+            })
             .map(Some)
+            .map_err(|e| about(&self.path, e))
     }
 }
 
@@ -129,17 +137,12 @@ pub fn write_runs(
     provenance: &Provenance,
 ) -> PolarsResult<u64> {
     let tmp = temp_path(out);
-    let result = write_windows(pieces, total_ids, &tmp, provenance);
-    match result {
-        Ok(rows) => {
-            std::fs::rename(&tmp, out)?;
-            Ok(rows)
-        }
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
+    let result = write_windows(pieces, total_ids, &tmp, provenance)
+        .and_then(|rows| std::fs::rename(&tmp, out).map(|_| rows).map_err(Into::into));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
+    result.map_err(|e| about(out, e))
 }
 
 fn write_windows(
@@ -218,11 +221,14 @@ pub const PLANE_SUMMARY_COLUMNS: [&str; 2] = ["plane_settling_revs", "plane_resi
 /// The summary's projection of the file at `path`: [`SUMMARY_COLUMNS`], and
 /// [`PLANE_SUMMARY_COLUMNS`] where the file has them.
 fn summary_projection(path: &Path) -> PolarsResult<Vec<&'static str>> {
-    let schema = if is_ipc(path) {
-        IpcReader::new(File::open(path)?).schema()?
-    } else {
-        ParquetReader::new(File::open(path)?).schema()?
+    let read = || -> PolarsResult<_> {
+        Ok(if is_ipc(path) {
+            IpcReader::new(File::open(path)?).schema()?
+        } else {
+            ParquetReader::new(File::open(path)?).schema()?
+        })
     };
+    let schema = read().map_err(|e| about(path, e))?;
     let mut columns = SUMMARY_COLUMNS.to_vec();
     columns.extend(PLANE_SUMMARY_COLUMNS.iter().filter(|c| schema.contains(c)));
     Ok(columns)

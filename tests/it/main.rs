@@ -32,6 +32,7 @@ mod never_settles;
 mod newton_reduction;
 mod operating_point;
 mod optimize;
+mod output_policy;
 mod plane_designs;
 mod plot;
 mod plot_layout;

@@ -33,11 +33,11 @@ pub struct BenchArgs {
     #[arg(long)]
     json: bool,
     /// Horizon of each solve in revolutions (default 500; 20 with --quick).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::bench_revolutions)]
     revolutions: Option<f64>,
     /// Timed solves per case and RHS batches per n (default 11 and 21; 3 with --quick);
     /// studies per thread count with --thread-scaling (default 7; 1 with --quick).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::repeats)]
     repeats: Option<usize>,
     /// Only the solves `bench/scipy` repeats with SciPy (dp5 and dop853 at rtol
     /// 1e-6, 1e-8, 1e-9), with start, tolerances, RHS samples and final states.
@@ -63,80 +63,33 @@ pub struct BenchArgs {
     lean_study: Option<std::path::PathBuf>,
     /// Samples per design with --thread-scaling (default 25; 1 with --quick)
     /// or --lean-inputs (default 20).
-    #[arg(long)]
-    samples: Option<u32>,
+    #[arg(long, value_parser = crate::limits::bench_runs)]
+    samples: Option<usize>,
+    /// Replace the --lean-inputs file if it exists.
+    #[arg(long, requires = "lean_inputs")]
+    overwrite: bool,
 }
 
 /// Run `study bench`.
 pub fn run(args: &BenchArgs) -> Result<(), UserError> {
-    if args.fidelity {
-        let revs = if args.quick { 1000.0 } else { 10_000.0 };
-        let rows = bench::fidelity::measure_fidelities(revs, 1e-6, if args.quick { 1 } else { 5 });
-        if args.json {
-            println!("{}", serde_json::to_string_pretty(&rows)?);
-            return Ok(());
-        }
-        let table: Vec<Vec<String>> = rows
-            .iter()
-            .map(|r| {
-                vec![
-                    r.fidelity.clone(),
-                    r.method.clone(),
-                    r.steps.to_string(),
-                    r.rhs_calls.to_string(),
-                    format!("{:.3}", 1e3 * r.wall_s),
-                    r.settling_revs.map_or("–".into(), |t| format!("{t:.3}")),
-                    format!("{:.1e}", r.residual_rel),
-                ]
-            })
-            .collect();
-        print!(
-            "{}",
-            crate::output::text_table(
-                &[
-                    "fidelity",
-                    "method",
-                    "steps",
-                    "RHS calls",
-                    "ms",
-                    "t_s rev",
-                    "residual/A_ref"
-                ],
-                &table
-            )
-        );
-        if let [full, rot] = rows.as_slice() {
-            println!(
-                "{revs} revolutions at rtol 1e-6: rotating uses {:.1}× fewer RHS calls and {:.1}× less time than full",
-                full.rhs_calls as f64 / rot.rhs_calls as f64,
-                full.wall_s / rot.wall_s
-            );
-        }
-        return Ok(());
-    }
-
-    if args.repeats == Some(0) {
-        return Err(UserError("--repeats 0: need at least one".into(), 2));
-    }
-    if args.samples == Some(0) {
-        return Err(UserError("--samples 0: need at least one".into(), 2));
-    }
-    if let Some(revs) = args.revolutions
-        && !(revs.is_finite() && revs > 0.0)
-    {
-        return Err(UserError(
-            format!("--revolutions {revs}: must be positive and finite"),
-            2,
-        ));
-    }
     if args.samples.is_some() && !(args.thread_scaling || args.lean_inputs.is_some()) {
         return Err(UserError(
             "--samples needs --thread-scaling or --lean-inputs".into(),
             2,
         ));
     }
+    if args.fidelity {
+        return run_fidelity(args);
+    }
     if let Some(path) = &args.lean_inputs {
-        return write_lean_inputs(path, args.lean_study.as_deref(), args.samples.unwrap_or(20));
+        autobal::output_file::prepare(
+            "--lean-inputs",
+            path,
+            autobal::output_file::WhenExists::from_overwrite(args.overwrite),
+        )?;
+        // bench_runs caps the samples at a million, well inside u32.
+        let samples = args.samples.map_or(20, |s| s as u32);
+        return write_lean_inputs(path, args.lean_study.as_deref(), samples);
     }
     if args.peer_cases {
         return run_peer_cases(args);
@@ -165,6 +118,56 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     Ok(())
 }
 
+/// `study bench --fidelity`: the `full` and `rotating` fidelities side by side.
+fn run_fidelity(args: &BenchArgs) -> Result<(), UserError> {
+    let revs = args
+        .revolutions
+        .unwrap_or(if args.quick { 1000.0 } else { 10_000.0 });
+    let repeats = args.repeats.unwrap_or(if args.quick { 1 } else { 5 });
+    let rows = bench::fidelity::measure_fidelities(revs, 1e-6, repeats);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    let table: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.fidelity.clone(),
+                r.method.clone(),
+                r.steps.to_string(),
+                r.rhs_calls.to_string(),
+                format!("{:.3}", 1e3 * r.wall_s),
+                r.settling_revs.map_or("–".into(), |t| format!("{t:.3}")),
+                format!("{:.1e}", r.residual_rel),
+            ]
+        })
+        .collect();
+    print!(
+        "{}",
+        crate::output::text_table(
+            &[
+                "fidelity",
+                "method",
+                "steps",
+                "RHS calls",
+                "ms",
+                "t_s rev",
+                "residual/A_ref"
+            ],
+            &table
+        )
+    );
+    if let [full, rot] = rows.as_slice() {
+        println!(
+            "{revs} revolutions at rtol 1e-6: rotating uses {:.1}× fewer RHS calls and {:.1}× less time than full",
+            full.rhs_calls as f64 / rot.rhs_calls as f64,
+            full.wall_s / rot.wall_s
+        );
+    }
+    Ok(())
+}
+
 /// Export the main job's runs, or `study`'s, for `bench/lean` (each run is
 /// solved once by autobal).
 fn write_lean_inputs(
@@ -178,12 +181,12 @@ fn write_lean_inputs(
         None => bench::lean_inputs::lean_plan(samples),
     };
     let rows = bench::lean_inputs::lean_rows(&plan).map_err(UserError::internal)?;
-    let write = || -> std::io::Result<()> {
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-        bench::lean_inputs::write_csv(&rows, &mut out)?;
-        std::io::Write::flush(&mut out)
-    };
-    write().map_err(|e| UserError(format!("{}: {e}", path.display()), 2))?;
+    let mut text = Vec::new();
+    bench::lean_inputs::write_csv(&rows, &mut text)
+        .map_err(|e| UserError::internal(e.to_string()))?;
+    let text = String::from_utf8(text).map_err(|e| UserError::internal(e.to_string()))?;
+    autobal::study::io::write_text(path, &text)
+        .map_err(|e| UserError::internal(format!("--lean-inputs {}: {e}", path.display())))?;
     eprintln!(
         "wrote {} runs of {} to {}",
         rows.len(),
@@ -266,7 +269,7 @@ fn run_thread_scaling(args: &BenchArgs) -> Result<(), UserError> {
         config.repeats = repeats;
     }
     if let Some(samples) = args.samples {
-        config.samples = samples;
+        config.samples = samples as u32;
     }
     let dir = std::env::temp_dir().join(format!("autobal-bench-threads-{}", std::process::id()));
     let result = bench::threads::measure_threads(&config, &dir);

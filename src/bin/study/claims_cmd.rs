@@ -2,6 +2,7 @@
 
 use crate::UserError;
 use autobal::claims::{report::render, run_claims};
+use autobal::output_file::{WhenExists, prepare};
 use autobal::study::config::load;
 use autobal::study::run::NoProgress;
 use clap::Args;
@@ -9,7 +10,7 @@ use std::path::PathBuf;
 
 /// Examples shown under `study claims --help`.
 pub const EXAMPLES: &str = "Examples:
-  study claims studies/paper_claims.toml --report docs/paper-claims.md";
+  study claims studies/paper_claims.toml --report docs/paper-claims.md --overwrite";
 
 /// Arguments of `study claims`.
 #[derive(Args)]
@@ -19,6 +20,9 @@ pub struct ClaimsArgs {
     /// Write the markdown report here (default: print it).
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Replace the --report file if it exists.
+    #[arg(long, requires = "report")]
+    overwrite: bool,
     /// The measure the verdicts rest on (default: the study's `[summary] rank_by`):
     /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
     #[arg(long, value_parser = crate::run_cmd::parse_criterion, value_name = "CRITERION")]
@@ -28,10 +32,16 @@ pub struct ClaimsArgs {
 /// Run `study claims`.
 pub fn run(args: &ClaimsArgs) -> Result<(), UserError> {
     let mut plan = load(&args.study)?;
+    if let Some(path) = &args.report {
+        prepare("--report", path, WhenExists::from_overwrite(args.overwrite))?;
+    }
     if let Some(criterion) = args.rank_by {
         plan.file.summary.rank_by = criterion;
     }
-    let out = run_claims(&plan, &NoProgress).map_err(|e| UserError::internal(e.to_string()))?;
+    let out = run_claims(&plan, &NoProgress).map_err(|e| {
+        let code = if e.is_user_error() { 2 } else { 1 };
+        UserError(e.to_string(), code)
+    })?;
     let command = format!(
         "study claims {}{}{}",
         args.study.display(),
@@ -44,7 +54,8 @@ pub fn run(args: &ClaimsArgs) -> Result<(), UserError> {
     let text = render(&plan, &out, &command);
     match &args.report {
         Some(path) => {
-            autobal::study::io::write_text(path, &text)?;
+            autobal::study::io::write_text(path, &text)
+                .map_err(|e| UserError::internal(format!("--report {}: {e}", path.display())))?;
             eprintln!("wrote {}", path.display());
         }
         None => print!("{text}"),

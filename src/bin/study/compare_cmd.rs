@@ -30,7 +30,7 @@ pub struct CompareArgs {
     #[arg(long, value_delimiter = ',')]
     designs: Option<Vec<u32>>,
     /// Significance level of the verdict.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, value_parser = crate::limits::significance)]
     alpha: f64,
     /// Also draw both designs' Kaplan–Meier curves into this file (.svg or .png, by extension).
     #[arg(long, value_name = "FILE")]
@@ -53,15 +53,6 @@ fn p_eq(p: f64) -> String {
 
 /// Run `study compare`.
 pub fn run(args: &CompareArgs) -> Result<(), UserError> {
-    if !(args.alpha > 0.0 && args.alpha <= 0.5) {
-        return Err(UserError(
-            format!(
-                "--alpha {}: a significance level in (0, 0.5], e.g. 0.05",
-                args.alpha
-            ),
-            2,
-        ));
-    }
     if let Some(path) = &args.plot {
         check_figure_path("--plot", path)?;
     }

@@ -74,6 +74,74 @@ pub fn progress_seconds(text: &str) -> Result<f64, String> {
     Ok(v)
 }
 
+/// Most repeats of a timed bench case.
+pub const MAX_REPEATS: usize = 10_000;
+/// Most samples per design a bench verb runs, or runs `study tradeoff` measures.
+pub const MAX_BENCH_RUNS: usize = 1_000_000;
+/// Longest horizon of a bench solve, in revolutions (as a study's `t_end_revs`).
+pub const MAX_BENCH_REVOLUTIONS: f64 = 1e7;
+
+/// A finite number in (0, `hi`], or the reason it is not.
+fn number_in(text: &str, what: &str, hi: f64) -> Result<f64, String> {
+    let v: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number ({what})"))?;
+    if !(v > 0.0 && v <= hi) {
+        return Err(format!(
+            "{text}: must be above 0 and at most {hi:e} ({what})"
+        ));
+    }
+    Ok(v)
+}
+
+/// `tradeoff --budget-revs`: a settling-time error in (0, 1e7] revolutions.
+pub fn budget_revs(text: &str) -> Result<f64, String> {
+    number_in(
+        text,
+        "settling-time error in revolutions",
+        MAX_BENCH_REVOLUTIONS,
+    )
+}
+
+/// `tradeoff --budget-residual`: a residual error in (0, 1e3] A_ref.
+pub fn budget_residual(text: &str) -> Result<f64, String> {
+    number_in(text, "residual error in units of A_ref", 1e3)
+}
+
+/// `bench --revolutions`: a horizon in (0, [`MAX_BENCH_REVOLUTIONS`]].
+pub fn bench_revolutions(text: &str) -> Result<f64, String> {
+    number_in(
+        text,
+        "horizon of each solve in revolutions",
+        MAX_BENCH_REVOLUTIONS,
+    )
+}
+
+/// `bench --repeats`: 1 ..= [`MAX_REPEATS`].
+pub fn repeats(text: &str) -> Result<usize, String> {
+    whole_in(text, "timed repeats per case", 1, MAX_REPEATS)
+}
+
+/// `bench --samples`, `tradeoff --runs`: 1 ..= [`MAX_BENCH_RUNS`].
+pub fn bench_runs(text: &str) -> Result<usize, String> {
+    whole_in(text, "runs", 1, MAX_BENCH_RUNS)
+}
+
+/// A significance level in (0, 0.5] (`study compare`).
+pub fn significance(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !(v > 0.0 && v <= 0.5) {
+        return Err(format!(
+            "{text}: a significance level in (0, 0.5], e.g. 0.05"
+        ));
+    }
+    Ok(v)
+}
+
 /// A family-wise false-alarm level in (0, 1) (`study check`).
 pub fn alpha(text: &str) -> Result<f64, String> {
     let v: f64 = text
@@ -107,5 +175,18 @@ mod tests {
         assert_eq!(progress_seconds("30"), Ok(30.0));
         assert!(alpha("0").is_err() && alpha("nan").is_err() && alpha("1").is_err());
         assert_eq!(alpha("0.01"), Ok(0.01));
+        for bad in ["-1", "nan", "inf", "0", "1e300"] {
+            assert!(budget_residual(bad).is_err(), "{bad}");
+            assert!(budget_revs(bad).is_err(), "{bad}");
+            assert!(bench_revolutions(bad).is_err(), "{bad}");
+        }
+        assert!(repeats("0").is_err() && bench_runs("0").is_err());
+        assert!(
+            bench_runs("4000000000")
+                .unwrap_err()
+                .contains("1..=1000000")
+        );
+        assert!(significance("0.6").is_err() && significance("nan").is_err());
+        assert_eq!(significance("0.05"), Ok(0.05));
     }
 }

@@ -2,6 +2,7 @@
 //! speeds and unbalances, as a Parquet table and a character picture.
 
 use crate::UserError;
+use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
 use autobal::study::io::{Provenance, write_parquet};
 use autobal::study::stability_map::{ascii, stability_map, to_dataframe};
@@ -31,6 +32,9 @@ pub struct MapArgs {
     /// Write one row per grid point to this Parquet file.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the --out file if it exists.
+    #[arg(long, requires = "out")]
+    overwrite: bool,
 }
 
 fn parse_range(name: &str, text: &str) -> Result<(f64, f64), UserError> {
@@ -76,6 +80,9 @@ pub fn run(args: &MapArgs) -> Result<(), UserError> {
             2,
         ));
     }
+    if let Some(path) = &args.out {
+        prepare("--out", path, WhenExists::from_overwrite(args.overwrite))?;
+    }
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
     let scene = file.simulation(&shown)?.scene;
@@ -85,10 +92,10 @@ pub fn run(args: &MapArgs) -> Result<(), UserError> {
         &speed_grid(u_lo, u_hi, nu),
     )?;
     if let Some(path) = &args.out {
-        let text = std::fs::read_to_string(&args.scene)?;
+        let text = autobal::input_file::read_text(&args.scene)?;
         let mut df = to_dataframe(&points).map_err(|e| UserError::internal(e.to_string()))?;
         write_parquet(path, &mut df, &Provenance::new(&text, 0, "stability map"))
-            .map_err(|e| UserError(format!("--out {}: {e}", path.display()), 2))?;
+            .map_err(|e| UserError::internal(format!("--out {e}")))?;
     }
     println!(
         "unbalance {u_hi} (top) to {u_lo} (bottom), speed {w_lo} (left) to {w_hi} (right)\n'#' stable balanced state, '.' unstable, ' ' unbalance beyond the balancer's capacity\n"

@@ -4,7 +4,9 @@ use crate::UserError;
 use crate::output::text_table;
 use autobal::optimize::optimize;
 use autobal::optimize::spec::Objective;
+use autobal::output_file::WhenExists;
 use autobal::study::config::load;
+use autobal::study::study_folder::claim;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -18,11 +20,21 @@ pub const EXAMPLES: &str = "Examples:
 pub struct OptimizeArgs {
     /// Study file with an [optimize] table.
     study: PathBuf,
+    /// Replace the study folder's optimize.parquet and optimum.parquet if they exist.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Run `study optimize`.
 pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
     let plan = load(&args.study)?;
+    autobal::optimize::checked_spec(&plan)?;
+    let _folder = claim(
+        &plan,
+        "optimize",
+        &["optimize.parquet", "optimum.parquet"],
+        WhenExists::from_overwrite(args.overwrite),
+    )?;
     let out = optimize(&plan)?;
     let objective = plan
         .file

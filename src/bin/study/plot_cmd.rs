@@ -198,8 +198,6 @@ fn plot_one_study(a: &StudyArgs) -> Result<Vec<PathBuf>, UserError> {
         ));
     }
     let data = StudyData::read(&a.dir).map_err(plot_error)?;
-    std::fs::create_dir_all(&a.out)
-        .map_err(|e| UserError(format!("--out {}: {e}", a.out.display()), 2))?;
     let format = match a.format {
         FormatArg::Svg => Format::Svg,
         FormatArg::Png => Format::Png,

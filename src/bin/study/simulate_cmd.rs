@@ -2,10 +2,11 @@
 
 use crate::UserError;
 use autobal::metrics::RunMetrics;
+use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
 use autobal::study::io::{Provenance, write_series};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Examples shown under `study simulate --help`.
 pub const EXAMPLES: &str = "Examples:
@@ -26,6 +27,9 @@ pub struct SimulateArgs {
     /// Parquet when it ends in .parquet, CSV otherwise.
     #[arg(long)]
     series: Option<PathBuf>,
+    /// Replace the --series file if it exists.
+    #[arg(long, requires = "series")]
+    overwrite: bool,
 }
 
 /// Run `study simulate`.
@@ -34,7 +38,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     let file = SceneFile::read(&args.scene)?;
     let simulation = file.simulation(&shown)?;
     if let Some(path) = &args.series {
-        check_writable(path)?;
+        prepare("--series", path, WhenExists::from_overwrite(args.overwrite))?;
     }
     let result = simulation.run(args.series.is_some())?;
     if let (Some(path), Some(series)) = (&args.series, &result.series) {
@@ -46,24 +50,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
         println!("{}", serde_json::to_string_pretty(&result.metrics)?);
     } else {
         print!("{}", describe(&result.metrics));
-    }
-    Ok(())
-}
-
-fn check_writable(path: &Path) -> Result<(), UserError> {
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(UserError(
-            format!(
-                "--series {}: folder {} does not exist",
-                path.display(),
-                parent.display()
-            ),
-            2,
-        ));
     }
     Ok(())
 }

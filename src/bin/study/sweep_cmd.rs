@@ -2,6 +2,7 @@
 //! compared with the criterion's prediction and linear stability.
 
 use crate::UserError;
+use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
 use autobal::study::io::{Provenance, write_parquet};
 use autobal::study::sweep::{SweepPoint, ranges, run_sweep, speed_grid, to_dataframe};
@@ -27,6 +28,9 @@ pub struct SweepArgs {
     /// Write one row per speed to this Parquet file.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the --out file if it exists.
+    #[arg(long, requires = "out")]
+    overwrite: bool,
     /// Print the points as JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -54,16 +58,19 @@ fn parse_range(text: &str) -> Result<(f64, f64), UserError> {
 /// Run `study sweep`.
 pub fn run(args: &SweepArgs) -> Result<(), UserError> {
     let (lo, hi) = parse_range(&args.omega)?;
+    if let Some(path) = &args.out {
+        prepare("--out", path, WhenExists::from_overwrite(args.overwrite))?;
+    }
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
     let simulation = file.simulation(&shown)?;
     let points = run_sweep(&simulation, &speed_grid(lo, hi, args.points))?;
     if let Some(path) = &args.out {
-        let text = std::fs::read_to_string(&args.scene)?;
+        let text = autobal::input_file::read_text(&args.scene)?;
         let provenance = Provenance::new(&text, 0, "sweep");
         let mut df = to_dataframe(&points).map_err(|e| UserError::internal(e.to_string()))?;
         write_parquet(path, &mut df, &provenance)
-            .map_err(|e| UserError(format!("--out {}: {e}", path.display()), 2))?;
+            .map_err(|e| UserError::internal(format!("--out {e}")))?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&points)?);

@@ -2,7 +2,9 @@
 
 use crate::UserError;
 use crate::output::text_table;
+use autobal::output_file::WhenExists;
 use autobal::study::config::load;
+use autobal::study::study_folder::claim;
 use autobal::tradeoff::{measure, recommend, spread_runs, summarize, write};
 use clap::Args;
 use std::path::PathBuf;
@@ -18,29 +20,29 @@ pub struct TradeoffArgs {
     /// Study file.
     study: PathBuf,
     /// How many of the study's runs to measure (spread evenly over designs).
-    #[arg(long, default_value_t = 12)]
-    runs: u64,
+    #[arg(long, default_value_t = 12, value_parser = crate::limits::bench_runs)]
+    runs: usize,
     /// Error budget: largest acceptable settling-time error (revolutions).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = crate::limits::budget_revs)]
     budget_revs: f64,
     /// Error budget on the residual vibration (units of A_ref).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = crate::limits::budget_residual)]
     budget_residual: f64,
+    /// Replace the study folder's tradeoff.parquet if it exists.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Run `study tradeoff`.
 pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
-    if !(args.budget_revs.is_finite() && args.budget_revs > 0.0) {
-        return Err(UserError(
-            format!("--budget-revs {}: must be positive", args.budget_revs),
-            2,
-        ));
-    }
-    if args.runs == 0 {
-        return Err(UserError("--runs 0: need at least one run".into(), 2));
-    }
     let plan = load(&args.study)?;
-    let rows = measure(&plan, &spread_runs(&plan, args.runs));
+    let _folder = claim(
+        &plan,
+        "tradeoff",
+        &["tradeoff.parquet"],
+        WhenExists::from_overwrite(args.overwrite),
+    )?;
+    let rows = measure(&plan, &spread_runs(&plan, args.runs as u64));
     let path = write(&plan, &rows).map_err(|e| UserError::internal(e.to_string()))?;
     let summary = summarize(&rows);
     let f = |v: Option<f64>| v.map_or("–".into(), |x| format!("{x:.3}"));

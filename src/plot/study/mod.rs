@@ -266,6 +266,17 @@ pub fn plot_study(
     format: Format,
     figures: &[StudyFigure],
 ) -> Result<Vec<PathBuf>, PlotError> {
+    // Every figure's data is checked before the folder or any figure is made.
+    data.check()?;
+    if figures.contains(&StudyFigure::Passage) {
+        passage::passage_data(data)?;
+    }
+    std::fs::create_dir_all(out_dir).map_err(|e| {
+        PlotError::Io(std::io::Error::new(
+            e.kind(),
+            format!("{}: {e}", out_dir.display()),
+        ))
+    })?;
     figures
         .iter()
         .map(|figure| {

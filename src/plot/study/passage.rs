@@ -17,6 +17,13 @@ struct Passage<'a> {
 /// Write the final spin rate against the stall torque to `path` (.svg or
 /// .png); only for a study that sweeps `designs.stall_torque`.
 pub fn plot_passage(data: &StudyData, path: &Path) -> Result<(), PlotError> {
+    passage_data(data)?;
+    style::render(&Passage { data }, path)
+}
+
+/// Whether the study has what the passage figure shows (checked before any
+/// figure is written).
+pub fn passage_data(data: &StudyData) -> Result<(), PlotError> {
     data.check()?;
     if !data
         .runs
@@ -27,7 +34,7 @@ pub fn plot_passage(data: &StudyData, path: &Path) -> Result<(), PlotError> {
             "no run has a stall torque and a final spin rate: the study does not sweep designs.stall_torque".into(),
         ));
     }
-    style::render(&Passage { data }, path)
+    Ok(())
 }
 
 impl Figure for Passage<'_> {
