@@ -23,9 +23,69 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     std::fs::read_to_string(path)
 }
 
+/// A TOML parser's message with serde's words for types put in a user's:
+/// "expected struct UnbalanceSpec" names a Rust type the user never wrote.
+pub fn in_user_words(message: &str) -> String {
+    let mut out = message
+        .replace("expected f64", "expected a number")
+        .replace("expected f32", "expected a number")
+        .replace("expected variant identifier", "expected a name in quotes");
+    for integer in ["u8", "u16", "u32", "u64", "usize", "i32", "i64"] {
+        out = out.replace(
+            &format!("expected {integer}"),
+            "expected a whole number in range",
+        );
+    }
+    for (phrase, words) in [
+        (
+            "expected struct ",
+            "expected a table of keys (`{ key = value }` or a [section])",
+        ),
+        (
+            "data did not match any variant of untagged enum ",
+            "expected one of the value's documented forms",
+        ),
+        (
+            "expected internally tagged enum ",
+            "expected a table with its kind key",
+        ),
+        ("expected enum ", "expected one of the documented names"),
+    ] {
+        while let Some(at) = out.find(phrase) {
+            let rest = &out[at + phrase.len()..];
+            let name_len = rest
+                .find(|c: char| !c.is_alphanumeric() && c != '_')
+                .unwrap_or(rest.len());
+            out = format!("{}{words}{}", &out[..at], &rest[name_len..]);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rust_type_names_never_reach_the_user() {
+        let cases = [
+            "invalid type: integer `5`, expected struct UnbalanceSpec",
+            "data did not match any variant of untagged enum Foo",
+            "invalid type: string \"x\", expected internally tagged enum SpeedLaw",
+            "invalid type: string \"fast\", expected f64",
+            "invalid value: integer `-3`, expected u32",
+        ];
+        for case in cases {
+            let words = in_user_words(case);
+            for rust in ["struct", "enum", "f64", "u32", "Unbalance", "SpeedLaw"] {
+                assert!(!words.contains(rust), "{case} -> {words}");
+            }
+        }
+        assert_eq!(
+            in_user_words("invalid type: integer `5`, expected struct UnbalanceSpec"),
+            "invalid type: integer `5`, expected a table of keys (`{ key = value }` or a [section])"
+        );
+    }
 
     #[test]
     fn a_fifo_or_folder_is_refused_without_blocking() {

@@ -7,7 +7,9 @@ use super::effect::{Effects, SceneFacts};
 use super::rotor::{PlaneRotor, RotorModel};
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
-use super::validate::{invalid, non_negative, positive, spin_rate};
+use super::validate::{
+    DENSITY_RANGE, RACE_RADIUS_RANGE, invalid, non_negative, positive, spin_rate, within,
+};
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
 use schemars::JsonSchema;
@@ -71,7 +73,10 @@ fn steel() -> f64 {
 /// (`"optimal"`: the capacity optimum of Table 1; `"half_race"`: the weights
 /// fill exactly half the race).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a radius ratio: a number in (0, 1), \"optimal\" or \"half_race\""
+)]
 pub enum RhoChoice {
     /// A given ρ.
     Value(f64),
@@ -209,8 +214,13 @@ impl Scene {
                             "needs at least one weight",
                         ));
                     }
-                    positive(&format!("{key}.race_radius"), d.race_radius)?;
-                    positive(&format!("{key}.density"), d.density)?;
+                    within(
+                        &format!("{key}.race_radius"),
+                        d.race_radius,
+                        RACE_RADIUS_RANGE,
+                        "m",
+                    )?;
+                    within(&format!("{key}.density"), d.density, DENSITY_RANGE, "kg/m³")?;
                     non_negative(&format!("{key}.drag"), d.drag)?;
                     if d.kind == Kind::Roller {
                         positive(&format!("{key}.roller_height"), d.roller_height)?;

@@ -5,7 +5,12 @@ use serde::{Deserialize, Serialize};
 
 /// How the rotor's spin angle φ evolves.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "mode", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "mode",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    expecting = "a table with `mode` = \"constant\", \"ramp\", \"motor\" or \"free\" and that mode's keys"
+)]
 pub enum SpeedLaw {
     /// φ = ω t (seed 004, eqs 19–20).
     Constant {

@@ -75,6 +75,33 @@ pub(crate) fn spin_rate(field: &str, value: f64, zero_allowed: bool) -> Result<(
     }
 }
 
+/// Smallest and largest race radius (m): a tenth of a millimetre to a
+/// hundred metres spans micro-drives to the largest drums (and the
+/// dimensionless scenes' R = 1); beyond it the weights' mass over- or
+/// underflows.
+pub const RACE_RADIUS_RANGE: (f64, f64) = (1e-4, 100.0);
+/// Lightest and densest weight material (kg/m³): from foam to ten times
+/// the densest metal (the dimensionless scenes use 10 to 20).
+pub const DENSITY_RANGE: (f64, f64) = (1.0, 1e5);
+
+/// Require `value` in `[range.0, range.1]` (`unit` for the message).
+pub(crate) fn within(
+    field: &str,
+    value: f64,
+    range: (f64, f64),
+    unit: &str,
+) -> Result<(), SceneError> {
+    if (range.0..=range.1).contains(&value) {
+        Ok(())
+    } else {
+        Err(invalid(
+            field,
+            value,
+            &format!("must be in [{}, {}] {unit}", shown(range.0), shown(range.1)),
+        ))
+    }
+}
+
 /// Require a finite value.
 pub(crate) fn finite(field: &str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() {

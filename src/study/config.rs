@@ -388,7 +388,12 @@ pub enum Scale {
 
 /// A distribution of a positive quantity.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "distribution", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "distribution",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    expecting = "a table with `distribution` = \"fixed\", \"uniform\", \"log_uniform\" or \"normal_truncated\" and its keys"
+)]
 pub enum Distribution {
     /// Always the same value.
     Fixed {
@@ -601,7 +606,7 @@ impl StudyFile {
     pub fn parse(text: &str, path: &str) -> Result<Self, StudyError> {
         toml::from_str(text).map_err(|e| StudyError::Parse {
             path: path.to_string(),
-            message: e.to_string(),
+            message: crate::input_file::in_user_words(&e.to_string()),
         })
     }
 

@@ -298,6 +298,42 @@ pub(crate) const SCENE_CASES: &[(&str, &str, &str)] = &[
     ),
 ];
 
+/// Study-file cases of issue 33's messages: a value that made an infinite
+/// mass, and serde's words for Rust types (struct, untagged and tagged enum).
+pub(crate) const MESSAGE_CASES: &[(&str, &str, &str)] = &[
+    (
+        "race_radius = 0.05",
+        "race_radius = 1e308",
+        "designs.race_radius = 1e308: must be in [0.0001, 100] m",
+    ),
+    (
+        "density = 7850.0",
+        "density = 1e306",
+        "designs.density = 1e306: must be in [1, 100000] kg/m³",
+    ),
+    (
+        "rho = \"optimal\"",
+        "rho = [0.3, true]",
+        "expected a radius ratio: a number in (0, 1), \"optimal\" or \"half_race\"",
+    ),
+    (
+        "unbalance = {",
+        "unbalance = 5\n# {",
+        "expected a table of keys",
+    ),
+    (
+        "mode = \"constant\"",
+        "mode = 3",
+        "expected a name in quotes",
+    ),
+    (
+        "mode = \"constant\"",
+        "mode = \"warp\"",
+        "unknown variant `warp`, expected one of `constant`, `ramp`, `motor`, `free`",
+    ),
+    ("omega = 300.0", "omega = \"fast\"", "expected a number"),
+];
+
 /// Command lines (after `study`) that must be refused with exit code 2.
 fn flag_cases(study_path: &str, scene_path: &str) -> Vec<(Vec<String>, &'static str)> {
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
@@ -386,13 +422,18 @@ fn run_study(dir: &Path, text: &str) -> (Option<i32>, String, bool) {
 #[test]
 fn every_bad_study_file_is_refused_naming_the_key_with_nothing_written() {
     let mut failures = Vec::new();
-    for (from, to, needle) in STUDY_CASES {
+    for (from, to, needle) in STUDY_CASES.iter().chain(MESSAGE_CASES) {
         let tmp = tempfile::tempdir().unwrap();
         let base = study(&tmp.path().join("results"));
         assert!(base.contains(from), "fixture lacks {from:?}");
         let text = base.replacen(from, to, 1);
         let (code, err, wrote) = run_study(tmp.path(), &text);
-        if code != Some(2) || !err.contains(needle) || wrote {
+        let rust_words = ["struct ", "enum ", "f64", "u32", "variant identifier"];
+        if code != Some(2)
+            || !err.contains(needle)
+            || wrote
+            || rust_words.iter().any(|w| err.contains(w))
+        {
             failures.push(format!(
                 "{to:?}: exit {code:?}, wrote {wrote}, expected {needle:?} in: {err}"
             ));
