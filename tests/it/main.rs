@@ -20,6 +20,7 @@ mod design_criterion;
 mod design_transient;
 mod extremes;
 mod fixtures;
+mod fuzz_cli;
 mod fuzz_input;
 mod golden;
 mod integrate;

@@ -59,7 +59,7 @@ pub struct BenchArgs {
     lean_inputs: Option<std::path::PathBuf>,
     /// With --lean-inputs: export this study's runs instead of the main
     /// job's (one plane rotor in the rotating frame; e.g. bench/lean/peer.toml).
-    #[arg(long, value_name = "STUDY", requires = "lean_inputs")]
+    #[arg(long, value_name = "STUDY", requires = "lean_inputs", conflicts_with_all = ["thread_scaling", "peer_cases", "fidelity"])]
     lean_study: Option<std::path::PathBuf>,
     /// Samples per design with --thread-scaling (default 25; 1 with --quick)
     /// or --lean-inputs (default 20).
