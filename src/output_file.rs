@@ -29,7 +29,7 @@ impl WhenExists {
 #[derive(Debug, thiserror::Error)]
 pub enum OutputFileError {
     /// The path is a folder.
-    #[error("{flag} {path}: is a folder; give a file name inside it")]
+    #[error("{flag} {path}: names a folder; give a file name")]
     Folder {
         /// The flag (or file role) the path was given for.
         flag: String,
@@ -75,7 +75,12 @@ pub enum OutputFileError {
 pub fn prepare(flag: &str, path: &Path, when: WhenExists) -> Result<(), OutputFileError> {
     let shown = path.display().to_string();
     let parent = parent_of(path);
-    if path.is_dir() {
+    // "out.svg/" names a folder even when none exists.
+    let names_folder = path
+        .as_os_str()
+        .to_string_lossy()
+        .ends_with(std::path::MAIN_SEPARATOR);
+    if path.is_dir() || names_folder {
         return Err(OutputFileError::Folder {
             flag: flag.into(),
             path: shown,
@@ -239,7 +244,12 @@ mod tests {
     fn folders_missing_folders_and_existing_results_are_refused_naming_the_flag() {
         let dir = tempfile::tempdir().unwrap();
         let err = prepare("--out", dir.path(), WhenExists::Replace).unwrap_err();
-        assert!(err.to_string().starts_with("--out ") && err.to_string().contains("is a folder"));
+        assert!(
+            err.to_string().starts_with("--out ") && err.to_string().contains("names a folder")
+        );
+        let slash = dir.path().join("fig.svg/");
+        let err = prepare("--out", &slash, WhenExists::Replace).unwrap_err();
+        assert!(err.to_string().contains("names a folder"), "{err}");
         let missing = dir.path().join("nope/out.parquet");
         let err = prepare("--series", &missing, WhenExists::Replace).unwrap_err();
         assert!(err.to_string().contains("does not exist"), "{err}");

@@ -124,7 +124,7 @@ fn single_file_outputs_refuse_existing_files_folders_and_missing_folders_before_
         assert_eq!(std::fs::read(&existing).unwrap(), b"earlier results");
         let call = args(fo);
         let call: Vec<&str> = call.iter().map(String::as_str).collect();
-        assert_refused(&call, &[flag, fo, "is a folder"], dir);
+        assert_refused(&call, &[flag, fo, "names a folder"], dir);
         let call = args(mi);
         let call: Vec<&str> = call.iter().map(String::as_str).collect();
         assert_refused(&call, &[flag, "does not exist"], dir);

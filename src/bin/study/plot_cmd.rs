@@ -221,23 +221,11 @@ fn check_out(out: &Path) -> Result<(), UserError> {
 }
 
 /// Reject a bad figure path given with `flag` before any work: wrong
-/// extension or missing folder.
+/// extension, a folder, a missing or unwritable folder. An existing figure
+/// is redrawn (docs/limits.md, "Output policy").
 pub(crate) fn check_figure_path(flag: &str, out: &Path) -> Result<(), UserError> {
     Format::from_path(out).map_err(|e| UserError(format!("{flag} {e}"), 2))?;
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(UserError(
-            format!(
-                "{flag} {}: folder {} does not exist",
-                out.display(),
-                parent.display()
-            ),
-            2,
-        ));
-    }
+    autobal::output_file::prepare(flag, out, autobal::output_file::WhenExists::Replace)?;
     Ok(())
 }
 
