@@ -22,7 +22,7 @@ pub const BAND: Transform = Transform::LogLog;
 /// One design's runs, as the figure draws them.
 #[derive(Debug, Clone)]
 pub struct KmCurve {
-    /// Legend label, e.g. "A: ball n=3 ρ=0.2500 β=10".
+    /// Legend label, e.g. "A: ball n=3 ρ=0.250 β=10".
     pub label: String,
     /// Every run: settled at its time, or censored there.
     pub observations: Vec<Observation>,

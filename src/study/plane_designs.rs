@@ -245,7 +245,7 @@ pub fn describe(d: &Design) -> String {
         .join("; ")
 }
 
-/// A design in one short line, "ball n=8 ρ=0.0400 β=0.05", each value
+/// A design in one short line, "ball n=8 ρ=0.040 β=0.05", each value
 /// joined by "/" over the planes where they differ ("n=2/3").
 pub fn short_label(d: &Design) -> String {
     let planes: Vec<&Design> = std::iter::once(d).chain(&d.plane_designs).collect();
@@ -261,7 +261,7 @@ pub fn short_label(d: &Design) -> String {
         "{} n={} ρ={} β={}",
         joined(&|p| p.spec.kind.name().to_string()),
         joined(&|p| p.spec.n.to_string()),
-        joined(&|p| format!("{:.4}", p.rho)),
+        joined(&|p| format!("{:.3}", p.rho)),
         joined(&|p| p.spec.drag.to_string())
     )
 }

@@ -33,6 +33,8 @@ fn run(dir: &Path, text: &str, args: &[&str]) -> Output {
         .arg("run")
         .arg(&path)
         .arg("--quiet")
+        // Whole sentences, not wrapped to 80 columns, for the assertions.
+        .arg("--wide")
         .args(args)
         .output()
         .unwrap()

@@ -48,6 +48,7 @@ mod study_input;
 mod study_runner;
 mod study_summary;
 mod study_sweep;
+mod terminal_fit;
 mod tilt_inertia;
 mod tolerances;
 mod toy_effect;

@@ -384,7 +384,7 @@ fn every_figure_keeps_its_text_inside_and_apart() {
     let curves: Vec<KmCurve> = (0..10)
         .map(|d| KmCurve {
             label: format!(
-                "{}: ball n={} ρ=0.2500 β={}",
+                "{}: ball n={} ρ=0.250 β={}",
                 char::from(b'A' + d as u8),
                 2 + d,
                 10 * (d + 1)

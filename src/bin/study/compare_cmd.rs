@@ -2,7 +2,7 @@
 //! unbalances, with a verdict at a stated α.
 
 use crate::UserError;
-use crate::output::{p_value_text, text_table};
+use crate::output::{p_value_text, say, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
 use autobal::plot::km::{KmCurve, plot_kaplan_meier};
 use autobal::stats::holm::holm_adjust;
@@ -130,8 +130,8 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         "design",
         "runs",
         "settled [95% CI]",
-        "t_s median, Kaplan–Meier [95% CI] (rev)",
-        "t_s restricted mean [95% CI] (rev)",
+        "t_s median [95% CI] (rev)",
+        "t_s mean to τ [95% CI] (rev)",
         "t_s p90 (rev)",
         "residual/A_ref, median",
         "residual/A_ref, p95",
@@ -147,11 +147,11 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
     rows.extend(plane_rows(&a, &b));
     rows.extend(folder);
     print!("{}", text_table(&["", "A", "B"], &rows));
-    println!(
+    say(&format!(
         "(settling times counted {}; a run that did not settle counts as censored; restricted mean and p90 up to τ = {:.1} rev, the earlier horizon of the two)",
         a.clock.describe(),
         scale.tau
-    );
+    ));
     let rev = |x: f64| {
         if x.is_finite() {
             format!("{x:.1}")
@@ -161,7 +161,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
     };
     match (&c.paired, &result.unpaired_because) {
         (Some(pair), _) => {
-            println!(
+            say(&format!(
                 "paired on {} samples that met the same unbalances: A settles sooner in {:.0} % [{:.0}, {:.0}], B in {:.0} %, ties {:.0} %",
                 pair.n,
                 100.0 * pair.a_sooner_share,
@@ -169,36 +169,36 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 100.0 * pair.a_sooner_share_interval.1,
                 100.0 * pair.b_sooner as f64 / pair.n as f64,
                 100.0 * pair.ties as f64 / pair.n as f64
-            );
-            println!(
+            ));
+            say(&format!(
                 "paired difference t_B − t_A: median {} rev [{}, {}] (∞: B did not settle in half the pairs or more); sign test p {}",
                 rev(pair.median_difference),
                 rev(pair.median_difference_interval.0),
                 rev(pair.median_difference_interval.1),
                 p_eq(pair.sign_test_p)
-            );
+            ));
             if let (Some(w), Some((ratio, (lo, hi)))) = (&c.residual_test, c.residual_ratio) {
-                println!(
+                say(&format!(
                     "residual vibration: median ratio A/B {ratio:.3} [{lo:.3}, {hi:.3}], Wilcoxon signed-rank p {} ({} pairs)",
                     p_eq(w.p_value),
                     w.n
-                );
+                ));
             }
         }
         (None, Some(why)) => {
-            println!("not paired: {why}");
+            say(&format!("not paired: {why}"));
             match &c.unpaired {
-                Some(lr) => println!(
+                Some(lr) => say(&format!(
                     "log-rank test: χ² = {:.3}, p {} (A settled {:.0} times, {:.1} expected if both settle alike)",
                     lr.chi_squared,
                     p_eq(lr.p_value),
                     lr.observed_a,
                     lr.expected_a
-                ),
-                None => println!("log-rank test: no run settled in either design"),
+                )),
+                None => say("log-rank test: no run settled in either design"),
             }
         }
-        (None, None) => println!("nothing to compare: no runs"),
+        (None, None) => say("nothing to compare: no runs"),
     }
     // Every measure of this one pair, Holm-adjusted over the measures.
     let raw: Vec<f64> = c
@@ -210,7 +210,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
     let mut favours_b = Vec::new();
     for (m, p_holm) in c.measures.iter().zip(&adjusted) {
         let Some(d) = m.difference else {
-            println!("{}: nothing to compare", m.criterion.label());
+            say(&format!("{}: nothing to compare", m.criterion.label()));
             continue;
         };
         let unit = m.criterion.unit();
@@ -233,7 +233,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         } else {
             format!(" {unit}")
         };
-        println!(
+        say(&format!(
             "{}: A {} vs B {}, A − B {}{interval}{unit}, {} p {} (Holm over the {} measures: {})",
             m.criterion.label(),
             show(d.a),
@@ -243,7 +243,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             p_eq(d.p_value),
             c.measures.len(),
             p_value_text(*p_holm)
-        );
+        ));
         if m.criterion != criterion
             && *p_holm <= args.alpha
             && d.difference != 0.0
@@ -275,16 +275,16 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             args.alpha
         ),
     };
-    println!("verdict: {verdict}");
+    say(&format!("verdict: {verdict}"));
     if !favours_b.is_empty() && verdict.starts_with("A is better") {
-        println!(
+        say(&format!(
             "but B is significantly better on the {}: the measures disagree",
             favours_b.join(" and the ")
-        );
+        ));
     }
     if let Some(path) = &args.plot {
         plot_sides(&a, &b, path)?;
-        println!("wrote {}", path.display());
+        say(&format!("wrote {}", path.display()));
     }
     Ok(())
 }

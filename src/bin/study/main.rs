@@ -23,7 +23,7 @@ mod simulate_cmd;
 mod sweep_cmd;
 mod tradeoff_cmd;
 
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Design passive auto-balancers by virtual experiment.
@@ -38,6 +38,9 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Print tables and notes at full width instead of fitting the terminal (80 columns off a terminal).
+    #[arg(long, global = true)]
+    wide: bool,
 }
 
 #[derive(Subcommand)]
@@ -126,7 +129,15 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = Cli::parse();
+    // Help text wraps at words to the terminal (80 columns off a terminal).
+    let matches = Cli::command()
+        .term_width(output::terminal_columns())
+        .get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    output::set_wide(cli.wide);
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),
         Command::Criterion(args) => criterion_cmd::run(&args),

@@ -1,7 +1,7 @@
 //! `study optimize`: choose counts, radii and drag for an objective.
 
 use crate::UserError;
-use crate::output::text_table;
+use crate::output::{fitted_table, say, say_err, text_width};
 use autobal::optimize::optimize;
 use autobal::optimize::spec::Objective;
 use autobal::output_file::WhenExists;
@@ -55,6 +55,17 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
             format!("{v:.5}")
         }
     };
+    // A simulated objective is shown to its standard error's two leading
+    // digits: five decimals on a value whose SE is 0.29 claimed precision
+    // the estimate does not have.
+    let with_se = |v: f64, se: f64| {
+        if metres || se <= 0.0 || !se.is_finite() {
+            shown(v)
+        } else {
+            let decimals = (1.0 - se.log10().floor()).clamp(0.0, 6.0) as usize;
+            format!("{v:.decimals$}")
+        }
+    };
     let rows: Vec<Vec<String>> = out
         .best
         .iter()
@@ -73,12 +84,12 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
                     None => e.candidate.n.to_string(),
                 },
                 match e.candidate.plane1 {
-                    Some(p) => format!("{:.4}/{:.4}", e.candidate.rho, p.rho),
-                    None => format!("{:.4}", e.candidate.rho),
+                    Some(p) => format!("{:.3}/{:.3}", e.candidate.rho, p.rho),
+                    None => format!("{:.3}", e.candidate.rho),
                 },
-                format!("{:.3}", e.candidate.drag),
-                e.value.map_or("–".into(), shown),
-                shown(e.std_err),
+                format!("{}", e.candidate.drag),
+                e.value.map_or("–".into(), |v| with_se(v, e.std_err)),
+                with_se(e.std_err, e.std_err),
                 e.capacity.map_or("–".into(), |c| format!("{c:.4e}")),
                 if e.feasible {
                     "ok".into()
@@ -88,30 +99,34 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
             ]
         })
         .collect();
-    print!(
-        "{}",
-        text_table(
-            &[
-                "scope",
-                "kind",
-                "n",
-                "ρ",
-                "β",
-                objective,
-                "± SE",
-                "capacity kg·m",
-                "constraints"
-            ],
-            &rows
-        )
-    );
-    for (label, _, why) in &out.terminations {
-        eprintln!("{label}: {why}");
+    // The scope and the objective stay; the capacity column (in kg·m
+    // beside a capacity objective it repeats) and β go first.
+    let header = [
+        "scope",
+        "kind",
+        "n",
+        "ρ",
+        "β\nN·s/m",
+        objective,
+        "± SE",
+        "capacity\nkg·m",
+        "constraints",
+    ];
+    let (table, dropped) = fitted_table(&header, &rows, &[0, 1, 1, 1, 3, 0, 2, 4, 2], text_width());
+    print!("{table}");
+    if !dropped.is_empty() {
+        say(&format!(
+            "(left out at this width: {}; --wide shows every column)",
+            dropped.join(", ")
+        ));
     }
-    eprintln!(
+    for (label, _, why) in &out.terminations {
+        say_err(&format!("{label}: {why}"));
+    }
+    say_err(&format!(
         "{} candidates evaluated; wrote {}/optimize.parquet and optimum.parquet",
         out.evaluations.len(),
         out.dir.display()
-    );
+    ));
     Ok(())
 }

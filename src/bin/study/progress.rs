@@ -50,9 +50,16 @@ impl RunProgress {
             let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
             bar.set_style(
                 ProgressStyle::with_template(
-                    "{elapsed_precise} {wide_bar} {pos}/{len} runs  {per_sec}  ETA {eta}  {msg}",
+                    "{elapsed_precise} {wide_bar} {pos}/{len} runs  {rate}  ETA {eta}  {msg}",
                 )
-                .expect("valid template"),
+                .expect("valid template")
+                // indicatif's {per_sec} prints "581.5896/s".
+                .with_key(
+                    "rate",
+                    |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                        let _ = write!(w, "{:.0} runs/s", state.per_sec());
+                    },
+                ),
             );
             Reporter::Bar(bar)
         } else {
@@ -155,32 +162,38 @@ impl Progress for RunProgress {
     }
 
     fn end(&self) {
-        match &self.reporter {
-            Reporter::Bar(bar) => bar.finish_and_clear(),
-            Reporter::Log { clock, .. } => {
-                let start = clock.lock().map_or_else(|e| e.into_inner().0, |c| c.0);
-                let elapsed = start.elapsed();
-                let done = self.done.load(Ordering::Relaxed);
-                let settled = self.settled.load(Ordering::Relaxed);
-                let certified = self.certified.load(Ordering::Relaxed);
-                let early = if certified > 0 {
-                    format!(
-                        " ({:.1} % by a certified hold)",
-                        100.0 * certified as f64 / done.max(1) as f64
-                    )
-                } else {
-                    String::new()
-                };
-                eprintln!(
-                    "finished: {} runs in {} ({:.0} runs/s), settled {:.1} %{early}, failures {}",
-                    done,
-                    hms(elapsed.as_secs_f64()),
-                    done as f64 / elapsed.as_secs_f64().max(1e-9),
-                    100.0 * settled as f64 / done.max(1) as f64,
-                    self.failures.load(Ordering::Relaxed)
-                );
+        let start = match &self.reporter {
+            Reporter::Quiet => return,
+            Reporter::Bar(bar) => {
+                bar.finish_and_clear();
+                Instant::now() - bar.elapsed()
             }
-            Reporter::Quiet => {}
-        }
+            Reporter::Log { clock, .. } => clock.lock().map_or_else(|e| e.into_inner().0, |c| c.0),
+        };
+        // The same closing line on a terminal as in a batch log.
+        let elapsed = start.elapsed();
+        let done = self.done.load(Ordering::Relaxed);
+        let settled = self.settled.load(Ordering::Relaxed);
+        let certified = self.certified.load(Ordering::Relaxed);
+        let early = if certified > 0 {
+            format!(
+                " ({:.1} % by a certified hold)",
+                100.0 * certified as f64 / done.max(1) as f64
+            )
+        } else {
+            String::new()
+        };
+        let line = format!(
+            "finished: {} runs in {} ({:.0} runs/s), settled {:.1} %{early}, failures {}",
+            done,
+            hms(elapsed.as_secs_f64()),
+            done as f64 / elapsed.as_secs_f64().max(1e-9),
+            100.0 * settled as f64 / done.max(1) as f64,
+            self.failures.load(Ordering::Relaxed)
+        );
+        eprint!(
+            "{}",
+            crate::output::wrap(&line, crate::output::text_width())
+        );
     }
 }

@@ -4,7 +4,7 @@
 //! design is recommended).
 
 use crate::UserError;
-use crate::output::{p_value_text, text_table};
+use crate::output::{fitted_table, p_value_text, text_table, text_width, wrap};
 use autobal::study::criterion::Criterion;
 use polars::prelude::DataFrame;
 
@@ -42,6 +42,11 @@ impl Summary<'_> {
             .map(Option::unwrap_or_default)
             .collect())
     }
+}
+
+/// A value as the user wrote it (`10`, `0.5`), or "–".
+fn plain(v: Option<f64>) -> String {
+    v.map_or("–".to_string(), |x| format!("{x}"))
 }
 
 /// A number with `digits` decimals, or "–".
@@ -115,8 +120,8 @@ impl PlaneCells {
                 n.iter()
                     .map(|v| v.map_or("–".into(), |v| v.to_string()))
                     .collect(),
-                rho.iter().map(|&v| num(v, 4)).collect(),
-                drag.iter().map(|&v| num(v, 3)).collect(),
+                rho.iter().map(|&v| num(v, 3)).collect(),
+                drag.iter().map(|&v| plain(v)).collect(),
             ]);
         }
         Ok((!planes.is_empty()).then_some(PlaneCells { planes }))
@@ -193,18 +198,20 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
         .iter()
         .enumerate()
         .map(|(r, &i)| {
-            let versus = match verdict[i].as_deref() {
-                Some("best") => "#1".to_string(),
-                Some("no_design_balances") => "#1 (does not balance)".to_string(),
-                Some("only_design") | None => "–".to_string(),
-                Some(_) if crit_diff[i].is_some() => format!(
-                    "{} [{}, {}], p {}",
-                    diff_text(criterion, crit_diff[i]),
-                    diff_text(criterion, crit_lo[i]),
-                    diff_text(criterion, crit_hi[i]),
-                    p_text(p_holm[i])
+            let (versus, p_versus) = match verdict[i].as_deref() {
+                Some("best") => ("#1".to_string(), "–".to_string()),
+                Some("no_design_balances") => ("#1 (does not balance)".into(), "–".into()),
+                Some("only_design") | None => ("–".into(), "–".into()),
+                Some(_) if crit_diff[i].is_some() => (
+                    format!(
+                        "{} [{}, {}]",
+                        diff_text(criterion, crit_diff[i]),
+                        diff_text(criterion, crit_lo[i]),
+                        diff_text(criterion, crit_hi[i]),
+                    ),
+                    p_text(p_holm[i]),
                 ),
-                Some(_) => format!("p {}", p_text(p_holm[i])),
+                Some(_) => ("–".into(), p_text(p_holm[i])),
             };
             let plane_cells = planes.as_ref().map(|p| p.row(i));
             let mut row = vec![(r + 1).to_string(), ids[i].to_string()];
@@ -212,8 +219,8 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
                 [
                     kind[i].clone().unwrap_or_default(),
                     n[i].map_or("–".into(), |v| v.to_string()),
-                    num(rho[i], 4),
-                    num(drag[i], 3),
+                    num(rho[i], 3),
+                    plain(drag[i]),
                 ]
             }));
             row.push(num(frac[i].map(|f| 100.0 * f), 1));
@@ -241,6 +248,7 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
                 row.push(measure_text(criterion, rank_value[i]));
             }
             row.push(failed[i].to_string());
+            row.push(p_versus);
             row.push(versus);
             row
         })
@@ -263,29 +271,30 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     } else {
         rows
     };
-    let mut header: Vec<String> = ["rank", "id", "kind", "n", "ρ", "β (N·s/m)"]
+    let mut header: Vec<String> = ["#", "id", "kind", "n", "ρ", "β\nN·s/m"]
         .map(String::from)
         .to_vec();
     if swept {
-        header.push("M_s (N·m)".into());
+        header.push("M_s\nN·m".into());
     }
-    header.push("settled %".into());
+    header.push("settled\n%".into());
     header.push(if criterion == Criterion::Median {
-        "median [95% CI]".into()
+        "median\n[95% CI]".into()
     } else {
         "median".into()
     });
     header.push(if criterion == Criterion::Mean {
-        "mean [95% CI]".into()
+        "mean\n[95% CI]".into()
     } else {
         "mean".into()
     });
-    header.extend(["p90".into(), "residual p95".into()]);
+    header.extend(["p90".into(), "residual\np95".into()]);
     if !Criterion::REPORTED.contains(&criterion) {
         header.push(criterion.to_string());
     }
     header.push("failed".into());
-    header.push(format!("vs #1 on {crit_name}: Δ [95% CI], Holm p"));
+    header.push("Holm p\nvs #1".into());
+    header.push("Δ vs #1\n[95% CI]".into());
     // A run-up ranks on the clock from the operating speed; the median
     // from t = 0 (motor and balancer together) stands beside it.
     let run_up = sum
@@ -301,7 +310,7 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             .unwrap_or(0)
             + 1;
         let mut header = header;
-        header.insert(at, "median from t = 0".into());
+        header.insert(at, "median\nfrom t = 0".into());
         let rows = rows
             .into_iter()
             .zip(&order)
@@ -343,16 +352,53 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
             p.planes.len() - 1
         )
     });
-    Ok(text_table(&header, &rows)
-        + &legend
+    let any_failed = failed.iter().any(|&f| f > 0);
+    let priority: Vec<u8> = header
+        .iter()
+        .map(|h| column_priority(h, criterion, any_failed))
+        .collect();
+    let width = text_width();
+    let (table, dropped) = fitted_table(&header, &rows, &priority, width);
+    let dropped_note = if dropped.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "(left out at this width: {}; --wide shows every column)\n",
+            dropped.join(", ")
+        )
+    };
+    let notes = legend
         + &plane_note
+        + &dropped_note
         + &verdict_line(&sum, &order, criterion)?
         + &disagreement_line(&sum, &order, criterion)?
         + &recommendation_line(&sum, &order, criterion)?
         + &merged_line(&sum, &order)?
         + &dead_band_line(&sum, &order)?
-        + &contact_line(summary)?
-        + &passage_table(summary)?)
+        + &contact_line(summary)?;
+    Ok(table + &wrap(&notes, width) + &passage_table(summary)?)
+}
+
+/// Which columns give way first when the ranking is wider than the
+/// terminal (higher goes first; 0 never): the design and the ranking
+/// criterion stay, then failures (when there are any), the test against
+/// #1, the residual, the other settling measures, and last the intervals
+/// of the differences.
+fn column_priority(header: &str, criterion: Criterion, any_failed: bool) -> u8 {
+    match header {
+        "#" | "id" => 0,
+        "kind" | "n" | "ρ" => 1,
+        h if h.starts_with("β\n") || h.starts_with("M_s\n") || h.starts_with("settled") => 1,
+        h if h.contains("[95% CI]") && !h.starts_with('Δ') => 1,
+        h if h == criterion.to_string() => 1,
+        "failed" if any_failed => 2,
+        "failed" => 8,
+        h if h.starts_with("Holm p") => 3,
+        h if h.starts_with("residual") => 4,
+        "p90" => 6,
+        h if h.starts_with('Δ') => 7,
+        _ => 5,
+    }
 }
 
 /// An optional p-value as printed.

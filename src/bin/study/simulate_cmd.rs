@@ -49,7 +49,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&result.metrics)?);
     } else {
-        print!("{}", describe(&result.metrics));
+        print!(
+            "{}",
+            crate::output::wrap(&describe(&result.metrics), crate::output::text_width())
+        );
     }
     Ok(())
 }
