@@ -26,7 +26,7 @@ CRATE_LAYERS = [
     {"metrics"},
     {"simulation", "scene_file"},
     {"study"},
-    {"optimize", "claims", "tradeoff", "check", "plot", "schema"},
+    {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report"},
 ]
 MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",

@@ -39,6 +39,7 @@ pub mod model;
 pub mod optimize;
 pub mod output_file;
 pub mod plot;
+pub mod report;
 pub mod scene_file;
 pub mod schema;
 pub mod simulation;

@@ -64,6 +64,7 @@ fn verbs() -> Vec<Vec<&'static str>> {
         vec!["plot", "study", "results/corpus"],
         vec!["plot", "design"],
         vec!["plot", "map", "scene.toml"],
+        vec!["report", "results/corpus"],
         vec!["linear", "scene.toml"],
         vec!["criterion", "scene.toml"],
         vec!["sweep", "scene.toml", "--omega", "1..4"],

@@ -38,6 +38,7 @@ mod plane_designs;
 mod plot;
 mod plot_layout;
 mod race_eccentricity;
+mod report;
 mod results_folder;
 mod rolling_resistance;
 mod sample_bounds;

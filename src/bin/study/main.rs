@@ -18,6 +18,7 @@ mod output;
 mod plot_cmd;
 mod progress;
 mod ranking;
+mod report_cmd;
 mod run_cmd;
 mod simulate_cmd;
 mod sweep_cmd;
@@ -93,6 +94,9 @@ enum Command {
     /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
     #[command(after_help = bench_cmd::EXAMPLES)]
     Bench(bench_cmd::BenchArgs),
+    /// Write one self-contained HTML report of a finished study: ranking, verdicts, figures, provenance.
+    #[command(after_help = report_cmd::EXAMPLES)]
+    Report(report_cmd::ReportArgs),
     /// Print a shell completion script (bash, zsh, fish, powershell, elvish).
     #[command(after_help = meta_cmd::COMPLETIONS_EXAMPLES)]
     Completions(meta_cmd::CompletionsArgs),
@@ -153,6 +157,7 @@ fn main() -> ExitCode {
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
+        Command::Report(args) => report_cmd::run(&args),
         Command::Check(args) => check_cmd::check(&args),
         Command::Baseline(args) => check_cmd::baseline(&args),
         Command::Completions(args) => meta_cmd::completions(&args, Cli::command()),

@@ -146,6 +146,39 @@ impl PlaneCells {
 
 /// The ranking, verdicts, disagreements and recommendation of a summary.
 pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
+    let parts = ranking(summary)?;
+    let header: Vec<&str> = parts.header.iter().map(String::as_str).collect();
+    let width = text_width();
+    let (table, dropped) = fitted_table(&header, &parts.rows, &parts.priority, width);
+    let dropped_note = if dropped.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "(left out at this width: {}; --wide shows every column)\n",
+            dropped.join(", ")
+        )
+    };
+    Ok(table + &wrap(&(parts.legend + &dropped_note + &parts.findings), width) + &parts.passage)
+}
+
+/// The ranking's pieces, for the terminal ([`ranked_table`]) and the report.
+pub struct Ranking {
+    /// Column headers ("\n" stacks a header on two lines).
+    pub header: Vec<String>,
+    /// One row per design, in rank order.
+    pub rows: Vec<Vec<String>>,
+    /// Which columns give way first on a narrow terminal (see `column_priority`).
+    pub priority: Vec<u8>,
+    /// What the columns mean, one note per line.
+    pub legend: String,
+    /// Verdict, disagreements, recommendation and the other findings, one per line.
+    pub findings: String,
+    /// The passage-through-resonance table of a stall-torque sweep (or empty).
+    pub passage: String,
+}
+
+/// The ranking of a summary, in pieces.
+pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     let sum = Summary(summary);
     let criterion = rank_criterion(&sum)?;
     let order = order_by_rank(summary)?;
@@ -326,7 +359,6 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     } else {
         (header, rows)
     };
-    let header: Vec<&str> = header.iter().map(String::as_str).collect();
     let from = sum
         .s("settling_from")?
         .into_iter()
@@ -357,26 +389,20 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
         .iter()
         .map(|h| column_priority(h, criterion, any_failed))
         .collect();
-    let width = text_width();
-    let (table, dropped) = fitted_table(&header, &rows, &priority, width);
-    let dropped_note = if dropped.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "(left out at this width: {}; --wide shows every column)\n",
-            dropped.join(", ")
-        )
-    };
-    let notes = legend
-        + &plane_note
-        + &dropped_note
-        + &verdict_line(&sum, &order, criterion)?
+    let findings = verdict_line(&sum, &order, criterion)?
         + &disagreement_line(&sum, &order, criterion)?
         + &recommendation_line(&sum, &order, criterion)?
         + &merged_line(&sum, &order)?
         + &dead_band_line(&sum, &order)?
         + &contact_line(summary)?;
-    Ok(table + &wrap(&notes, width) + &passage_table(summary)?)
+    Ok(Ranking {
+        header,
+        rows,
+        priority,
+        legend: legend + &plane_note,
+        findings,
+        passage: passage_table(summary)?,
+    })
 }
 
 /// Which columns give way first when the ranking is wider than the

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Open a `study report` page in a real headless browser and check that it
+# renders: no script error and no console error, every figure has a
+# non-empty box, the ranking table has rows, and nothing is fetched from
+# elsewhere. Usage: scripts/check-report.sh REPORT.html
+# Exit 0: rendered and checked (or no browser here: said plainly, skipped);
+# 1: a check failed; 2: usage.
+# Needs Chromium (Debian: apt-get install chromium) and python3.
+set -euo pipefail
+report=${1:?usage: scripts/check-report.sh REPORT.html}
+[ -f "$report" ] || { echo "check-report: $report: no such file" >&2; exit 2; }
+
+browser=""
+for b in chromium chromium-browser google-chrome google-chrome-stable; do
+    if command -v "$b" >/dev/null 2>&1; then browser=$(command -v "$b"); break; fi
+done
+if [ -z "$browser" ]; then
+    echo "check-report: no Chromium here, so the report was NOT checked in a browser (install one: apt-get install chromium)"
+    exit 0
+fi
+
+work=$(mktemp -d "${TMPDIR:-/tmp}/check-report.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+
+# A copy of the page with a probe: errors are caught from the first line
+# on, and after load each figure's box and the table are measured into the
+# DOM, which the browser prints.
+python3 - "$report" "$work/page.html" <<'EOF'
+import re, sys
+src, dst = sys.argv[1], sys.argv[2]
+html = open(src, encoding="utf-8").read()
+# Nothing may be fetched: no src/href/url() to another place.
+external = re.findall(r'''(?:src|href)\s*=\s*["'](?!#|data:)[^"']+|url\(\s*["']?(?!#|data:)[^)'"]+''', html)
+if external:
+    print("check-report: the page fetches from elsewhere:", external[:5], file=sys.stderr)
+    sys.exit(1)
+catch = """<script>window.__errors=[];window.addEventListener('error',function(e){__errors.push(String(e.message))});
+var __ce=console.error;console.error=function(){__errors.push(Array.prototype.join.call(arguments,' '));__ce.apply(console,arguments)};</script>"""
+probe = """<script>window.addEventListener('load',function(){
+var figs=[].slice.call(document.querySelectorAll('figure'));
+var boxes=figs.map(function(f){var s=f.querySelector('svg');if(!s)return [f.id,0,0];var r=s.getBoundingClientRect();return [f.id,r.width,r.height]});
+var rows=document.querySelectorAll('#ranking-table tbody tr').length;
+var out=document.createElement('pre');out.id='__check';
+out.textContent=JSON.stringify({errors:window.__errors,boxes:boxes,rows:rows});document.body.appendChild(out)});</script>"""
+html = html.replace("<head>", "<head>" + catch, 1).replace("</body>", probe + "</body>", 1)
+open(dst, "w", encoding="utf-8").write(html)
+EOF
+
+"$browser" --headless --no-sandbox --disable-gpu --window-size=1200,3000 \
+    --virtual-time-budget=10000 --enable-logging=stderr --v=0 \
+    --dump-dom "file://$work/page.html" >"$work/dom.html" 2>"$work/browser.log" || true
+
+python3 - "$work/dom.html" "$work/browser.log" "$report" <<'EOF'
+import html as h, json, re, sys
+dom, log = (open(p, encoding="utf-8", errors="replace").read() for p in sys.argv[1:3])
+report = sys.argv[3]
+m = re.search(r'<pre id="__check">(.*?)</pre>', dom, re.S)
+if not m:
+    print("check-report: the page did not finish loading in the browser", file=sys.stderr)
+    print(log[-2000:], file=sys.stderr)
+    sys.exit(1)
+result = json.loads(h.unescape(m.group(1)))
+problems = []
+problems += ["script error: " + e for e in result["errors"]]
+problems += ["console: " + l for l in log.splitlines() if "Uncaught" in l or ("CONSOLE" in l and "error" in l.lower())]
+if not result["boxes"]:
+    problems.append("no figure")
+problems += [f"figure {i} has an empty box ({w:.0f} x {hgt:.0f})" for i, w, hgt in result["boxes"] if w < 10 or hgt < 10]
+if result["rows"] < 1:
+    problems.append("the ranking table has no row")
+if problems:
+    print(f"check-report: {report}: " + "; ".join(problems), file=sys.stderr)
+    sys.exit(1)
+print(f"check-report: {report}: rendered in Chromium: {len(result['boxes'])} figures with non-empty boxes, "
+      f"ranking table with {result['rows']} rows, no script or console error, nothing fetched")
+EOF

@@ -1,0 +1,111 @@
+//! `study report`: one self-contained HTML page of a finished study, to
+//! share: its question, ranking and verdicts, figures, the Kaplan–Meier
+//! curves of the leading designs, and how to reproduce it.
+
+use crate::UserError;
+use crate::plot_cmd::plot_error;
+use crate::ranking::ranking;
+use autobal::output_file::{WhenExists, prepare};
+use autobal::report::{Report, question, study_figures};
+use autobal::study::io::{read_metadata, read_parquet, write_text};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study report --help`.
+pub const EXAMPLES: &str = "Examples:
+  study report results/three_balls --out three_balls.html
+  scripts/check-report.sh three_balls.html     opens it in a headless browser";
+
+/// Arguments of `study report`.
+#[derive(Args)]
+pub struct ReportArgs {
+    /// The output folder of `study run` (or `study merge`).
+    dir: PathBuf,
+    /// The HTML file to write.
+    #[arg(long)]
+    out: PathBuf,
+    /// Replace the --out file if it exists.
+    #[arg(long)]
+    overwrite: bool,
+    /// How many leading designs get a Kaplan–Meier curve.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=8))]
+    leading: u32,
+}
+
+/// Run `study report`.
+pub fn run(args: &ReportArgs) -> Result<(), UserError> {
+    prepare(
+        "--out",
+        &args.out,
+        WhenExists::from_overwrite(args.overwrite),
+    )?;
+    let summary_path = args.dir.join("summary.parquet");
+    if !summary_path.is_file() {
+        return Err(UserError(
+            format!(
+                "{}: no summary.parquet (give the output folder of a finished `study run` or `study merge`)",
+                args.dir.display()
+            ),
+            2,
+        ));
+    }
+    let summary = read_parquet(&summary_path).map_err(|e| UserError(e.to_string(), 2))?;
+    let parts = ranking(&summary)?;
+    let study_text = autobal::input_file::read_text(&args.dir.join("study.toml"))
+        .map_err(|e| UserError(format!("{}/study.toml: {e}", args.dir.display()), 2))?;
+    // The leading designs' ids, in rank order (the table's "id" column).
+    let id_column = parts.header.iter().position(|h| h == "id").unwrap_or(1);
+    let leading: Vec<u32> = parts
+        .rows
+        .iter()
+        .take(args.leading as usize)
+        .filter_map(|row| row.get(id_column)?.parse().ok())
+        .collect();
+    let figures = study_figures(&args.dir, &leading).map_err(plot_error)?;
+    let meta = read_metadata(&args.dir.join("runs.parquet")).unwrap_or_default();
+    let value = |key: &str| {
+        meta.iter()
+            .find(|(k, _)| k == key)
+            .map_or("unknown".to_string(), |(_, v)| v.clone())
+    };
+    let title = args
+        .dir
+        .file_name()
+        .map_or("study".into(), |n| n.to_string_lossy().into_owned());
+    let lines = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(str::to_string)
+            .collect()
+    };
+    let report = Report {
+        title,
+        question: question(&study_text),
+        header: parts.header,
+        rows: parts.rows,
+        legend: lines(&parts.legend),
+        findings: lines(&parts.findings),
+        preformatted: parts.passage,
+        figures,
+        provenance: vec![
+            ("autobal".into(), value("build")),
+            ("git commit".into(), value("git_commit")),
+            ("study file SHA-256".into(), value("study_sha256")),
+            ("seed".into(), value("seed")),
+            ("shard".into(), value("shard")),
+            (
+                "reproduce".into(),
+                format!(
+                    "study run {}/study.toml --overwrite && study report {} --out {} --overwrite",
+                    args.dir.display(),
+                    args.dir.display(),
+                    args.out.display()
+                ),
+            ),
+        ],
+    };
+    write_text(&args.out, &report.html())
+        .map_err(|e| UserError::internal(format!("--out {}: {e}", args.out.display())))?;
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
