@@ -9,7 +9,7 @@ use crate::stats::bootstrap;
 use crate::stats::quantile::{Interpolation, quantile};
 use crate::study::config::{Design, StudyPlan};
 use crate::study::run::run_design_sample;
-use crate::study::sample::{Purpose, stream};
+use crate::study::stream::{Purpose, stream};
 use crate::study::verdict::settling_horizon;
 use rayon::prelude::*;
 

@@ -18,7 +18,7 @@
 //! random numbers hold as for the static part.
 
 use super::config::{Design, DirectionSpec, Scale, UnbalanceSpec};
-use super::sample::{Purpose, stream};
+use super::stream::{Purpose, stream};
 use crate::model::rotor::RotorModel;
 use crate::model::rotor::two_support::PointUnbalance;
 use rand::RngExt;

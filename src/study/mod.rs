@@ -2,7 +2,8 @@
 //! statistics → Parquet.
 //!
 //! - [`config`]: the study file schema, validation and the resolved plan.
-//! - [`sample`]: per-run random streams and draws.
+//! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
+//! - [`sample`]: the draws of one run (unbalance, direction, start angles).
 //! - [`tolerance`]: manufacturing tolerances of the weights, sampled per run.
 //! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
@@ -41,6 +42,7 @@ pub mod run;
 pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
+pub mod stream;
 pub mod study_folder;
 pub mod sweep;
 pub mod tolerance;

@@ -1,61 +1,21 @@
-//! Random streams and the draws of one run.
+//! The draws of one run: unbalance, direction, start angles and, where the
+//! study samples them, the couple part and the weights as built.
 //!
-//! Every run draws from its own stream, seeded by mixing (study seed, design
-//! index, sample index) through SplitMix64 steps: results do not depend on
-//! thread count, scheduling or sharding. With common random numbers (the
-//! default) the design index is left out of the unbalance and direction
-//! draws, so every design meets the same unbalances and differences between
-//! designs are not sampling noise.
+//! Every run draws from its own streams ([`super::stream`]): results do not
+//! depend on thread count, scheduling or sharding. With common random
+//! numbers (the default) the design index is left out of the unbalance and
+//! direction draws, so every design meets the same unbalances and
+//! differences between designs are not sampling noise.
 
 use super::config::{Design, DirectionSpec, Distribution, InitialSpec, Scale, StudyPlan};
+pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
 use crate::model::start::balanced_fan;
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_distr::{Distribution as _, Exp1};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::f64::consts::PI;
-
-/// One SplitMix64 step: a bijective 64-bit mixer (Steele, Lea & Flood 2014).
-pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// Purposes of streams, so that independent draws never share a stream.
-#[derive(Debug, Clone, Copy)]
-#[repr(u64)]
-pub enum Purpose {
-    /// Unbalance magnitude and direction.
-    Unbalance = 1,
-    /// Initial cargo positions.
-    Initial = 2,
-    /// Bootstrap resampling of a design's statistics.
-    Bootstrap = 3,
-    /// Bootstrap resampling of a comparison of two designs.
-    Comparison = 4,
-    /// Each weight's mass ([`super::tolerance`]).
-    MassTolerance = 5,
-    /// Each weight's radius ([`super::tolerance`]).
-    RadiusTolerance = 6,
-    /// The race centre's offset from the axis ([`super::tolerance`]).
-    EccentricityTolerance = 7,
-    /// The couple unbalance of a two-plane rotor ([`super::couple`]).
-    Couple = 8,
-}
-
-/// The stream for (seed, design, sample, purpose); `design = None` for
-/// streams shared by every design (common random numbers).
-pub fn stream(seed: u64, design: Option<u32>, sample: u64, purpose: Purpose) -> Xoshiro256PlusPlus {
-    let d = design.map_or(u64::MAX, u64::from);
-    let mut h = splitmix64(seed);
-    h = splitmix64(h ^ d);
-    h = splitmix64(h ^ sample);
-    h = splitmix64(h ^ purpose as u64);
-    Xoshiro256PlusPlus::seed_from_u64(h)
-}
 
 /// What was drawn for one run.
 #[derive(Debug, Clone, PartialEq)]

@@ -30,7 +30,7 @@
 //! at a prescribed speed; other studies are refused when validated.
 
 use super::config::{Design, StudyPlan};
-use super::sample::{Purpose, stream};
+use super::stream::{Purpose, stream};
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
 use crate::model::effect::SceneFacts;

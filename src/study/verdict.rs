@@ -7,7 +7,7 @@ use super::criterion::{Criterion, Scale, sign_difference};
 pub use super::design_runs::{
     DesignRuns, SettlingClock, design_runs, measure_scale, settling_horizon,
 };
-use super::sample::{Purpose, stream};
+use super::stream::{Purpose, stream};
 use crate::stats::holm::holm_adjust;
 use crate::stats::paired::{
     Settling, SettlingComparison, WilcoxonResult, compare_settling, median_ratio,
