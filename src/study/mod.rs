@@ -1,6 +1,7 @@
 //! The study runner: TOML studies → Monte Carlo on all cores → polars
 //! statistics → Parquet.
 //!
+//! - [`distribution`]: the distributions of `[sampling]` (unbalance, direction, start), checked and drawn.
 //! - [`config`]: the study file schema, validation and the resolved plan.
 //! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
 //! - [`sample`]: the draws of one run (unbalance, direction, start angles).
@@ -30,6 +31,7 @@ pub mod couple;
 pub mod criterion;
 pub mod design_runs;
 pub mod diagnosis;
+pub mod distribution;
 pub mod failures;
 pub mod io;
 pub mod lock;

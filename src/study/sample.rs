@@ -7,7 +7,9 @@
 //! direction draws, so every design meets the same unbalances and
 //! differences between designs are not sampling noise.
 
-use super::config::{Design, DirectionSpec, Distribution, InitialSpec, Scale, StudyPlan};
+use super::config::{Design, StudyPlan};
+pub use super::distribution::draw_value;
+use super::distribution::{DirectionSpec, InitialSpec, Scale};
 pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
@@ -35,27 +37,6 @@ pub struct Sample {
     pub couple: Option<super::couple::SampledCouple>,
 }
 
-/// One value of distribution `d` from `rng`.
-pub fn draw_value(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
-    draw(d, rng)
-}
-
-fn draw(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
-    match *d {
-        Distribution::Fixed { value } => value,
-        Distribution::Uniform { min, max } => min + (max - min) * rng.random::<f64>(),
-        Distribution::LogUniform { min, max } => {
-            (min.ln() + (max.ln() - min.ln()) * rng.random::<f64>()).exp()
-        }
-        Distribution::NormalTruncated {
-            mean,
-            std,
-            min,
-            max,
-        } => super::truncated::draw(rng, mean, std, min, max),
-    }
-}
-
 /// Draw the sample of run (design, sample index).
 pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     let s = &plan.file.sampling;
@@ -66,7 +47,7 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         Some(design.id)
     };
     let mut rng = stream(seed, shared, sample, Purpose::Unbalance);
-    let value = draw(&s.unbalance.distribution, &mut rng);
+    let value = draw_value(&s.unbalance.distribution, &mut rng);
     let (unbalance, fraction) = match s.unbalance.scale() {
         Scale::Capacity => (value * design.capacity, value),
         Scale::Absolute => (value, value / design.capacity),
