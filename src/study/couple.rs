@@ -17,7 +17,7 @@
 //! static draws, and every study without the table, are unchanged; common
 //! random numbers hold as for the static part.
 
-use super::config::Design;
+use super::design::Design;
 use super::distribution::{DirectionSpec, Scale, UnbalanceSpec, draw_value};
 use super::stream::{Purpose, stream};
 use crate::model::rotor::RotorModel;

@@ -11,7 +11,8 @@
 //! 5. a horizon too short for the slowest mode, or an unstable balanced
 //!    state (the linear analysis of `study linear`).
 
-use super::config::{Design, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
 use crate::model::linear::analyse;
 use crate::model::rotor::{MAX_DOF, PlaneRotor};
 

@@ -2,6 +2,7 @@
 //! statistics → Parquet.
 //!
 //! - [`distribution`]: the distributions of `[sampling]` (unbalance, direction, start), checked and drawn.
+//! - [`design`]: one resolved design of the grid, and the grid's one-or-many values.
 //! - [`config`]: the study file schema, validation and the resolved plan.
 //! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
 //! - [`sample`]: the draws of one run (unbalance, direction, start angles).
@@ -29,6 +30,7 @@ pub mod compare_designs;
 pub mod config;
 pub mod couple;
 pub mod criterion;
+pub mod design;
 pub mod design_runs;
 pub mod diagnosis;
 pub mod distribution;

@@ -8,7 +8,8 @@
 
 use super::adaptive::{Precision, batch_ids, batches, precision};
 use super::aggregate::summarize_table;
-use super::config::{Design, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
 use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet, write_text};
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};

@@ -7,7 +7,8 @@
 //! direction draws, so every design meets the same unbalances and
 //! differences between designs are not sampling noise.
 
-use super::config::{Design, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
 pub use super::distribution::draw_value;
 use super::distribution::{DirectionSpec, InitialSpec, Scale};
 pub use super::stream::{Purpose, splitmix64, stream};

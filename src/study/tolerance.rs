@@ -29,7 +29,8 @@
 //! `race_offset` (m) and `race_angle_deg`. The effect models the plane rotor
 //! at a prescribed speed; other studies are refused when validated.
 
-use super::config::{Design, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
 use super::stream::{Purpose, stream};
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
