@@ -14,6 +14,7 @@ use super::distribution::{DirectionSpec, InitialSpec, Scale};
 pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
+use crate::model::scene::Scene;
 use crate::model::start::balanced_fan;
 use rand::RngExt;
 use rand_distr::{Distribution as _, Exp1};
@@ -42,11 +43,7 @@ pub struct Sample {
 pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     let s = &plan.file.sampling;
     let seed = plan.file.seed;
-    let shared = if s.common_random_numbers {
-        None
-    } else {
-        Some(design.id)
-    };
+    let shared = shared(plan, design);
     let mut rng = stream(seed, shared, sample, Purpose::Unbalance);
     let value = draw_value(&s.unbalance.distribution, &mut rng);
     let (unbalance, fraction) = match s.unbalance.scale() {
@@ -76,6 +73,37 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
             super::couple::draw(spec, seed, shared, design, sample, (unbalance, direction))
         }),
     }
+}
+
+/// The design index of a run's streams: none when every design meets the
+/// same draws (common random numbers, the default).
+fn shared(plan: &StudyPlan, design: &Design) -> Option<u32> {
+    if plan.file.sampling.common_random_numbers {
+        None
+    } else {
+        Some(design.id)
+    }
+}
+
+/// Draw the weights of run (design, sample index) into `scene`, when the
+/// study samples tolerances (`[sampling.tolerances]`); `None`, and the scene
+/// left alone, when it does not.
+pub fn draw_weights(
+    plan: &StudyPlan,
+    design: &Design,
+    sample: u64,
+    scene: &mut Scene,
+) -> Option<SampledWeights> {
+    let t = plan.file.sampling.tolerances.as_ref()?;
+    let shared = shared(plan, design);
+    Some(super::tolerance::apply(
+        t,
+        plan.file.seed,
+        shared,
+        design,
+        sample,
+        scene,
+    ))
 }
 
 /// The start angles of one balancer's weights (`design`'s plane), from the
