@@ -12,6 +12,7 @@
 //! - [`record`]: one row of `runs.parquet`.
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`measured_runs`]: a design's runs as the criteria measure them, and their scale (τ, revolution).
 //! - [`criterion`]: what "best" means: the declared ranking criterion and its test.
 //! - [`design_runs`]: each design's runs as the statistics count them (clock, τ).
 //! - [`diagnosis`]: why no design balances, when none does.
@@ -37,6 +38,7 @@ pub mod distribution;
 pub mod failures;
 pub mod io;
 pub mod lock;
+pub mod measured_runs;
 pub mod merge;
 pub mod optimize_spec;
 pub mod plane_designs;
