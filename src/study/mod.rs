@@ -1,9 +1,9 @@
 //! The study runner: TOML studies → Monte Carlo on all cores → polars
 //! statistics → Parquet.
 //!
-//! - [`distribution`]: the distributions of `[sampling]` (unbalance, direction, start), checked and drawn.
-//! - [`design`]: one resolved design of the grid, and the grid's one-or-many values.
 //! - [`config`]: the study file schema, validation and the resolved plan.
+//! - [`distribution`]: the `[sampling]` distributions (unbalance, direction, start).
+//! - [`design`]: one resolved design of the grid, and the grid's one-or-many values.
 //! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
 //! - [`sample`]: the draws of one run (unbalance, direction, start angles).
 //! - [`tolerance`]: manufacturing tolerances of the weights, sampled per run.
@@ -12,7 +12,7 @@
 //! - [`record`]: one row of `runs.parquet`.
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
-//! - [`measured_runs`]: a design's runs as the criteria measure them, and their scale (τ, revolution).
+//! - [`measured_runs`]: a design's runs and their scale (τ, revolution), as criteria see them.
 //! - [`criterion`]: what "best" means: the declared ranking criterion and its test.
 //! - [`design_runs`]: each design's runs as the statistics count them (clock, τ).
 //! - [`diagnosis`]: why no design balances, when none does.
