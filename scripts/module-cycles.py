@@ -1,15 +1,15 @@
 #!/usr/bin/env python3
 """Import cycles and layer violations between the modules of the library.
 
-Two levels are checked: the crate's top modules (design, model, integrate,
-study, ...), and the units inside `model`. A "unit" is a direct child of its
-parent (a file such as scene.rs, or a folder such as rotor/ together with
+Three graphs are checked: the crate's top modules (design, model, integrate,
+study, ...), the units inside `model` and the units inside `study`. A "unit"
+is a direct child of its parent (a file such as scene.rs, or a folder such as rotor/ together with
 everything below it): edges inside a unit (a file using its folder's mod.rs
 and the re-exports back) are how Rust folders work and are not counted.
 Every `use` tree and every inline `crate::…`/`super::…` path outside
 comments and strings is an edge.
 
-Exits 1 when either graph has a cycle or a module imports one from a higher
+Exits 1 when any graph has a cycle or a module imports one from a higher
 layer, so it can run in CI: python3 scripts/module-cycles.py
 """
 
@@ -33,6 +33,21 @@ MODEL_LAYERS = [
      "tilt_inertia", "sommerfeld"},
     {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "quasi_static", "start",
      "unbalance", "zero_approx"},
+]
+STUDY_LAYERS = [
+    # Plain data and helpers: streams, distributions, a resolved design, a
+    # design's measured runs, files.
+    {"stream", "truncated", "distribution", "design", "measured_runs", "io", "lock", "runs_file"},
+    # The parts of the study file that check, draw or measure on their own.
+    {"couple", "tolerance", "plane_designs", "criterion", "optimize_spec"},
+    # The study file and its resolved plan.
+    {"config"},
+    # One run or one design, from a plan.
+    {"sample", "record", "failures", "diagnosis", "design_runs", "verdict", "plane_summary"},
+    # Statistics over many runs.
+    {"adaptive", "aggregate", "compare_designs"},
+    # The runner and the verbs on top of it.
+    {"run", "merge", "study_folder", "sweep", "stability_map"},
 ]
 
 CODE_NOISE = re.compile(
@@ -183,6 +198,8 @@ def main() -> int:
     bad = analyse(files, modules, 0, "crate module", CRATE_LAYERS)
     model_files = [f for f in files if module_path(f)[:1] == ("model",)]
     bad += analyse(model_files, modules, 1, "model unit", MODEL_LAYERS)
+    study_files = [f for f in files if module_path(f)[:1] == ("study",)]
+    bad += analyse(study_files, modules, 1, "study unit", STUDY_LAYERS)
     return 1 if bad else 0
 
 

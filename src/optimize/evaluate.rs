@@ -7,9 +7,10 @@ use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
 use crate::stats::bootstrap;
 use crate::stats::quantile::{Interpolation, quantile};
-use crate::study::config::{Design, StudyPlan};
+use crate::study::config::StudyPlan;
+use crate::study::design::Design;
 use crate::study::run::run_design_sample;
-use crate::study::sample::{Purpose, stream};
+use crate::study::stream::{Purpose, stream};
 use crate::study::verdict::settling_horizon;
 use rayon::prelude::*;
 

@@ -6,9 +6,8 @@
 //! however often the run is interrupted and resumed.
 
 use super::config::{StopWhen, StudyPlan};
-use super::verdict::{
-    DesignRuns, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
-};
+use super::measured_runs::DesignRuns;
+use super::verdict::{LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale};
 use crate::stats::survival::Transform;
 use polars::prelude::*;
 use std::ops::Range;

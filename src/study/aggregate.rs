@@ -8,11 +8,12 @@
 //! over the sampled unbalances; diverged and failed runs are counted.
 
 use super::config::StudyPlan;
-use super::criterion::{Criterion, Scale};
+use super::criterion::Criterion;
 use super::diagnosis::{DesignFacts, dead_band, diagnose, settling_band};
+use super::measured_runs::{DesignRuns, Scale};
 use super::record::{RunRecord, to_dataframe};
 use super::verdict::{
-    BestVersusRest, DesignRuns, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
+    BestVersusRest, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
 };
 use crate::model::gap::GapGauge;
 use crate::stats::interval::wilson_interval;

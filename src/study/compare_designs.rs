@@ -3,9 +3,10 @@
 //! otherwise, with the reason pairing was refused.
 
 use super::config::{StudyFile, StudyPlan};
-use super::criterion::{Criterion, Scale};
+use super::criterion::Criterion;
 use super::io::read_parquet;
-use super::verdict::{Comparison, DesignRuns, SettlingClock, compare, design_runs, measure_scale};
+use super::measured_runs::{DesignRuns, Scale};
+use super::verdict::{Comparison, SettlingClock, compare, design_runs, measure_scale};
 use crate::stats::interval::wilson_interval;
 use crate::stats::survival::{KaplanMeier, Transform};
 use polars::prelude::*;

@@ -6,6 +6,8 @@
 //! and resolves the design grid, so that a study either starts with a fully
 //! valid plan or fails before anything is written.
 
+pub use super::design::{Design, MAX_WEIGHTS, OneOrMany};
+pub use super::distribution::{DirectionSpec, Distribution, InitialSpec, Scale, UnbalanceSpec};
 use crate::design::geometry::check_fits;
 use crate::metrics::MetricOptions;
 use crate::model::balancer::Kind;
@@ -14,7 +16,6 @@ use crate::model::rotor::RotorModel;
 use crate::model::scene::{DesignSpec, RhoChoice, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
-use crate::model::validate::shown;
 use crate::simulation::SolverSettings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -133,57 +134,6 @@ pub struct SceneTemplate {
     #[serde(default)]
     pub start: StartMode,
 }
-
-/// A one-or-many value in the design grid.
-#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
-#[serde(untagged)]
-#[schemars(inline)]
-pub enum OneOrMany<T> {
-    /// A single value.
-    One(T),
-    /// A list of values.
-    Many(Vec<T>),
-}
-
-/// Written by hand instead of serde's `untagged`: that one can only say "data
-/// did not match any variant"; this one passes on what was wrong with the
-/// value (or with which list entry), e.g. "invalid value: integer `-3`,
-/// expected u32" or "unknown variant `bal`, expected one of ...".
-impl<'de, T: Deserialize<'de>> Deserialize<'de> for OneOrMany<T> {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        use serde::de::Error;
-        match toml::Value::deserialize(deserializer)? {
-            toml::Value::Array(items) => items
-                .into_iter()
-                .enumerate()
-                .map(|(i, item)| {
-                    T::deserialize(item)
-                        .map_err(|e| D::Error::custom(format!("entry {}: {}", i + 1, e.message())))
-                })
-                .collect::<Result<Vec<T>, _>>()
-                .map(OneOrMany::Many),
-            value => T::deserialize(value).map(OneOrMany::One).map_err(|e| {
-                D::Error::custom(format!(
-                    "{} (give one value or a list of them)",
-                    e.message()
-                ))
-            }),
-        }
-    }
-}
-
-impl<T: Clone> OneOrMany<T> {
-    /// The values as a list.
-    pub fn values(&self) -> Vec<T> {
-        match self {
-            OneOrMany::One(v) => vec![v.clone()],
-            OneOrMany::Many(v) => v.clone(),
-        }
-    }
-}
-
-/// Most weights one balancer may have (docs/running-at-scale.md).
-pub const MAX_WEIGHTS: u32 = 256;
 
 /// Most runs one study may hold. The runner streams runs to disk but keeps
 /// about 80 bytes a run (run ids and the columns the summary reads): about
@@ -308,194 +258,6 @@ fn accept_old_win_share_name(schema: &mut schemars::Schema) {
     }
 }
 
-/// Unbalance magnitude U = M e: a distribution, absolute (kg·m) or as a
-/// fraction of each design's balancing capacity.
-// No deny_unknown_fields here: serde cannot combine it with `flatten`; the
-// flattened distribution rejects unknown keys itself.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[schemars(transform = close_unbalance_tables)]
-pub struct UnbalanceSpec {
-    /// The distribution.
-    #[serde(flatten)]
-    pub distribution: Distribution,
-    /// Required: "capacity" (a fraction of each design's capacity, no unit)
-    /// or "absolute" (kg·m). Never guessed: the same numbers mean a 10⁴-fold
-    /// different unbalance under the two.
-    #[serde(default)]
-    pub relative_to: Option<Scale>,
-}
-
-impl UnbalanceSpec {
-    /// The scale the values are in (`relative_to`; [`StudyFile::plan`]
-    /// refuses a study without it, so a plan's spec always has one).
-    pub fn scale(&self) -> Scale {
-        self.relative_to.unwrap_or(Scale::Capacity)
-    }
-}
-
-/// schemars flattens the distribution as one alternative per distribution
-/// beside `relative_to`, and none of them closed: a misspelt key would pass
-/// the schema that the parser refuses. Each alternative gets `relative_to`
-/// and forbids other keys, as the parser does.
-fn close_unbalance_tables(schema: &mut schemars::Schema) {
-    let shared = schema
-        .remove("properties")
-        .and_then(|p| p.as_object().cloned())
-        .unwrap_or_default();
-    let shared_required = schema
-        .remove("required")
-        .and_then(|r| r.as_array().cloned())
-        .unwrap_or_default();
-    let Some(alternatives) = schema
-        .get_mut("oneOf")
-        .and_then(serde_json::Value::as_array_mut)
-    else {
-        return;
-    };
-    for alternative in alternatives.iter_mut().filter_map(|a| a.as_object_mut()) {
-        if let Some(properties) = alternative
-            .get_mut("properties")
-            .and_then(serde_json::Value::as_object_mut)
-        {
-            properties.extend(shared.clone());
-        }
-        if let Some(required) = alternative
-            .entry("required")
-            .or_insert_with(|| serde_json::Value::Array(Vec::new()))
-            .as_array_mut()
-        {
-            required.extend(shared_required.iter().cloned());
-            // Units are never guessed: `relative_to` is required, though
-            // the field is an Option so that the parser can name both
-            // choices in its message.
-            if !required.iter().any(|r| r == "relative_to") {
-                required.push("relative_to".into());
-            }
-        }
-        alternative.insert("additionalProperties".into(), false.into());
-    }
-}
-
-/// Scale of sampled unbalances.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Scale {
-    /// A fraction of the design's capacity.
-    Capacity,
-    /// kg·m.
-    Absolute,
-}
-
-/// A distribution of a positive quantity.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(
-    tag = "distribution",
-    rename_all = "snake_case",
-    deny_unknown_fields,
-    expecting = "a table with `distribution` = \"fixed\", \"uniform\", \"log_uniform\" or \"normal_truncated\" and its keys"
-)]
-pub enum Distribution {
-    /// Always the same value.
-    Fixed {
-        /// The value (a fraction of capacity, or kg·m with `relative_to = "absolute"`).
-        value: f64,
-    },
-    /// Uniform on [min, max].
-    Uniform {
-        /// Lower bound.
-        min: f64,
-        /// Upper bound.
-        max: f64,
-    },
-    /// Log-uniform on [min, max] (min > 0).
-    LogUniform {
-        /// Lower bound.
-        min: f64,
-        /// Upper bound.
-        max: f64,
-    },
-    /// Normal(mean, std) truncated to [min, max] (rejection sampling).
-    NormalTruncated {
-        /// Mean.
-        mean: f64,
-        /// Standard deviation.
-        std: f64,
-        /// Lower bound.
-        min: f64,
-        /// Upper bound.
-        max: f64,
-    },
-}
-
-impl Distribution {
-    /// Largest value the distribution can produce.
-    pub fn upper(&self) -> f64 {
-        match *self {
-            Distribution::Fixed { value } => value,
-            Distribution::Uniform { max, .. }
-            | Distribution::LogUniform { max, .. }
-            | Distribution::NormalTruncated { max, .. } => max,
-        }
-    }
-}
-
-/// Unbalance direction.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum DirectionSpec {
-    /// Uniform on [0, 2π).
-    #[default]
-    Uniform,
-    /// A fixed angle (degrees).
-    Fixed(f64),
-}
-
-/// Initial cargo positions.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum InitialSpec {
-    /// Pressed together (touching) around a uniformly random direction.
-    #[default]
-    Clustered,
-    /// Uniformly random positions without overlap (weights of radius r cannot
-    /// come closer than 2α).
-    Uniform,
-    /// Evenly spaced (a regular polygon).
-    Even,
-    /// Balanced for an unbalance of the same magnitude turned by this many
-    /// degrees (the `step` start: e.g. 90 for the paper's Fig. 1 argument).
-    BalancedForShift(f64),
-}
-
-/// One resolved design of the grid.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Design {
-    /// Index in grid order.
-    pub id: u32,
-    /// The balancer.
-    pub spec: DesignSpec,
-    /// Resolved ρ.
-    pub rho: f64,
-    /// Mass of one weight (kg).
-    pub weight_mass: f64,
-    /// Track radius l = R − r (m).
-    pub track_radius: f64,
-    /// Balancing capacity (kg·m): S_AB of seed 000 for balls and rollers
-    /// (weights pressed together), n m l for pendulums (they can pass each
-    /// other); with a design per plane, its weakest plane's.
-    pub capacity: f64,
-    /// Plane 0's own capacity (kg·m): `capacity` unless planes differ.
-    #[serde(skip)]
-    pub plane_zero_capacity: f64,
-    /// The balancers of planes 1, 2, … when they have designs of their own
-    /// (`[[designs.per_plane]]`); empty: `spec` in every plane.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub plane_designs: Vec<Design>,
-    /// The motor's stall torque M_s (N·m) when the grid sweeps it
-    /// (`designs.stall_torque`); `None`: the scene's own speed law.
-    pub stall_torque: Option<f64>,
-}
-
 /// A validated study: the file plus its resolved designs.
 #[derive(Debug, Clone)]
 pub struct StudyPlan {
@@ -543,27 +305,6 @@ impl StudyPlan {
             cargo: Vec::new(),
             speed: design.speed(&t.speed),
             effects: t.effects.clone(),
-        }
-    }
-}
-
-impl Design {
-    /// The study's speed law with this design's stall torque, if it has one.
-    pub fn speed(&self, law: &SpeedLaw) -> SpeedLaw {
-        match (self.stall_torque, law.clone()) {
-            (
-                Some(torque),
-                SpeedLaw::Motor {
-                    omega_sync,
-                    omega_start,
-                    ..
-                },
-            ) => SpeedLaw::Motor {
-                stall_torque: torque,
-                omega_sync,
-                omega_start,
-            },
-            (_, law) => law,
         }
     }
 }
@@ -694,11 +435,11 @@ impl StudyFile {
                 }
             }
         }
-        check_distribution(&s.unbalance.distribution)
+        super::distribution::check(&s.unbalance.distribution)
             .map_err(|(k, v, r)| invalid(&format!("sampling.unbalance.{k}"), v, r))?;
         if let Some(couple) = &s.couple {
             super::couple::validate(couple, &self.scene.rotor, |u| {
-                check_distribution(&u.distribution).map_err(|(k, v, r)| {
+                super::distribution::check(&u.distribution).map_err(|(k, v, r)| {
                     (format!("sampling.couple.unbalance.{k}"), v, r.to_string())
                 })
             })
@@ -1131,64 +872,6 @@ fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String
                 k => format!("designs.{k}"),
             };
             (key, format!("{kind} n = {n}"), d.to_string())
-        }
-    }
-}
-
-fn check_distribution(d: &Distribution) -> Result<(), (String, String, &'static str)> {
-    let pos = |k: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err((k.to_string(), shown(v), "must be positive and finite"))
-        }
-    };
-    match *d {
-        Distribution::Fixed { value } => pos("value", value),
-        Distribution::Uniform { min, max } | Distribution::LogUniform { min, max } => {
-            pos("min", min)?;
-            pos("max", max)?;
-            if max < min {
-                return Err(("max".into(), shown(max), "must not be below min"));
-            }
-            Ok(())
-        }
-        Distribution::NormalTruncated {
-            mean,
-            std,
-            min,
-            max,
-        } => {
-            pos("std", std)?;
-            pos("min", min)?;
-            pos("max", max)?;
-            if max <= min {
-                return Err((
-                    "max".into(),
-                    shown(max),
-                    "must be above min (a single value is `distribution = \"fixed\"`)",
-                ));
-            }
-            if !mean.is_finite() {
-                return Err(("mean".into(), shown(mean), "must be finite"));
-            }
-            // Rejection sampling needs a reasonable acceptance rate.
-            if (min - mean) / std > 5.0 || (mean - max) / std > 5.0 {
-                return Err((
-                    "mean".into(),
-                    shown(mean),
-                    "lies more than 5 std outside [min, max]",
-                ));
-            }
-            let mass = super::truncated::accepted_mass(mean, std, min, max);
-            if mass < super::truncated::MIN_ACCEPTED_MASS {
-                return Err((
-                    "std".into(),
-                    shown(std),
-                    "leaves less than 0.1 % of the normal inside [min, max]: each draw would need over 1 000 tries; narrow std or widen [min, max]",
-                ));
-            }
-            Ok(())
         }
     }
 }

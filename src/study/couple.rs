@@ -17,8 +17,9 @@
 //! static draws, and every study without the table, are unchanged; common
 //! random numbers hold as for the static part.
 
-use super::config::{Design, DirectionSpec, Scale, UnbalanceSpec};
-use super::sample::{Purpose, stream};
+use super::design::Design;
+use super::distribution::{DirectionSpec, Scale, UnbalanceSpec, draw_value};
+use super::stream::{Purpose, stream};
 use crate::model::rotor::RotorModel;
 use crate::model::rotor::two_support::PointUnbalance;
 use rand::RngExt;
@@ -166,7 +167,7 @@ pub fn draw(
         .as_ref()
         .expect("validated: unbalance or follows_static");
     let mut rng = stream(seed, shared, sample, Purpose::Couple);
-    let value = super::sample::draw_value(&spec_u.distribution, &mut rng);
+    let value = draw_value(&spec_u.distribution, &mut rng);
     let (unbalance, fraction) = match spec_u.scale() {
         Scale::Capacity => (value * design.capacity, value),
         Scale::Absolute => (value, value / design.capacity),

@@ -6,7 +6,8 @@
 //! run counts as settling at the horizon τ for the restricted mean and the
 //! p90 (never dropped), and as "not settled" for the shares.
 
-use super::design_runs::DesignRuns;
+use super::measured_runs::DesignRuns;
+pub use super::measured_runs::Scale;
 use crate::stats::paired::{Settling, SettlingComparison, compare_settling};
 use crate::stats::paired_measures::{
     Difference, honest_p, mean_difference_bootstrap, paired_mean_difference, quantile_difference,
@@ -328,16 +329,6 @@ pub fn sign_difference(c: &SettlingComparison, a: f64, b: f64) -> Difference {
         p_value: honest_p(c.sign_test_p),
         test: "sign",
     }
-}
-
-/// What turns the runs into numbers: the restricted-mean horizon τ (rev)
-/// and the length of a revolution (s).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Scale {
-    /// τ: the restricted mean and the capped times run up to it (rev).
-    pub tau: f64,
-    /// One revolution of the nominal speed (s).
-    pub rev_seconds: f64,
 }
 
 /// Settling times with a run that did not settle counted as τ.

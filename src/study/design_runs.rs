@@ -1,36 +1,12 @@
-//! The runs of each design as the statistics see them: settling
-//! observations (censored where a run did not settle), residuals, and the
-//! clock and horizon τ they are counted with.
+//! Each design's runs read from a runs table as the statistics see them:
+//! settling observations (censored where a run did not settle) and
+//! residuals, counted with the plan's clock and horizon τ.
 
 use super::config::StudyPlan;
-use super::criterion::Scale;
-use crate::stats::survival::{KaplanMeier, Observation};
+pub use super::measured_runs::DesignRuns;
+use super::measured_runs::Scale;
+use crate::stats::survival::Observation;
 use polars::prelude::*;
-
-/// The runs of one design, in sample order: its settling observations and
-/// residual vibrations.
-#[derive(Debug, Clone)]
-pub struct DesignRuns {
-    /// The design.
-    pub design_id: u32,
-    /// Sample index of each run (what pairs runs of two designs).
-    pub sample_ids: Vec<u32>,
-    /// Settled at t (revolutions), or censored: at `censoring_revs` for a
-    /// run simulated to its end, at the horizon for one that diverged,
-    /// failed or ran out of budget (it never settled within the run).
-    pub settling: Vec<Observation>,
-    /// Residual vibration / A_ref of runs simulated to their end.
-    pub residual: Vec<Option<f64>>,
-    /// Residual vibration (m) of runs simulated to their end.
-    pub residual_abs: Vec<Option<f64>>,
-}
-
-impl DesignRuns {
-    /// The Kaplan–Meier estimate of its settling.
-    pub fn kaplan_meier(&self) -> Option<KaplanMeier> {
-        KaplanMeier::fit(&self.settling)
-    }
-}
 
 /// The latest settling time a run of the plan can show (revolutions): the
 /// end of the run less the hold window. Runs that never settled are

@@ -11,7 +11,8 @@
 //! 5. a horizon too short for the slowest mode, or an unstable balanced
 //!    state (the linear analysis of `study linear`).
 
-use super::config::{Design, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
 use crate::model::linear::analyse;
 use crate::model::rotor::{MAX_DOF, PlaneRotor};
 
@@ -43,7 +44,7 @@ pub fn diagnose(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> Strin
     let cause = first_cause(plan, design, facts);
     // Fractions of capacity this small are usually kg·m read as fractions.
     if facts.unbalance_fraction_median < 0.01
-        && plan.file.sampling.unbalance.scale() == super::config::Scale::Capacity
+        && plan.file.sampling.unbalance.scale() == super::distribution::Scale::Capacity
     {
         return format!(
             "{cause} (note: the median unbalance drawn is {:.1e} of the capacity; if the values were meant in kg·m, set relative_to = \"absolute\")",

@@ -2,13 +2,17 @@
 //! statistics → Parquet.
 //!
 //! - [`config`]: the study file schema, validation and the resolved plan.
-//! - [`sample`]: per-run random streams and draws.
+//! - [`distribution`]: the `[sampling]` distributions (unbalance, direction, start).
+//! - [`design`]: one resolved design of the grid, and the grid's one-or-many values.
+//! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
+//! - [`sample`]: the draws of one run (unbalance, direction, start angles).
 //! - [`tolerance`]: manufacturing tolerances of the weights, sampled per run.
 //! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
 //! - [`record`]: one row of `runs.parquet`.
 //! - [`runs_file`]: `runs.parquet` assembled in run order with bounded memory.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`measured_runs`]: a design's runs and their scale (τ, revolution), as criteria see them.
 //! - [`criterion`]: what "best" means: the declared ranking criterion and its test.
 //! - [`design_runs`]: each design's runs as the statistics count them (clock, τ).
 //! - [`diagnosis`]: why no design balances, when none does.
@@ -27,11 +31,14 @@ pub mod compare_designs;
 pub mod config;
 pub mod couple;
 pub mod criterion;
+pub mod design;
 pub mod design_runs;
 pub mod diagnosis;
+pub mod distribution;
 pub mod failures;
 pub mod io;
 pub mod lock;
+pub mod measured_runs;
 pub mod merge;
 pub mod optimize_spec;
 pub mod plane_designs;
@@ -41,6 +48,7 @@ pub mod run;
 pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
+pub mod stream;
 pub mod study_folder;
 pub mod sweep;
 pub mod tolerance;

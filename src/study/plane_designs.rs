@@ -8,7 +8,7 @@
 //! runs.parquet and summary.parquet then name every plane's design in
 //! columns of their own (`kind_plane0`, `n_plane1`, …).
 
-use super::config::{Design, OneOrMany};
+use super::design::{Design, MAX_WEIGHTS, OneOrMany};
 use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
 use polars::prelude::*;
@@ -81,18 +81,14 @@ pub fn validate(axes: &[PlaneAxes], planes: usize) -> Result<(), Refusal> {
         if let Some((k, _)) = empty.iter().find(|(_, e)| *e) {
             return Err((key(k), "[]".into(), "needs at least one value".into()));
         }
-        if let Some(n) = a.n.as_ref().and_then(|v| {
-            v.values()
-                .into_iter()
-                .find(|&n| n > super::config::MAX_WEIGHTS)
-        }) {
+        if let Some(n) =
+            a.n.as_ref()
+                .and_then(|v| v.values().into_iter().find(|&n| n > MAX_WEIGHTS))
+        {
             return Err((
                 key("n"),
                 n.to_string(),
-                format!(
-                    "at most {} weights per balancer",
-                    super::config::MAX_WEIGHTS
-                ),
+                format!("at most {} weights per balancer", MAX_WEIGHTS),
             ));
         }
     }

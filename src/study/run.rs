@@ -8,12 +8,13 @@
 
 use super::adaptive::{Precision, batch_ids, batches, precision};
 use super::aggregate::summarize_table;
-use super::config::{Design, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
 use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet, write_text};
 use super::lock::{FolderLock, LockError};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
-use super::sample::{Sample, draw_sample};
+use super::sample::{Sample, draw_sample, draw_weights};
 use crate::metrics::{Outcome, RunMetrics};
 use crate::simulation::Simulation;
 use polars::prelude::{ChunkCompareIneq, DataFrame, PolarsError, PolarsResult};
@@ -296,7 +297,7 @@ pub fn sample_simulation(
         let at = plan.file.sampling.couple.as_ref().and_then(|c| c.at);
         super::couple::apply(&mut scene.rotor, at, &planes);
     }
-    sample.weights = super::tolerance::apply(plan, design, sample_id, &mut scene);
+    sample.weights = draw_weights(plan, design, sample_id, &mut scene);
     let simulation = Simulation {
         scene,
         start: plan.file.scene.start,

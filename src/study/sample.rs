@@ -1,61 +1,25 @@
-//! Random streams and the draws of one run.
+//! The draws of one run: unbalance, direction, start angles and, where the
+//! study samples them, the couple part and the weights as built.
 //!
-//! Every run draws from its own stream, seeded by mixing (study seed, design
-//! index, sample index) through SplitMix64 steps: results do not depend on
-//! thread count, scheduling or sharding. With common random numbers (the
-//! default) the design index is left out of the unbalance and direction
-//! draws, so every design meets the same unbalances and differences between
-//! designs are not sampling noise.
+//! Every run draws from its own streams ([`super::stream`]): results do not
+//! depend on thread count, scheduling or sharding. With common random
+//! numbers (the default) the design index is left out of the unbalance and
+//! direction draws, so every design meets the same unbalances and
+//! differences between designs are not sampling noise.
 
-use super::config::{Design, DirectionSpec, Distribution, InitialSpec, Scale, StudyPlan};
+use super::config::StudyPlan;
+use super::design::Design;
+pub use super::distribution::draw_value;
+use super::distribution::{DirectionSpec, InitialSpec, Scale};
+pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
+use crate::model::scene::Scene;
 use crate::model::start::balanced_fan;
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_distr::{Distribution as _, Exp1};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::f64::consts::PI;
-
-/// One SplitMix64 step: a bijective 64-bit mixer (Steele, Lea & Flood 2014).
-pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// Purposes of streams, so that independent draws never share a stream.
-#[derive(Debug, Clone, Copy)]
-#[repr(u64)]
-pub enum Purpose {
-    /// Unbalance magnitude and direction.
-    Unbalance = 1,
-    /// Initial cargo positions.
-    Initial = 2,
-    /// Bootstrap resampling of a design's statistics.
-    Bootstrap = 3,
-    /// Bootstrap resampling of a comparison of two designs.
-    Comparison = 4,
-    /// Each weight's mass ([`super::tolerance`]).
-    MassTolerance = 5,
-    /// Each weight's radius ([`super::tolerance`]).
-    RadiusTolerance = 6,
-    /// The race centre's offset from the axis ([`super::tolerance`]).
-    EccentricityTolerance = 7,
-    /// The couple unbalance of a two-plane rotor ([`super::couple`]).
-    Couple = 8,
-}
-
-/// The stream for (seed, design, sample, purpose); `design = None` for
-/// streams shared by every design (common random numbers).
-pub fn stream(seed: u64, design: Option<u32>, sample: u64, purpose: Purpose) -> Xoshiro256PlusPlus {
-    let d = design.map_or(u64::MAX, u64::from);
-    let mut h = splitmix64(seed);
-    h = splitmix64(h ^ d);
-    h = splitmix64(h ^ sample);
-    h = splitmix64(h ^ purpose as u64);
-    Xoshiro256PlusPlus::seed_from_u64(h)
-}
 
 /// What was drawn for one run.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,38 +39,13 @@ pub struct Sample {
     pub couple: Option<super::couple::SampledCouple>,
 }
 
-/// One value of distribution `d` from `rng`.
-pub fn draw_value(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
-    draw(d, rng)
-}
-
-fn draw(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
-    match *d {
-        Distribution::Fixed { value } => value,
-        Distribution::Uniform { min, max } => min + (max - min) * rng.random::<f64>(),
-        Distribution::LogUniform { min, max } => {
-            (min.ln() + (max.ln() - min.ln()) * rng.random::<f64>()).exp()
-        }
-        Distribution::NormalTruncated {
-            mean,
-            std,
-            min,
-            max,
-        } => super::truncated::draw(rng, mean, std, min, max),
-    }
-}
-
 /// Draw the sample of run (design, sample index).
 pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     let s = &plan.file.sampling;
     let seed = plan.file.seed;
-    let shared = if s.common_random_numbers {
-        None
-    } else {
-        Some(design.id)
-    };
+    let shared = shared(plan, design);
     let mut rng = stream(seed, shared, sample, Purpose::Unbalance);
-    let value = draw(&s.unbalance.distribution, &mut rng);
+    let value = draw_value(&s.unbalance.distribution, &mut rng);
     let (unbalance, fraction) = match s.unbalance.scale() {
         Scale::Capacity => (value * design.capacity, value),
         Scale::Absolute => (value, value / design.capacity),
@@ -134,6 +73,37 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
             super::couple::draw(spec, seed, shared, design, sample, (unbalance, direction))
         }),
     }
+}
+
+/// The design index of a run's streams: none when every design meets the
+/// same draws (common random numbers, the default).
+fn shared(plan: &StudyPlan, design: &Design) -> Option<u32> {
+    if plan.file.sampling.common_random_numbers {
+        None
+    } else {
+        Some(design.id)
+    }
+}
+
+/// Draw the weights of run (design, sample index) into `scene`, when the
+/// study samples tolerances (`[sampling.tolerances]`); `None`, and the scene
+/// left alone, when it does not.
+pub fn draw_weights(
+    plan: &StudyPlan,
+    design: &Design,
+    sample: u64,
+    scene: &mut Scene,
+) -> Option<SampledWeights> {
+    let t = plan.file.sampling.tolerances.as_ref()?;
+    let shared = shared(plan, design);
+    Some(super::tolerance::apply(
+        t,
+        plan.file.seed,
+        shared,
+        design,
+        sample,
+        scene,
+    ))
 }
 
 /// The start angles of one balancer's weights (`design`'s plane), from the

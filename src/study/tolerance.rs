@@ -29,8 +29,8 @@
 //! `race_offset` (m) and `race_angle_deg`. The effect models the plane rotor
 //! at a prescribed speed; other studies are refused when validated.
 
-use super::config::{Design, StudyPlan};
-use super::sample::{Purpose, stream};
+use super::design::Design;
+use super::stream::{Purpose, stream};
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
 use crate::model::effect::SceneFacts;
@@ -263,22 +263,22 @@ fn truncated(rng: &mut Xoshiro256PlusPlus, limit: f64) -> f64 {
     super::truncated::draw(rng, 0.0, 1.0, -limit, limit)
 }
 
-/// Draw this run's weights and put them into `scene` as explicit cargoes
-/// (every plane; the plan's scene holds the nominal design). Returns what
-/// was drawn, or `None` (and leaves the scene alone) when the study has no
-/// tolerances.
+/// Draw the weights of sample `sample` of `design` under the tolerances `t`
+/// and put them into `scene` as explicit cargoes (every plane; the plan's
+/// scene holds the nominal design). Returns what was drawn.
+///
+/// `seed` and `shared` (the design index of the streams, `None` under common
+/// random numbers) are the run's, passed rather than the plan (as for the
+/// couple part) because the study file that holds the tolerances imports
+/// this file; [`super::sample::draw_weights`] reads them from the plan.
 pub fn apply(
-    plan: &StudyPlan,
+    t: &Tolerances,
+    seed: u64,
+    shared: Option<u32>,
     design: &Design,
     sample: u64,
     scene: &mut Scene,
-) -> Option<SampledWeights> {
-    let t = plan.file.sampling.tolerances.as_ref()?;
-    let shared = if plan.file.sampling.common_random_numbers {
-        None
-    } else {
-        Some(design.id)
-    };
+) -> SampledWeights {
     // Plan validation built these for every design and every reachable radius.
     let nominal = scene.cargoes().expect("the plan validated the design");
     // The design of the plane a weight runs in (plane 0's unless planes
@@ -287,7 +287,6 @@ pub fn apply(
         0 => design,
         p => design.plane_designs.get(p - 1).unwrap_or(design),
     };
-    let seed = plan.file.seed;
     let mut mass_rng = stream(seed, shared, sample, Purpose::MassTolerance);
     let mut radius_rng = stream(seed, shared, sample, Purpose::RadiusTolerance);
     let mut cargo: Vec<Cargo> = Vec::with_capacity(nominal.len());
@@ -358,5 +357,5 @@ pub fn apply(
     scene.balancer = None;
     scene.balancers.clear();
     scene.cargo = cargo;
-    Some(weights)
+    weights
 }

@@ -3,11 +3,11 @@
 //! designs met the same sampled unbalances (common random numbers), and the
 //! best design against every other with Holm's correction.
 
-use super::criterion::{Criterion, Scale, sign_difference};
-pub use super::design_runs::{
-    DesignRuns, SettlingClock, design_runs, measure_scale, settling_horizon,
-};
-use super::sample::{Purpose, stream};
+use super::criterion::{Criterion, sign_difference};
+pub use super::design_runs::{SettlingClock, design_runs, measure_scale, settling_horizon};
+pub use super::measured_runs::DesignRuns;
+use super::measured_runs::Scale;
+use super::stream::{Purpose, stream};
 use crate::stats::holm::holm_adjust;
 use crate::stats::paired::{
     Settling, SettlingComparison, WilcoxonResult, compare_settling, median_ratio,

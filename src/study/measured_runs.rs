@@ -1,0 +1,45 @@
+//! A design's runs as the criteria measure them: its settling observations
+//! and residuals ([`DesignRuns`]) and the scale that turns them into numbers
+//! (the horizon τ and the length of a revolution, [`Scale`]).
+//!
+//! Plain data with no reference to a plan: the criteria ([`super::criterion`])
+//! measure it, the study file declares a criterion, and reading the runs
+//! ([`super::design_runs`]) needs the plan's horizon and clock, so the data
+//! sit below all three.
+
+use crate::stats::survival::{KaplanMeier, Observation};
+
+/// The runs of one design, in sample order: its settling observations and
+/// residual vibrations.
+#[derive(Debug, Clone)]
+pub struct DesignRuns {
+    /// The design.
+    pub design_id: u32,
+    /// Sample index of each run (what pairs runs of two designs).
+    pub sample_ids: Vec<u32>,
+    /// Settled at t (revolutions), or censored: at `censoring_revs` for a
+    /// run simulated to its end, at the horizon for one that diverged,
+    /// failed or ran out of budget (it never settled within the run).
+    pub settling: Vec<Observation>,
+    /// Residual vibration / A_ref of runs simulated to their end.
+    pub residual: Vec<Option<f64>>,
+    /// Residual vibration (m) of runs simulated to their end.
+    pub residual_abs: Vec<Option<f64>>,
+}
+
+impl DesignRuns {
+    /// The Kaplan–Meier estimate of its settling.
+    pub fn kaplan_meier(&self) -> Option<KaplanMeier> {
+        KaplanMeier::fit(&self.settling)
+    }
+}
+
+/// What turns the runs into numbers: the restricted-mean horizon τ (rev)
+/// and the length of a revolution (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scale {
+    /// τ: the restricted mean and the capped times run up to it (rev).
+    pub tau: f64,
+    /// One revolution of the nominal speed (s).
+    pub rev_seconds: f64,
+}
