@@ -130,7 +130,10 @@ pub fn write_baseline(
     write_parquet(&dir.join("runs.parquet"), &mut df, &provenance)?;
     let mut summary = summarize(plan, runs)?;
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
-    write_text(&dir.join("study.toml"), &plan.text)?;
+    write_text(
+        &dir.join("study.toml"),
+        &crate::study::io::folder_copy(&plan.text),
+    )?;
     let manifest = Manifest {
         format: FORMAT,
         study_name: plan.name.clone(),

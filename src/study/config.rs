@@ -871,7 +871,20 @@ fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String
                 "" => "designs".to_string(),
                 k => format!("designs.{k}"),
             };
-            (key, format!("{kind} n = {n}"), d.to_string())
+            // "rho = \"opt\": expected …" reads as the key's value and the
+            // reason, with the design it was met in after them.
+            let message = d.to_string();
+            match message.split_once(": ") {
+                Some((lhs, reason)) if lhs.contains(" = ") => {
+                    let value = lhs.split_once(" = ").map_or(lhs, |(_, v)| v).to_string();
+                    (
+                        key,
+                        value,
+                        format!("{reason} (in the design {kind} n = {n})"),
+                    )
+                }
+                _ => (key, format!("{kind} n = {n}"), message),
+            }
         }
     }
 }

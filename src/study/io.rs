@@ -144,6 +144,18 @@ pub fn read_metadata(path: &Path) -> PolarsResult<Vec<(String, String)>> {
         .unwrap_or_default())
 }
 
+/// The study text as a results folder keeps it (`study.toml`): without a
+/// first line `#:schema …`, whose path is relative to the study file's own
+/// folder and resolves nowhere from the results folder (editors and taplo
+/// would flag the copy).
+pub fn folder_copy(study_text: &str) -> String {
+    match study_text.split_once('\n') {
+        Some((first, rest)) if first.trim_start().starts_with("#:schema") => rest.to_string(),
+        None if study_text.trim_start().starts_with("#:schema") => String::new(),
+        _ => study_text.to_string(),
+    }
+}
+
 /// Write a text file atomically.
 pub fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
     let tmp = temp_path(path);

@@ -127,7 +127,15 @@ pub fn merge(
         }
         .into());
     }
-    let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
+    let mut provenance = Provenance::new(&plan.text, plan.file.seed, "all");
+    // The shards' folders keep the study text without its `#:schema` line:
+    // the hash of the study file itself is the one the shards recorded.
+    if let Some(sha) = super::io::read_metadata(&dirs[0].join("runs.parquet"))
+        .ok()
+        .and_then(|m| m.into_iter().find(|(k, _)| k == "study_sha256"))
+    {
+        provenance.study_sha256 = sha.1;
+    }
     let runs_path = dir.join("runs.parquet");
     let runs = write_runs(&pieces, total, &runs_path, &provenance)?;
     drop(pieces);

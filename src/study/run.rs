@@ -445,7 +445,7 @@ fn run_in_folder(
         || summary_path.exists()
         || std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some());
     if options.resume && manifest.exists() {
-        if std::fs::read_to_string(&manifest)? != plan.text {
+        if std::fs::read_to_string(&manifest)? != super::io::folder_copy(&plan.text) {
             return Err(RunError::StudyChanged {
                 path: dir.display().to_string(),
             });
@@ -478,7 +478,7 @@ fn run_in_folder(
         if chunks.exists() {
             std::fs::remove_dir_all(&chunks)?;
         }
-        write_text(&manifest, &plan.text)?;
+        write_text(&manifest, &super::io::folder_copy(&plan.text))?;
         write_text(&plan_file, &id)?;
     }
     std::fs::create_dir_all(&chunks)?;

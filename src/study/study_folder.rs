@@ -77,8 +77,8 @@ pub fn claim(
         return Err(StudyFolderError::OtherVerb { path: shown, what });
     }
     let manifest = dir.join("study.toml");
-    if manifest.is_file() && std::fs::read_to_string(&manifest).is_ok_and(|text| text != plan.text)
-    {
+    let copy = crate::study::io::folder_copy(&plan.text);
+    if manifest.is_file() && std::fs::read_to_string(&manifest).is_ok_and(|text| text != copy) {
         return Err(StudyFolderError::OtherStudy { path: shown });
     }
     let not_writable = |source| StudyFolderError::NotWritable {
@@ -93,7 +93,7 @@ pub fn claim(
     }
     if !manifest.exists() {
         // Says which study the folder's files belong to.
-        crate::study::io::write_text(&manifest, &plan.text).map_err(not_writable)?;
+        crate::study::io::write_text(&manifest, &copy).map_err(not_writable)?;
     }
     Ok(ClaimedFolder { dir, _lock: lock })
 }

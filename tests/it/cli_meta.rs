@@ -56,7 +56,30 @@ fn the_man_page_is_roff_with_the_version_and_the_verbs() {
         &page[..200.min(page.len())]
     );
     assert!(page.contains(autobal::build_info::GIT_COMMIT));
-    for verb in ["run", "merge", "compare", "check", "completions"] {
-        assert!(page.contains(verb), "no {verb}");
+    for verb in [
+        "run",
+        "merge",
+        "compare",
+        "check",
+        "completions",
+        "report",
+        "plot run",
+    ] {
+        assert!(
+            page.contains(&format!(".SS \"study {verb}\"")),
+            "no section for {verb}"
+        );
     }
+    // One page: no reference to pages it cannot produce (study-run(1), …).
+    assert!(
+        !page.contains("\\-run(1)") && !page.contains("-run(1)"),
+        "dangling page reference"
+    );
+    // Plain roff: groff renders it without a UTF-8 preprocessor.
+    assert!(page.is_ascii(), "non-ASCII characters in the roff");
+    assert!(page.contains("\\[u03C1]"), "ρ as a groff escape");
+    // The footer: short fields, the full version line in its own section.
+    let th = page.lines().find(|l| l.starts_with(".TH")).unwrap();
+    assert!(!th.contains("commit") && th.contains("autobal 0."), "{th}");
+    assert!(page.contains(".SH VERSION"));
 }

@@ -121,3 +121,49 @@ fn a_second_writer_is_turned_away_with_the_holders_name() {
     // Released: the run goes ahead.
     assert!(study(&path, &["--resume"]).status.success());
 }
+
+#[test]
+fn the_folders_copy_of_the_study_leaves_out_the_schema_line_and_still_resumes_and_merges() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let path = tmp.path().join("folder.toml");
+    let text = format!(
+        "#:schema ../schema/study.schema.json\n{}",
+        study_text(&results)
+    );
+    std::fs::write(&path, &text).unwrap();
+    assert!(study(&path, &[]).status.success());
+    let folder = results.join("folder");
+    let copy = std::fs::read_to_string(folder.join("study.toml")).unwrap();
+    // The line's path is relative to the study file's folder: from the
+    // results folder it resolves nowhere, and editors flag it.
+    assert!(!copy.contains("#:schema"), "{copy}");
+    assert_eq!(copy, study_text(&results));
+    let resumed = study(&path, &["--resume"]);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    // Shards and their merge record the study file's own hash, as one run does.
+    for k in 1..=2 {
+        let shard = study(&path, &["--shard", &format!("{k}/2")]);
+        assert!(shard.status.success(), "{}", stderr(&shard));
+    }
+    let merged_dir = tmp.path().join("merged");
+    let merged = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["merge", "--out", merged_dir.to_str().unwrap()])
+        .arg(folder.join("shard-1-of-2"))
+        .arg(folder.join("shard-2-of-2"))
+        .output()
+        .unwrap();
+    assert!(merged.status.success(), "{}", stderr(&merged));
+    let sha = |p: &Path| {
+        autobal::study::io::read_metadata(p)
+            .unwrap()
+            .into_iter()
+            .find(|(k, _)| k == "study_sha256")
+            .unwrap()
+            .1
+    };
+    let whole = sha(&folder.join("runs.parquet"));
+    assert_eq!(whole, autobal::study::io::sha256_hex(&text));
+    assert_eq!(sha(&merged_dir.join("runs.parquet")), whole);
+    assert_eq!(sha(&merged_dir.join("summary.parquet")), whole);
+}

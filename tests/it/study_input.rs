@@ -129,9 +129,16 @@ fn negative_or_zero_physical_values_are_named() {
 fn rho_outside_its_range_and_zero_weights_are_named() {
     rejects(
         |t| t.replace("rho = \"optimal\"", "rho = 0.9"),
-        &["ρ = 0.9", "ρ_max(3)"],
+        &[
+            "designs.rho = 0.9",
+            "ρ_max(3)",
+            "(in the design ball n = 3)",
+        ],
     );
-    rejects(|t| t.replace("rho = \"optimal\"", "rho = 0.0"), &["ρ = 0"]);
+    rejects(
+        |t| t.replace("rho = \"optimal\"", "rho = 0.0"),
+        &["designs.rho = 0:"],
+    );
     rejects(
         |t| t.replace("rho = \"optimal\"", "rho = \"optimum\""),
         &["optimum", "\"optimal\""],

@@ -50,7 +50,7 @@ fn describe(r: &LinearReport, delta: f64) -> String {
         "–".into()
     };
     format!(
-        "speed ω            {:.4} rad/s\nstable             {}\nslowest decay σ    {:.4e} 1/s (λ = {:.4e} {:+.4e}i)\nln(1/δ)/σ          {predicted} (δ = {delta})\nneutral directions {}\nbalancing error ε  {:.3e}\neigenvalues        {}\n",
+        "speed ω            {:.4} rad/s\nstable             {}\nslowest decay σ    {:.4e} 1/s (λ = {:.4e} {:+.4e}i)\nln(1/δ)/σ          {predicted} (δ = {delta})\nneutral directions {}\nbalancing error ε  {:.3e}\neigenvalue count   {} (--json lists them)\n",
         r.omega,
         r.stable,
         r.slowest_decay,
