@@ -195,6 +195,15 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
         rows.res_median.push(res_q(0.5));
         rows.res_p95.push(res_q(0.95));
+        let abs_sorted = sorted_values(simulated.column("residual_abs")?.f64()?);
+        rows.res_abs_p95
+            .push(quantile_sorted(&abs_sorted, 0.95, Interpolation::Linear));
+        rows.seconds_per_rev.push(match plan.file.scene.speed {
+            crate::model::speed::SpeedLaw::Constant { omega } => {
+                Some(std::f64::consts::TAU / omega)
+            }
+            _ => None,
+        });
         rows.censored.push(count("censored"));
         rows.not_settled.push(count("not_settled"));
         rows.diverged.push(count("diverged"));
@@ -292,6 +301,10 @@ struct SummaryColumns {
     res_mean: Vec<Option<f64>>,
     res_median: Vec<Option<f64>>,
     res_p95: Vec<Option<f64>>,
+    /// 95th percentile of the residual whirl in metres.
+    res_abs_p95: Vec<Option<f64>>,
+    /// Seconds per revolution at a constant speed (null under a speed law).
+    seconds_per_rev: Vec<Option<f64>>,
     censored: Vec<u64>,
     not_settled: Vec<u64>,
     diverged: Vec<u64>,
@@ -427,6 +440,8 @@ impl SummaryColumns {
             Column::new("residual_rel_mean".into(), self.res_mean),
             Column::new("residual_rel_median".into(), self.res_median),
             Column::new("residual_rel_p95".into(), self.res_p95),
+            Column::new("residual_abs_p95".into(), self.res_abs_p95),
+            Column::new("seconds_per_rev".into(), self.seconds_per_rev),
             Column::new("censored".into(), self.censored),
             Column::new("not_settled".into(), self.not_settled),
             Column::new("diverged".into(), self.diverged),

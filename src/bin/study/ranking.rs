@@ -207,6 +207,15 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         sum.f("residual_rel_p95")?,
         sum.f("rank_value")?,
     );
+    // Older summaries lack the absolute residual and the speed's period.
+    let optional = |name: &str| -> Result<Vec<Option<f64>>, UserError> {
+        match summary.column(name) {
+            Ok(_) => sum.f(name),
+            Err(_) => Ok(vec![None; summary.height()]),
+        }
+    };
+    let res_abs95 = optional("residual_abs_p95")?;
+    let seconds_per_rev = optional("seconds_per_rev")?.into_iter().flatten().next();
     let failed: Vec<u64> = sum
         .u("solver_failed")?
         .iter()
@@ -276,6 +285,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
                 num(rmst[i], 1)
             });
             row.push(p90[i].map_or("beyond".into(), |x| format!("{x:.1}")));
+            row.push(res_abs95[i].map_or("–".into(), |r| format!("{:.2}", r * 1e6)));
             row.push(num(res95[i], 4));
             if !Criterion::REPORTED.contains(&criterion) {
                 row.push(measure_text(criterion, rank_value[i]));
@@ -321,7 +331,11 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     } else {
         "mean".into()
     });
-    header.extend(["p90".into(), "residual\np95".into()]);
+    header.extend([
+        "p90".into(),
+        "residual\np95 µm".into(),
+        "residual\np95/A_ref".into(),
+    ]);
     if !Criterion::REPORTED.contains(&criterion) {
         header.push(criterion.to_string());
     }
@@ -366,7 +380,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .next()
         .unwrap_or_else(|| "from t = 0".into());
     let legend = format!(
-        "(ranked by the {}; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: restricted to τ = {} rev; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window / A_ref; failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
+        "(ranked by the {}; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: restricted to τ = {} rev; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window, in µm and relative to A_ref (the whirl the same unbalance causes without a balancer); failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
         criterion.label(),
         if run_up {
             " (but the column “median from t = 0”)"
@@ -378,6 +392,29 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
             0
         )
     );
+    // At a constant speed, revolutions are a clock: say what they are in seconds.
+    let seconds_note = match (seconds_per_rev, order.first()) {
+        (Some(period), Some(&best)) => {
+            let value = match criterion {
+                Criterion::Median => median[best],
+                _ => rmst[best],
+            };
+            format!(
+                "(at the constant speed one revolution takes {:.2} ms{})\n",
+                1e3 * period,
+                value.map_or(String::new(), |v| format!(
+                    ": #1's {} {v:.1} rev is {:.3} s",
+                    if criterion == Criterion::Median {
+                        "median"
+                    } else {
+                        "restricted mean"
+                    },
+                    v * period
+                ))
+            )
+        }
+        _ => String::new(),
+    };
     let plane_note = planes.as_ref().map_or(String::new(), |p| {
         format!(
             "(kind, n, ρ, β: each balancer plane's, plane 0 to {} joined by “/”, one value where every plane has it; the planes' designs are columns kind_plane0 … of summary.parquet and runs.parquet)\n",
@@ -399,7 +436,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         header,
         rows,
         priority,
-        legend: legend + &plane_note,
+        legend: legend + &seconds_note + &plane_note,
         findings,
         passage: passage_table(summary)?,
     })
@@ -420,7 +457,7 @@ fn column_priority(header: &str, criterion: Criterion, any_failed: bool) -> u8 {
         "failed" if any_failed => 2,
         "failed" => 8,
         h if h.starts_with("Holm p") => 3,
-        h if h.starts_with("residual") => 4,
+        h if h.starts_with("residual") && h.ends_with("µm") => 4,
         "p90" => 6,
         h if h.starts_with('Δ') => 7,
         _ => 5,
@@ -605,7 +642,7 @@ fn short(m: Criterion) -> &'static str {
         Criterion::Median => "median",
         Criterion::Mean => "restricted mean",
         Criterion::P90 => "p90",
-        _ => "residual p95",
+        _ => "residual p95/A_ref",
     }
 }
 
