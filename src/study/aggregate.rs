@@ -120,6 +120,10 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.kind.push(design.spec.kind.name().to_string());
         rows.n.push(design.spec.n);
         rows.rho.push(design.rho);
+        rows.rho_rule.push(match &design.spec.rho {
+            crate::model::scene::RhoChoice::Rule(rule) => Some(rule.clone()),
+            crate::model::scene::RhoChoice::Value(_) => None,
+        });
         rows.drag.push(design.spec.drag);
         rows.capacity.push(design.capacity);
         rows.runs.push(runs_n);
@@ -272,6 +276,8 @@ struct SummaryColumns {
     kind: Vec<String>,
     n: Vec<u32>,
     rho: Vec<f64>,
+    /// The rule that chose ρ ("optimal", "half_race"), null for a given ρ.
+    rho_rule: Vec<Option<String>>,
     drag: Vec<f64>,
     capacity: Vec<f64>,
     runs: Vec<u64>,
@@ -408,6 +414,7 @@ impl SummaryColumns {
             Column::new("kind".into(), self.kind),
             Column::new("n".into(), self.n),
             Column::new("rho".into(), self.rho),
+            Column::new("rho_rule".into(), self.rho_rule),
             Column::new("drag".into(), self.drag),
             Column::new("capacity".into(), self.capacity),
             Column::new("runs".into(), self.runs),

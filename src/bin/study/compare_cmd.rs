@@ -122,6 +122,16 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             p90.map_or("beyond the run".into(), |x| format!("{x:.1}")),
             f(residual, 4),
             f(residual_p95, 4),
+            {
+                let mut abs: Vec<f64> = side.runs.residual_abs.iter().flatten().copied().collect();
+                abs.sort_by(f64::total_cmp);
+                autobal::stats::quantile::quantile_sorted(
+                    &abs,
+                    0.95,
+                    autobal::stats::quantile::Interpolation::Linear,
+                )
+                .map_or("–".into(), |r| format!("{:.2}", r * 1e6))
+            },
             side.dir.display().to_string(),
         ]
     };
@@ -135,6 +145,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         "t_s p90 (rev)",
         "residual/A_ref, median",
         "residual/A_ref, p95",
+        "residual p95 (µm)",
         "folder",
     ];
     let mut rows: Vec<Vec<String>> = names

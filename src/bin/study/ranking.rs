@@ -415,6 +415,38 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         }
         _ => String::new(),
     };
+    // Which ρ came from a rule rather than a number: the value alone does
+    // not say that 0.364 is the Table-1 optimum.
+    let rules: Vec<Option<String>> = match summary.column("rho_rule") {
+        Ok(_) => sum.s("rho_rule")?,
+        Err(_) => vec![None; summary.height()],
+    };
+    let mut rule_notes = Vec::new();
+    for rule in ["optimal", "half_race"] {
+        let mut with: Vec<(u32, Option<f64>)> = (0..summary.height())
+            .filter(|&i| rules[i].as_deref() == Some(rule))
+            .map(|i| (ids[i], rho[i]))
+            .collect();
+        if with.is_empty() {
+            continue;
+        }
+        with.sort_by_key(|w| w.0);
+        let mut values: Vec<String> = with.iter().map(|w| num(w.1, 3)).collect();
+        values.dedup();
+        rule_notes.push(format!(
+            "ρ = \"{rule}\" is {} (ids {})",
+            values.join(", "),
+            with.iter()
+                .map(|w| w.0.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    let rho_note = if rule_notes.is_empty() {
+        String::new()
+    } else {
+        format!("({})\n", rule_notes.join("; "))
+    };
     let plane_note = planes.as_ref().map_or(String::new(), |p| {
         format!(
             "(kind, n, ρ, β: each balancer plane's, plane 0 to {} joined by “/”, one value where every plane has it; the planes' designs are columns kind_plane0 … of summary.parquet and runs.parquet)\n",
@@ -436,7 +468,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         header,
         rows,
         priority,
-        legend: legend + &seconds_note + &plane_note,
+        legend: legend + &seconds_note + &rho_note + &plane_note,
         findings,
         passage: passage_table(summary)?,
     })
