@@ -8,8 +8,8 @@
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 /// Values a flag may be given (no absolute path: whatever a verb accepts is
 /// written inside the test's folder).
@@ -137,32 +137,7 @@ fn snapshot(dir: &Path) -> Vec<(PathBuf, u64)> {
 }
 
 fn run_boxed(cwd: &Path, args: &[String]) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_study"))
-        .args(args)
-        .current_dir(cwd)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let mut err = String::new();
-            use std::io::Read;
-            child
-                .stderr
-                .take()
-                .unwrap()
-                .read_to_string(&mut err)
-                .unwrap();
-            return (status.code(), err);
-        }
-        if start.elapsed() > TIME_BOX {
-            child.kill().unwrap();
-            panic!("study {args:?} did not finish within {TIME_BOX:?}");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    crate::fuzz_input::run_boxed_in(cwd, args, TIME_BOX)
 }
 
 #[test]

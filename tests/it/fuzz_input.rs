@@ -90,8 +90,19 @@ fn small(text: &str, results: &Path) -> String {
 }
 
 fn run_boxed(args: &[&str]) -> (Option<i32>, String) {
+    run_boxed_in(Path::new("."), args, TIME_BOX)
+}
+
+/// `study args…` in the folder `cwd`: (exit code, stderr); a run longer
+/// than `limit` is killed and counts as a hang (the test fails).
+pub(crate) fn run_boxed_in<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(
+    cwd: &Path,
+    args: &[S],
+    limit: Duration,
+) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_study"))
         .args(args)
+        .current_dir(cwd)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -109,11 +120,11 @@ fn run_boxed(args: &[&str]) -> (Option<i32>, String) {
                 .unwrap();
             return (status.code(), err);
         }
-        if start.elapsed() > TIME_BOX {
+        if start.elapsed() > limit {
             child.kill().unwrap();
-            panic!("study {args:?} did not finish within {TIME_BOX:?}");
+            panic!("study {args:?} did not finish within {limit:?}");
         }
-        std::thread::sleep(Duration::from_millis(20));
+        std::thread::sleep(Duration::from_millis(10));
     }
 }
 

@@ -62,16 +62,11 @@ pub fn sweep_points(text: &str) -> Result<usize, String> {
 
 /// `--progress-every`: seconds in (0, [`MAX_PROGRESS_SECONDS`]].
 pub fn progress_seconds(text: &str) -> Result<f64, String> {
-    let v: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a number of seconds"))?;
-    if !(v > 0.0 && v <= MAX_PROGRESS_SECONDS) {
-        return Err(format!(
-            "{text}: seconds between progress lines, above 0 and at most {MAX_PROGRESS_SECONDS:.0} (a year)"
-        ));
-    }
-    Ok(v)
+    number_in(
+        text,
+        "seconds between progress lines; a year at most",
+        MAX_PROGRESS_SECONDS,
+    )
 }
 
 /// Most repeats of a timed bench case.
