@@ -2,7 +2,7 @@
 //! study against its committed baseline.
 
 use crate::UserError;
-use crate::output::text_table;
+use crate::output::{fitted_table, text_width, wrap};
 use autobal::check::baseline::default_dir;
 use autobal::check::compare::{CheckReport, DEFAULT_ALPHA, Metric};
 use autobal::check::study::{CheckError, CheckOptions, check_study, record_baseline};
@@ -94,7 +94,7 @@ pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
         ..RunOptions::default()
     };
     let manifest = record_baseline(&plan, &dir, &run, &NoProgress).map_err(|e| exit_code(e, 1))?;
-    println!(
+    crate::output::say(&format!(
         "baseline of {} written to {}: {} designs × {} runs, seed {}, study sha256 {}",
         manifest.study_name,
         dir.display(),
@@ -102,7 +102,7 @@ pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
         manifest.samples,
         manifest.seed,
         &manifest.study_sha256[..12]
-    );
+    ));
     Ok(())
 }
 
@@ -132,7 +132,7 @@ pub fn check(args: &CheckArgs) -> Result<(), UserError> {
         } else {
             "another seed than the baseline: independent inputs"
         };
-        println!(
+        crate::output::say(&format!(
             "{} hypotheses, Holm-corrected at family-wise α = {}; seed {} ({inputs}){}",
             report.tested,
             report.alpha,
@@ -142,18 +142,18 @@ pub fn check(args: &CheckArgs) -> Result<(), UserError> {
             } else {
                 ""
             }
-        );
-        println!(
+        ));
+        crate::output::say(&format!(
             "baseline: {} (autobal {}, commit {}); compared: {}",
             dir.display(),
             outcome.baseline.autobal_version,
             short(&outcome.baseline.git_commit),
             outcome.runs_file.display()
-        );
+        ));
     }
     if report.passed() {
         if !args.json {
-            println!("verdict: pass");
+            crate::output::say("verdict: pass");
         }
         Ok(())
     } else {
@@ -215,20 +215,38 @@ fn verdict_table(report: &CheckReport) -> String {
             ]
         })
         .collect();
-    text_table(
+    // The metric, its Holm-adjusted p and the verdict stay at any width.
+    let (table, dropped) = fitted_table(
         &[
             "id",
             "design",
             "metric",
             "test",
-            "n base/now",
+            "n\nbase/now",
             "baseline",
             "now",
             "effect",
             "p",
-            "p (Holm)",
+            "p\n(Holm)",
             "verdict",
         ],
         &rows,
-    ) + "(settling_revs: median settling time in revolutions of settled runs; residual_rel: median RMS vibration / A_ref;\n effect: relative change of the median, or of the fraction in percentage points; D: KS statistic)\n"
+        &[0, 2, 0, 4, 5, 3, 3, 2, 6, 0, 0],
+        text_width(),
+    );
+    let dropped_note = if dropped.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "(left out at this width: {}; --wide shows every column)\n",
+            dropped.join(", ")
+        )
+    };
+    table
+        + &wrap(
+            &format!(
+                "{dropped_note}(settling_revs: median settling time in revolutions of settled runs; residual_rel: median RMS vibration / A_ref; effect: relative change of the median, or of the fraction in percentage points; D: KS statistic)\n"
+            ),
+            text_width(),
+        )
 }

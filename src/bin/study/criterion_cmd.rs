@@ -86,7 +86,10 @@ pub fn run(args: &CriterionArgs) -> Result<(), UserError> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", describe(&report));
+        print!(
+            "{}",
+            crate::output::wrap(&describe(&report), crate::output::text_width())
+        );
     }
     Ok(())
 }

@@ -167,7 +167,10 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(UserError(message, code)) => {
-            eprintln!("error: {message}");
+            eprint!(
+                "{}",
+                output::wrap(&format!("error: {message}"), output::text_width())
+            );
             ExitCode::from(code)
         }
     }

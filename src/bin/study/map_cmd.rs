@@ -97,9 +97,9 @@ pub fn run(args: &MapArgs) -> Result<(), UserError> {
         write_parquet(path, &mut df, &Provenance::new(&text, 0, "stability map"))
             .map_err(|e| UserError::internal(format!("--out {e}")))?;
     }
-    println!(
+    crate::output::say(&format!(
         "unbalance {u_hi} (top) to {u_lo} (bottom), speed {w_lo} (left) to {w_hi} (right)\n'#' stable balanced state, '.' unstable, ' ' unbalance beyond the balancer's capacity\n"
-    );
+    ));
     print!("{}", ascii(&points, nw));
     Ok(())
 }

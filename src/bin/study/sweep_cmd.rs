@@ -86,22 +86,34 @@ fn describe(points: &[SweepPoint]) -> String {
         Some(false) => "no",
         None => "–",
     };
-    let mut s = String::from(
-        "   omega  criterion  closed form  linear   sigma       outcome      t_s        eps\n",
+    let rows: Vec<Vec<String>> = points
+        .iter()
+        .map(|p| {
+            vec![
+                format!("{:.4}", p.omega),
+                yn(Some(p.criterion)).to_string(),
+                yn(p.closed_form).to_string(),
+                yn(p.linear_stable).to_string(),
+                p.slowest_decay.map_or("–".into(), |v| format!("{v:.3e}")),
+                p.outcome.name().to_string(),
+                p.settling_time.map_or("–".into(), |v| format!("{v:.2}")),
+                format!("{:.2e}", p.balancing_error),
+            ]
+        })
+        .collect();
+    let mut s = crate::output::text_table(
+        &[
+            "ω\nrad/s",
+            "criterion",
+            "closed\nform",
+            "linear\nstable",
+            "slowest\ndecay σ",
+            "outcome",
+            "t_s\ns",
+            "ε",
+        ],
+        &rows,
     );
-    for p in points {
-        s += &format!(
-            "{:8.4}  {:9}  {:11}  {:6}  {:>10}  {:11}  {:>9}  {:.2e}\n",
-            p.omega,
-            yn(Some(p.criterion)),
-            yn(p.closed_form),
-            yn(p.linear_stable),
-            p.slowest_decay.map_or("–".into(), |v| format!("{v:.3e}")),
-            p.outcome.name(),
-            p.settling_time.map_or("–".into(), |v| format!("{v:.2}")),
-            p.balancing_error
-        );
-    }
     let show = |r: Vec<(f64, f64)>| {
         if r.is_empty() {
             "none".to_string()

@@ -65,30 +65,33 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
         text_table(
             &[
                 "setting",
-                "median |Δt_s| rev",
-                "max |Δt_s| rev",
-                "max |Δresidual|/A_ref",
-                "outcome agrees",
-                "RHS calls",
+                "median\n|Δt_s| rev",
+                "max\n|Δt_s| rev",
+                "max |Δresidual|\n/A_ref",
+                "outcome\nagrees",
+                "RHS\ncalls",
                 "ms/run"
             ],
             &table
         )
     );
     match recommend(&summary, args.budget_revs, args.budget_residual) {
-        Some(best) => println!(
+        Some(best) => crate::output::say(&format!(
             "recommended within {} rev and {} A_ref: {} ({:.3} ms/run, {:.0} RHS calls)",
             args.budget_revs,
             args.budget_residual,
             best.setting.label(),
             1e3 * best.mean_wall_time_s,
             best.mean_rhs_calls
-        ),
-        None => println!(
+        )),
+        None => crate::output::say(&format!(
             "no setting stays within {} rev on every measured run",
             args.budget_revs
-        ),
+        )),
     }
-    eprintln!("reference: full/dop853/1e-11; wrote {}", path.display());
+    crate::output::say_err(&format!(
+        "reference: full/dop853/1e-11; wrote {}",
+        path.display()
+    ));
     Ok(())
 }
