@@ -79,17 +79,29 @@ fn the_ranking_compare_and_help_fit_80_columns_and_wide_keeps_every_column() {
         Some("120"),
     );
     assert!(widest(&at_120.stdout) <= 120);
+    let scenes = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes");
+    let two_support = format!("{scenes}/two_support_single.toml");
+    let three_balls = format!("{scenes}/three_balls.toml");
+    let baseline = concat!(env!("CARGO_MANIFEST_DIR"), "/results/baselines/regression/");
     for args in [
         vec!["compare", "results/corpus", "--designs", "0,1"],
         vec!["--help"],
         vec!["run", "--help"],
         vec!["simulate", "--help"],
+        vec!["simulate", &three_balls],
+        vec!["sweep", &two_support, "--omega", "0.5..8", "--points", "4"],
+        vec!["criterion", &two_support],
+        vec!["linear", &three_balls],
+        vec!["design", "--kind", "ball", "--n", "1..8"],
+        vec!["design", "--kind", "ball", "--n", "1..8", "--rho", "0.3"],
+        vec!["check", "s.toml", "--baseline", baseline],
     ] {
         let out = study(dir, &args, None);
         assert!(
-            widest(&out.stdout) <= 80,
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stdout)
+            widest(&out.stdout) <= 80 && widest(&out.stderr) <= 80,
+            "{args:?}: {}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
         );
     }
 }
