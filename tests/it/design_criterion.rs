@@ -333,6 +333,8 @@ fn study_criterion_prints_the_ranges_of_a_scene() {
             .args([
                 "criterion",
                 &format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR")),
+                // Whole lines, not wrapped to 80 columns, for the assertions.
+                "--wide",
             ])
             .output()
             .unwrap()

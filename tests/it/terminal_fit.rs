@@ -15,9 +15,12 @@ fn study(dir: &Path, args: &[&str], columns: Option<&str>) -> Output {
     cmd.output().unwrap()
 }
 
+/// The widest line, error lines aside: off a terminal an error stays on one
+/// line, for logs and scripts that search it.
 fn widest(text: &[u8]) -> usize {
     String::from_utf8_lossy(text)
         .lines()
+        .filter(|l| !l.starts_with("error: "))
         .map(|l| l.chars().count())
         .max()
         .unwrap_or(0)

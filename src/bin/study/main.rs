@@ -167,10 +167,14 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(UserError(message, code)) => {
-            eprint!(
-                "{}",
-                output::wrap(&format!("error: {message}"), output::text_width())
-            );
+            // Wrapped on a terminal; whole on one line in a log or a pipe,
+            // where scripts and tests search it.
+            let line = format!("error: {message}");
+            if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+                eprint!("{}", output::wrap(&line, output::text_width()));
+            } else {
+                eprintln!("{line}");
+            }
             ExitCode::from(code)
         }
     }
