@@ -370,6 +370,7 @@ fn study_figures_reject_bad_input() {
         name: "empty".into(),
         runs: Vec::new(),
         designs: Vec::new(),
+        operating_speed: None,
     };
     let out = dir.path().join("x.svg");
     assert!(matches!(
@@ -843,6 +844,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
         name: "no_sweep".into(),
         runs: runs.clone(),
         designs: vec![],
+        operating_speed: None,
     };
     let dir = out_dir("passage");
     let path = dir.path.join("passage.svg");
@@ -858,6 +860,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
         name: "sweep".into(),
         runs,
         designs: autobal::plot::study::design_stats(&summary).unwrap(),
+        operating_speed: Some(300.0),
     };
     StudyFigure::Passage.plot(&data, &path).unwrap();
     check_svg(
@@ -867,6 +870,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
             "spin rate at the end of the run-up vs motor stall torque",
             "motor stall torque M_s  (N·m)",
             "held below the operating speed",
+            "operating speed ω_op = 300 rad/s",
         ],
     );
 }

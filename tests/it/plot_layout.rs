@@ -294,6 +294,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                 settled_lo: (p - 0.12).max(0.0),
                 settled_hi: (p + 0.06).min(1.0),
                 planes: Vec::new(),
+                stall_torque: None,
             });
         }
     }
@@ -301,6 +302,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
         name: "a_study_with_a_rather_long_folder_name".into(),
         runs,
         designs,
+        operating_speed: None,
     }
 }
 
