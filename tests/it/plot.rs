@@ -503,10 +503,12 @@ fn compare_plot_writes_kaplan_meier_figure() {
         &svg,
         5_000,
         &[
-            "fraction of runs settled by t",
+            // The title names the study folder, the legend gives β its unit.
+            "s: fraction of runs settled by t",
             "settling time t  (revolutions, log scale)",
             "settled by t, 1 − S(t)",
             "A: ball n=3",
+            " N·s/m",
             "(40 runs, 0 not settled)",
             "(40 runs, 5 not settled)",
             "horizon t_end − W",
