@@ -92,6 +92,21 @@ struct MapFigure<'a> {
     title: &'a str,
 }
 
+/// What the map sampled: the grid's size and the ranges of ω and U.
+fn grid_caption(ws: &[f64], us: &[f64]) -> String {
+    let range = |v: &[f64]| {
+        let (lo, hi) = (v[0], v[v.len() - 1]);
+        format!("{}–{}", style::short(lo), style::short(hi))
+    };
+    format!(
+        "{} speeds ω = {} rad/s × {} unbalances U = {} kg·m",
+        ws.len(),
+        range(ws),
+        us.len(),
+        range(us)
+    )
+}
+
 /// Write the stability map of `points` to `path` (.svg or .png).
 pub fn plot_stability_map(points: &[MapPoint], title: &str, path: &Path) -> Result<(), PlotError> {
     if points.is_empty() {
@@ -117,9 +132,12 @@ impl Figure for MapFigure<'_> {
         ];
         // The legend swatches are the cells' own opaque colours (they were
         // drawn as translucent bands, paler than any cell on the map).
-        let area = style::panel_header(&body, "Linear stability of the balanced state", &legend)?;
         let ws = grid(self.points.iter().map(|p| p.omega));
         let us = grid(self.points.iter().map(|p| p.unbalance));
+        // The title names the map; the caption says what was sampled, which
+        // the title cannot know.
+        let caption = grid_caption(&ws, &us);
+        let area = style::panel_header(&body, &caption, &legend)?;
         let (x_lo, _) = cell_edges(&ws, 0);
         let (_, x_hi) = cell_edges(&ws, ws.len() - 1);
         let (y_lo, _) = cell_edges(&us, 0);

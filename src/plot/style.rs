@@ -112,19 +112,31 @@ const MARKERS: [Marker; 5] = [
 ];
 
 /// The look of the i-th line series: the seven colours first, then again
-/// dashed, dotted and long-dashed, then all of those with each marker, so
-/// a figure's first 168 series are all different.
+/// with each marker, then all of those dashed, dotted and long-dashed, so
+/// a figure's first 42 series differ in colour or marker alone (a dash is
+/// hard to see in a short legend swatch) and its first 168 in some way.
 pub fn series_style(i: usize) -> SeriesStyle {
     let n = PALETTE.len();
     let round = i / n;
-    let marker = match (round / DASHES.len()) % (MARKERS.len() + 1) {
+    let marker = match round % (MARKERS.len() + 1) {
         0 => Marker::None,
         k => MARKERS[k - 1],
     };
     SeriesStyle {
         colour: PALETTE[i % n],
-        dash: DASHES[round % DASHES.len()],
+        dash: DASHES[(round / (MARKERS.len() + 1)) % DASHES.len()],
         marker,
+    }
+}
+
+/// The look of the i-th outline (a box, no marks): the seven colours, then
+/// again dashed, dotted and long-dashed; 28 different looks.
+pub fn outline_style(i: usize) -> SeriesStyle {
+    let n = PALETTE.len();
+    SeriesStyle {
+        colour: PALETTE[i % n],
+        dash: DASHES[(i / n) % DASHES.len()],
+        marker: Marker::None,
     }
 }
 
@@ -891,7 +903,22 @@ mod tests {
             (series_style(3).dash, series_style(3).marker),
             (Dash::Solid, Marker::None)
         );
-        assert_eq!(series_style(8).dash, Dash::Dashed);
+        // The next seven keep the line solid and add a marker: a colour and
+        // marker tell the first 42 apart even in a short legend swatch.
+        assert_eq!(
+            (series_style(8).dash, series_style(8).marker),
+            (Dash::Solid, Marker::Circle)
+        );
+        let marks: Vec<(RGBColor, Marker)> = (0..42)
+            .map(|i| (series_style(i).colour, series_style(i).marker))
+            .collect();
+        for (i, a) in marks.iter().enumerate() {
+            assert!(!marks[i + 1..].contains(a), "{i}: {a:?} repeats");
+        }
+        let outlines: Vec<SeriesStyle> = (0..28).map(outline_style).collect();
+        for (i, a) in outlines.iter().enumerate() {
+            assert!(!outlines[i + 1..].contains(a), "{i}: {a:?} repeats");
+        }
     }
 
     #[test]

@@ -137,6 +137,9 @@ fn aggregate(rows: Vec<TradeoffPoint>) -> Vec<TradeoffPoint> {
         .collect()
 }
 
+/// What the figure does not show, and why (written under its legend).
+const LEFT_OUT: &str = "not shown: the analytic and linear rungs (no RHS calls: no place on a log cost axis) and runs whose outcome differs from the reference's";
+
 /// The work–precision figure: error vs RHS calls and error vs wall time.
 struct WorkPrecision<'a> {
     points: &'a [TradeoffPoint],
@@ -203,6 +206,9 @@ impl Figure for WorkPrecision<'_> {
             entries.push(("error 0 (drawn on the floor)".into(), Swatch::Ring(BLACK)));
         }
         let body = style::legend(&body, &entries)?;
+        // read_tradeoff drops them before the figure sees them: say so, so
+        // that a reader does not take their absence for a missing result.
+        let body = style::text_block(&body, LEFT_OUT, TICK)?;
         let panels = body.split_evenly((1, 2));
         self.panel(
             &panels[0],
@@ -256,7 +262,7 @@ impl WorkPrecision<'_> {
         chart
             .configure_mesh()
             .x_desc(x_desc)
-            .y_desc("settling-time error  (rev, log scale)")
+            .y_desc("max |Δt_s| over the measured runs  (rev, log scale)")
             .axis_desc_style(text(style::AXIS))
             .label_style(text(TICK))
             .x_label_formatter(&style::log_formatter(x_lo, x_hi))

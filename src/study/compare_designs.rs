@@ -44,8 +44,10 @@ pub enum CompareError {
 pub struct Side {
     /// The results folder.
     pub dir: PathBuf,
-    /// A short description: kind, n, ρ, β.
+    /// A short description: kind, n, ρ, β (and M_s).
     pub label: String,
+    /// The same with units, for a figure's legend.
+    pub figure_label: String,
     /// Its runs, in sample order.
     pub runs: DesignRuns,
     /// Latest settling time its runs can show (revolutions).
@@ -110,6 +112,7 @@ impl Side {
         Ok(Side {
             dir: dir.to_path_buf(),
             label: super::plane_designs::short_label(d),
+            figure_label: super::plane_designs::figure_label(d),
             plane_stats,
             runs,
             horizon,

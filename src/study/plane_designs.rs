@@ -242,8 +242,20 @@ pub fn describe(d: &Design) -> String {
 }
 
 /// A design in one short line, "ball n=8 ρ=0.040 β=0.05", each value
-/// joined by "/" over the planes where they differ ("n=2/3").
+/// joined by "/" over the planes where they differ ("n=2/3"), and
+/// "M_s=2" at the end when the design has a stall torque.
 pub fn short_label(d: &Design) -> String {
+    label(d, false)
+}
+
+/// [`short_label`] with units, "ball n=8 ρ=0.040 β=0.05 N·s/m", for a
+/// figure's legend, where no table header gives them.
+pub fn figure_label(d: &Design) -> String {
+    label(d, true)
+}
+
+/// The short label, with or without units.
+fn label(d: &Design, units: bool) -> String {
     let planes: Vec<&Design> = std::iter::once(d).chain(&d.plane_designs).collect();
     let joined = |f: &dyn Fn(&Design) -> String| {
         let values: Vec<String> = planes.iter().map(|p| f(p)).collect();
@@ -253,11 +265,17 @@ pub fn short_label(d: &Design) -> String {
             values.join("/")
         }
     };
+    let unit = |u: &'static str| if units { u } else { "" };
+    let stall = d
+        .stall_torque
+        .map(|m| format!(" M_s={m}{}", unit(" N·m")))
+        .unwrap_or_default();
     format!(
-        "{} n={} ρ={} β={}",
+        "{} n={} ρ={} β={}{}{stall}",
         joined(&|p| p.spec.kind.name().to_string()),
         joined(&|p| p.spec.n.to_string()),
         joined(&|p| format!("{:.3}", p.rho)),
-        joined(&|p| p.spec.drag.to_string())
+        joined(&|p| p.spec.drag.to_string()),
+        unit(" N·s/m")
     )
 }

@@ -370,6 +370,7 @@ fn study_figures_reject_bad_input() {
         name: "empty".into(),
         runs: Vec::new(),
         designs: Vec::new(),
+        operating_speed: None,
     };
     let out = dir.path().join("x.svg");
     assert!(matches!(
@@ -502,10 +503,12 @@ fn compare_plot_writes_kaplan_meier_figure() {
         &svg,
         5_000,
         &[
-            "fraction of runs settled by t",
+            // The title names the study folder, the legend gives β its unit.
+            "s: fraction of runs settled by t",
             "settling time t  (revolutions, log scale)",
             "settled by t, 1 − S(t)",
             "A: ball n=3",
+            " N·s/m",
             "(40 runs, 0 not settled)",
             "(40 runs, 5 not settled)",
             "horizon t_end − W",
@@ -611,7 +614,8 @@ fn tradeoff_table_round_trips_and_plots() {
             "Work–precision test",
             "RHS calls  (count, log scale)",
             "wall time  (s, log scale)",
-            "settling-time error  (rev, log scale)",
+            "max |Δt_s| over the measured runs  (rev, log scale)",
+            "not shown: the analytic and linear rungs",
             "dop853",
             "radau5",
         ],
@@ -843,6 +847,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
         name: "no_sweep".into(),
         runs: runs.clone(),
         designs: vec![],
+        operating_speed: None,
     };
     let dir = out_dir("passage");
     let path = dir.path.join("passage.svg");
@@ -858,6 +863,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
         name: "sweep".into(),
         runs,
         designs: autobal::plot::study::design_stats(&summary).unwrap(),
+        operating_speed: Some(300.0),
     };
     StudyFigure::Passage.plot(&data, &path).unwrap();
     check_svg(
@@ -867,6 +873,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
             "spin rate at the end of the run-up vs motor stall torque",
             "motor stall torque M_s  (N·m)",
             "held below the operating speed",
+            "operating speed ω_op = 300 rad/s",
         ],
     );
 }

@@ -294,6 +294,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                 settled_lo: (p - 0.12).max(0.0),
                 settled_hi: (p + 0.06).min(1.0),
                 planes: Vec::new(),
+                stall_torque: None,
             });
         }
     }
@@ -301,6 +302,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
         name: "a_study_with_a_rather_long_folder_name".into(),
         runs,
         designs,
+        operating_speed: None,
     }
 }
 
@@ -453,4 +455,69 @@ fn the_box_approximation_is_honest() {
     let (_, boxes) = text_boxes(svg);
     let up = boxes.iter().find(|b| b.text == "up").unwrap();
     assert!((up.x1 - up.x0 - 10.0).abs() < 1e-9 && (up.y1 - up.y0 - 12.0).abs() < 1e-9);
+}
+
+#[test]
+fn study_figures_name_every_varying_parameter_and_colour_each_drive() {
+    // Three geometries (n and ρ vary) × two drags, each design with its own
+    // stall torque: every one of them must be named, and no two (β, M_s)
+    // may share a colour.
+    let mut data = crowded_study(3, 2, 14);
+    let torque = |id: u32| 0.5 * f64::from(id + 1);
+    for d in &mut data.designs {
+        d.stall_torque = Some(torque(d.design_id));
+    }
+    for r in &mut data.runs {
+        r.stall_torque = Some(torque(r.design_id));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for figure in [StudyFigure::SettlingTime, StudyFigure::SettledFraction] {
+        let path = dir.path().join(format!("{}.svg", figure.file_stem()));
+        figure.plot(&data, &path).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        for d in &data.designs {
+            let ms = format!("M_s = {} N·m", torque(d.design_id));
+            assert!(svg.contains(&ms), "{}: no {ms}", figure.file_stem());
+        }
+        for part in ["2 balls", "3 balls", "ρ = 0.18", "ρ = 0.287", "β = 2 N·s/m"] {
+            assert!(svg.contains(part), "{}: no {part}", figure.file_stem());
+        }
+    }
+    let path = dir.path().join("scatter.svg");
+    StudyFigure::SettlingVsUnbalance.plot(&data, &path).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let styles = legend_styles();
+    for d in &data.designs {
+        let ms = format!("M_s = {} N·m", torque(d.design_id));
+        assert!(svg.contains(&ms), "settling vs unbalance: no {ms}");
+    }
+    let drives: Vec<&(String, SeriesStyle)> =
+        styles.iter().filter(|(l, _)| l.contains("M_s")).collect();
+    assert_eq!(drives.len(), data.designs.len(), "{styles:?}");
+    for (i, a) in drives.iter().enumerate() {
+        assert!(
+            drives[i + 1..].iter().all(|b| b.1.colour != a.1.colour),
+            "{a:?} shares its colour"
+        );
+    }
+}
+
+#[test]
+fn design_curves_for_twelve_counts_look_different() {
+    let dir = tempfile::tempdir().unwrap();
+    let ns: Vec<u32> = (1..=12).collect();
+    plot_design(&[Shape::Ball], &ns, &dir.path().join("design.svg")).unwrap();
+    let looks: Vec<(String, SeriesStyle)> = legend_styles()
+        .into_iter()
+        .filter(|(l, _)| l.starts_with("n = "))
+        .collect();
+    assert_eq!(looks.len(), 12, "{looks:?}");
+    for (i, (label, a)) in looks.iter().enumerate() {
+        assert!(
+            looks[i + 1..]
+                .iter()
+                .all(|(_, b)| (b.colour, b.marker) != (a.colour, a.marker)),
+            "{label} shares its colour and marker"
+        );
+    }
 }

@@ -340,15 +340,35 @@ fn plane_rows(a: &Side, b: &Side) -> Vec<Vec<String>> {
     rows
 }
 
+/// The figure's title, naming the study folder (or both, when the sides
+/// come from two studies).
+fn compare_title(a: &Side, b: &Side) -> String {
+    let folder = |s: &Side| {
+        s.dir
+            .canonicalize()
+            .unwrap_or_else(|_| s.dir.clone())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| s.dir.display().to_string())
+    };
+    let (fa, fb) = (folder(a), folder(b));
+    let studies = if fa == fb {
+        fa
+    } else {
+        format!("{fa} vs {fb}")
+    };
+    format!("{studies}: fraction of runs settled by t")
+}
+
 fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
     let curve = |name: &str, side: &Side| KmCurve {
-        label: format!("{name}: {}", side.label),
+        label: format!("{name}: {}", side.figure_label),
         observations: side.runs.settling.clone(),
         horizon: side.horizon,
     };
     let curves = [curve("A", a), curve("B", b)];
-    let title = "study compare: fraction of runs settled by t";
-    plot_kaplan_meier(&curves, title, path).map_err(|e| {
+    let title = compare_title(a, b);
+    plot_kaplan_meier(&curves, &title, path).map_err(|e| {
         let UserError(message, code) = plot_error(e);
         UserError(format!("--plot {}: {message}", path.display()), code)
     })

@@ -38,7 +38,12 @@ pub(super) fn labels(designs: &[DesignStats]) -> Labels {
             per_plane(d, |p| short(p.drag)).unwrap_or_else(|| short(d.drag))
         )
     };
-    let parts: [&dyn Fn(&DesignStats) -> String; 3] = [&weights, &rho, &drag];
+    // Empty without a motor, so that designs without one are not labelled.
+    let stall = |d: &DesignStats| match d.stall_torque {
+        Some(m) => format!("M_s = {} N·m", short(m)),
+        None => String::new(),
+    };
+    let parts: [&dyn Fn(&DesignStats) -> String; 4] = [&weights, &rho, &drag, &stall];
     let (vary, fixed): (Vec<_>, Vec<_>) = parts.iter().partition(|f| varies(**f));
     let per_design = designs
         .iter()
@@ -48,6 +53,7 @@ pub(super) fn labels(designs: &[DesignStats]) -> Labels {
             } else {
                 vary.iter()
                     .map(|f: &&dyn Fn(&DesignStats) -> String| f(d))
+                    .filter(|s| !s.is_empty())
                     .collect::<Vec<_>>()
                     .join(", ")
             }
@@ -56,6 +62,7 @@ pub(super) fn labels(designs: &[DesignStats]) -> Labels {
     let common = fixed
         .iter()
         .map(|f| f(&designs[0]))
+        .filter(|s| !s.is_empty())
         .collect::<Vec<_>>()
         .join(", ");
     Labels { per_design, common }
@@ -116,6 +123,53 @@ pub(super) fn geometries(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
     (index, names)
 }
 
+/// Index of each design's drive and damping (β, M_s), the parameters a
+/// geometry's panel does not name, with a label for each naming those of
+/// them that vary (β alone when neither does): designs in one panel that
+/// differ in either get different colours.
+pub(super) fn drives(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
+    let drag = |d: &DesignStats| format!("β = {} N·s/m", short(d.drag));
+    let stall = |d: &DesignStats| {
+        d.stall_torque
+            .map(|m| format!("M_s = {} N·m", short(m)))
+            .unwrap_or_default()
+    };
+    let mut keys: Vec<(f64, Option<f64>, usize)> = Vec::new();
+    for (i, d) in designs.iter().enumerate() {
+        if !keys.iter().any(|k| k.0 == d.drag && k.1 == d.stall_torque) {
+            keys.push((d.drag, d.stall_torque, i));
+        }
+    }
+    // In order of β then M_s, so the legend reads as a sweep.
+    keys.sort_by(|a, b| {
+        a.0.total_cmp(&b.0)
+            .then(a.1.unwrap_or(f64::NAN).total_cmp(&b.1.unwrap_or(f64::NAN)))
+    });
+    let index = designs
+        .iter()
+        .map(|d| {
+            keys.iter()
+                .position(|k| k.0 == d.drag && k.1 == d.stall_torque)
+                .unwrap_or(0)
+        })
+        .collect();
+    let first = &designs[keys[0].2];
+    let drag_varies = keys.iter().any(|k| k.0 != first.drag);
+    let stall_varies = keys.iter().any(|k| k.1 != first.stall_torque);
+    let names = keys
+        .iter()
+        .map(|k| {
+            let d = &designs[k.2];
+            match (drag_varies, stall_varies) {
+                (true, true) => format!("{}, {}", drag(d), stall(d)),
+                (false, true) => stall(d),
+                _ => drag(d),
+            }
+        })
+        .collect();
+    (index, names)
+}
+
 /// Width in pixels to reserve for category labels of this many characters.
 pub(super) fn label_width(labels: &[String]) -> u32 {
     let longest = labels.iter().map(|l| l.chars().count()).max().unwrap_or(4) as u32;
@@ -161,10 +215,43 @@ mod tests {
             settled_lo: 0.7,
             settled_hi: 1.0,
             planes: Vec::new(),
+            stall_torque: None,
         };
         let l = labels(&[d(0, 0.25, 2.0), d(1, 0.25, 5.0)]);
         assert_eq!(l.per_design, vec!["β = 2 N·s/m", "β = 5 N·s/m"]);
         assert_eq!(l.common, "3 balls, ρ = 0.25");
+    }
+
+    #[test]
+    fn stall_torque_is_named_where_it_varies() {
+        let d = |id, drag, m| DesignStats {
+            design_id: id,
+            kind: "ball".into(),
+            n: 3,
+            rho: 0.25,
+            drag,
+            runs: 10,
+            settled_fraction: 1.0,
+            settled_lo: 0.7,
+            settled_hi: 1.0,
+            planes: Vec::new(),
+            stall_torque: Some(m),
+        };
+        let designs = [d(0, 2.0, 0.5), d(1, 2.0, 1.0), d(2, 5.0, 0.5)];
+        let l = labels(&designs);
+        assert_eq!(
+            l.per_design,
+            vec![
+                "β = 2 N·s/m, M_s = 0.5 N·m",
+                "β = 2 N·s/m, M_s = 1 N·m",
+                "β = 5 N·s/m, M_s = 0.5 N·m"
+            ]
+        );
+        let (index, names) = drives(&designs);
+        assert_eq!(index, vec![0, 1, 2]);
+        assert_eq!(names[1], "β = 2 N·s/m, M_s = 1 N·m");
+        let (index, names) = drives(&designs[..2]);
+        assert_eq!((index, names[0].as_str()), (vec![0, 1], "M_s = 0.5 N·m"));
     }
 
     #[test]
@@ -186,6 +273,7 @@ mod tests {
             settled_lo: 0.7,
             settled_hi: 1.0,
             planes: vec![plane(2), plane(n1)],
+            stall_torque: None,
         };
         let designs = [d(0, 3), d(1, 4)];
         let l = labels(&designs);

@@ -46,6 +46,9 @@ pub struct DesignStats {
     /// Every balancer plane's (kind, n, ρ, β) when the planes have designs
     /// of their own (`kind_plane0`, … columns of the summary); empty otherwise.
     pub planes: Vec<PlaneDesignStats>,
+    /// The motor's stall torque M_s (N·m) when the design drives the rotor
+    /// through a motor (`designs.stall_torque`); `None` otherwise.
+    pub stall_torque: Option<f64>,
 }
 
 /// One balancer plane's design as the summary names it.
@@ -104,6 +107,11 @@ pub fn design_stats(summary: &DataFrame) -> Result<Vec<DesignStats>, PlotError> 
     );
     let (ids, ns, runs) = (ids.u32()?, ns.u32()?, runs.u64()?);
     let mut planes = plane_designs(summary)?.into_iter();
+    // Older summaries have no stall_torque column: no design had a motor.
+    let stall: Vec<Option<f64>> = match summary.column("stall_torque") {
+        Ok(c) => c.cast(&DataType::Float64)?.f64()?.iter().collect(),
+        Err(_) => vec![None; summary.height()],
+    };
     (0..summary.height())
         .map(|i| {
             Ok(DesignStats {
@@ -119,9 +127,22 @@ pub fn design_stats(summary: &DataFrame) -> Result<Vec<DesignStats>, PlotError> 
                 settled_lo: lo[i],
                 settled_hi: hi[i],
                 planes: planes.next().unwrap_or_default(),
+                stall_torque: stall[i],
             })
         })
         .collect()
+}
+
+/// The operating speed of the study in `dir`, from its `study.toml`; a
+/// figure only marks it, so a folder without a readable plan goes without.
+fn operating_speed(dir: &Path) -> Option<f64> {
+    use crate::study::config::StudyFile;
+    let shown = dir.display().to_string();
+    let text = std::fs::read_to_string(dir.join("study.toml")).ok()?;
+    let plan = StudyFile::parse(&text, &shown)
+        .and_then(|f| f.plan(&text, &shown))
+        .ok()?;
+    Some(plan.file.scene.speed.nominal_speed()).filter(|w| w.is_finite() && *w > 0.0)
 }
 
 /// A study's runs and per-design statistics.
@@ -133,6 +154,9 @@ pub struct StudyData {
     pub runs: Vec<RunRecord>,
     /// One entry per design, from `summary.parquet`.
     pub designs: Vec<DesignStats>,
+    /// The speed law's operating speed (rad/s) from the folder's
+    /// `study.toml`; `None` when it cannot be read.
+    pub operating_speed: Option<f64>,
 }
 
 impl StudyData {
@@ -161,6 +185,7 @@ impl StudyData {
             name,
             runs,
             designs,
+            operating_speed: operating_speed(dir),
         })
     }
 

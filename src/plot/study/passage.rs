@@ -1,13 +1,24 @@
 //! Passage through resonance (the Sommerfeld effect): each run's spin rate
 //! at its end against the motor's stall torque, one colour per kind; runs
-//! held below the operating speed sit low, those that passed near ω_sync.
+//! held below the operating speed sit low, those that passed near ω_sync,
+//! which a dashed line marks.
 
 use super::StudyData;
 use crate::plot::PlotError;
-use crate::plot::style::{self, Figure, Swatch, TICK, linear_label, point_style, text};
+use crate::plot::style::{
+    self, Dash, Figure, Marker, SeriesStyle, Swatch, TICK, draw_line, linear_label, point_style,
+    text,
+};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
+
+/// The operating-speed line: grey and dashed, apart from every kind's colour.
+const OPERATING: SeriesStyle = SeriesStyle {
+    colour: style::REFERENCE,
+    dash: Dash::Dashed,
+    marker: Marker::None,
+};
 
 /// Final spin rate against stall torque, colour by kind.
 struct Passage<'a> {
@@ -62,7 +73,13 @@ impl Figure for Passage<'_> {
         let (x_lo, x_hi) = style::extent(points.iter().map(|p| p.1))
             .map(|(a, b)| style::padded(a, b, 0.06))
             .unwrap_or((0.0, 1.0));
-        let y_hi = points.iter().map(|p| p.2).fold(0.0, f64::max) * 1.05;
+        let omega_op = self.data.operating_speed;
+        let y_hi = points
+            .iter()
+            .map(|p| p.2)
+            .chain(omega_op)
+            .fold(0.0, f64::max)
+            * 1.05;
         // Kinds side by side at each torque, so their points do not cover each other.
         let offset =
             |k: usize| (k as f64 - 0.5 * (kinds.len() as f64 - 1.0)) * 0.012 * (x_hi - x_lo);
@@ -80,6 +97,12 @@ impl Figure for Passage<'_> {
             "held below the operating speed (cross)".into(),
             Swatch::Cross(style::REFERENCE),
         ));
+        if let Some(w) = omega_op {
+            entries.push((
+                format!("operating speed ω_op = {} rad/s", style::short(w)),
+                Swatch::Series(OPERATING),
+            ));
+        }
         let body = style::legend(&body, &entries)?;
         let mut chart = ChartBuilder::on(&body)
             .margin(12)
@@ -97,12 +120,16 @@ impl Figure for Passage<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
+        // The line the runs that passed resonance end on, and those held do not.
+        if let Some(w) = omega_op {
+            draw_line(&mut chart, &[(x_lo, w), (x_hi, w)], OPERATING, 2)?;
+        }
         for (k, kind) in kinds.iter().enumerate() {
             let look = point_style(k);
             let mine = points.iter().filter(|p| p.0 == *kind);
             chart.draw_series(mine.clone().filter(|p| p.3).map(|p| {
                 EmptyElement::at((p.1 + offset(k), p.2))
-                    + style::marker(look.marker, 4, look.colour.mix(0.6).filled())
+                    + style::marker(look.marker, 4, look.colour.filled())
             }))?;
             chart.draw_series(
                 mine.filter(|p| !p.3)

@@ -7,9 +7,7 @@ use super::labels::{
     Labels, category_height, category_label, category_y, geometries, label_width, labels,
 };
 use crate::plot::PlotError;
-use crate::plot::style::{
-    self, Figure, TICK, draw_line, log_ticks, point_style, series_style, text,
-};
+use crate::plot::style::{self, Figure, TICK, draw_line, log_ticks, point_style, text};
 use crate::stats::survival::{KaplanMeier, Observation};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -174,11 +172,8 @@ impl Figure for SettlingBoxes<'_> {
             };
             let h = 0.32;
             // Past seven geometries the colours come round again; the outlines
-            // then turn dashed (series_style), the outlier marks change shape.
-            let outline_look = style::SeriesStyle {
-                marker: style::Marker::None,
-                ..series_style(group[i])
-            };
+            // then turn dashed (outline_style), the outlier marks change shape.
+            let outline_look = style::outline_style(group[i]);
             style::note_series(names[group[i]].clone(), outline_look);
             // Past the last settling the box runs off the right edge, open.
             let right = b.q3.unwrap_or(hi);

@@ -1,18 +1,17 @@
 //! Settling time against unbalance / capacity, one panel per geometry,
-//! colour by drag; runs that never settled form a row of crosses above.
+//! colour by drive and damping (β, and M_s where it varies); runs that never settled form a row of crosses above.
 
 use super::StudyData;
-use super::labels::geometries;
+use super::labels::{drives, geometries};
 use crate::plot::PlotError;
-use crate::plot::style::{
-    self, Figure, Swatch, TICK, linear_label, log_ticks, point_style, short, text,
-};
+use crate::plot::style::{self, Figure, Swatch, TICK, linear_label, log_ticks, point_style, text};
 use crate::study::record::RunRecord;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Settling time against unbalance / capacity, one panel per geometry, colour by drag.
+/// Settling time against unbalance / capacity, one panel per geometry,
+/// colour by (β, M_s).
 struct SettlingScatter<'a> {
     data: &'a StudyData,
 }
@@ -48,9 +47,13 @@ impl Figure for SettlingScatter<'_> {
         let designs = &self.data.designs;
         let runs = &self.data.runs;
         let (group, names) = geometries(designs);
-        let mut drags: Vec<f64> = designs.iter().map(|d| d.drag).collect();
-        drags.sort_by(f64::total_cmp);
-        drags.dedup();
+        let (drive, drive_names) = drives(designs);
+        let drive_of = |r: &RunRecord| {
+            designs
+                .iter()
+                .position(|d| d.design_id == r.design_id)
+                .map(|i| drive[i])
+        };
         let geometry_of = |r: &RunRecord| {
             designs
                 .iter()
@@ -83,17 +86,12 @@ impl Figure for SettlingScatter<'_> {
             self.data.name
         );
         let body = style::titled(root, &title)?;
-        // Grey, outside the palette: no drag's colour is mistaken for it.
+        // Grey, outside the palette: no drive's colour is mistaken for it.
         let red = style::REFERENCE;
-        let mut entries: Vec<(String, Swatch)> = drags
+        let mut entries: Vec<(String, Swatch)> = drive_names
             .iter()
             .enumerate()
-            .map(|(k, d)| {
-                (
-                    format!("β = {} N·s/m", short(*d)),
-                    Swatch::Point(point_style(k)),
-                )
-            })
+            .map(|(k, name)| (name.clone(), Swatch::Point(point_style(k))))
             .collect();
         if any_unsettled {
             entries.push((
@@ -136,15 +134,16 @@ impl Figure for SettlingScatter<'_> {
                 .light_line_style(WHITE.mix(0.0))
                 .bold_line_style(BLACK.mix(0.08))
                 .draw()?;
-            for (k, drag) in drags.iter().enumerate() {
+            for k in 0..drive_names.len() {
                 let look = point_style(k);
+                // Opaque, as in the legend: a translucent mark reads as another colour.
                 chart.draw_series(
                     mine.iter()
-                        .filter(|r| r.drag == *drag && r.metrics.settled)
+                        .filter(|r| drive_of(r) == Some(k) && r.metrics.settled)
                         .filter_map(|r| Some((r.unbalance_fraction, r.metrics.settling_revs?)))
                         .map(|p| {
                             EmptyElement::at(p)
-                                + style::marker(look.marker, 3, look.colour.mix(0.6).filled())
+                                + style::marker(look.marker, 3, look.colour.filled())
                         }),
                 )?;
             }
