@@ -2,7 +2,7 @@
 //! study against its committed baseline.
 
 use crate::UserError;
-use crate::output::{fitted_table, text_width, wrap};
+use crate::output::{dropped_note, fitted_table, text_width, wrap};
 use autobal::check::baseline::default_dir;
 use autobal::check::compare::{CheckReport, DEFAULT_ALPHA, Metric};
 use autobal::check::study::{CheckError, CheckOptions, check_study, record_baseline};
@@ -234,14 +234,7 @@ fn verdict_table(report: &CheckReport) -> String {
         &[0, 2, 0, 4, 5, 3, 3, 2, 6, 0, 0],
         text_width(),
     );
-    let dropped_note = if dropped.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "(left out at this width: {}; --wide shows every column)\n",
-            dropped.join(", ")
-        )
-    };
+    let dropped_note = dropped_note(&dropped);
     table
         + &wrap(
             &format!(

@@ -1,7 +1,7 @@
 //! `study optimize`: choose counts, radii and drag for an objective.
 
 use crate::UserError;
-use crate::output::{fitted_table, say, say_err, text_width};
+use crate::output::{dropped_note, fitted_table, say_err, text_width, wrap};
 use autobal::optimize::optimize;
 use autobal::optimize::spec::Objective;
 use autobal::output_file::WhenExists;
@@ -114,12 +114,7 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
     ];
     let (table, dropped) = fitted_table(&header, &rows, &[0, 1, 1, 1, 3, 0, 2, 4, 2], text_width());
     print!("{table}");
-    if !dropped.is_empty() {
-        say(&format!(
-            "(left out at this width: {}; --wide shows every column)",
-            dropped.join(", ")
-        ));
-    }
+    print!("{}", wrap(&dropped_note(&dropped), text_width()));
     for (label, _, why) in &out.terminations {
         say_err(&format!("{label}: {why}"));
     }

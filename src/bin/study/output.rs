@@ -53,6 +53,18 @@ pub fn say_err(text: &str) {
     eprint!("{}", wrap(text, text_width()));
 }
 
+/// The line that says which columns [`fitted_table`] left out (empty when none).
+pub fn dropped_note(dropped: &[String]) -> String {
+    if dropped.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "(left out at this width: {}; --wide shows every column)\n",
+            dropped.join(", ")
+        )
+    }
+}
+
 /// A [`text_table`] that fits `width`: while it is too wide, the column of
 /// the highest `priority` goes (ties: the rightmost). Returns the table and
 /// the headers left out.

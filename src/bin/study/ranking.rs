@@ -4,7 +4,7 @@
 //! design is recommended).
 
 use crate::UserError;
-use crate::output::{fitted_table, p_value_text, text_table, text_width, wrap};
+use crate::output::{dropped_note, fitted_table, p_value_text, text_table, text_width, wrap};
 use autobal::study::criterion::Criterion;
 use polars::prelude::DataFrame;
 
@@ -150,14 +150,7 @@ pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
     let header: Vec<&str> = parts.header.iter().map(String::as_str).collect();
     let width = text_width();
     let (table, dropped) = fitted_table(&header, &parts.rows, &parts.priority, width);
-    let dropped_note = if dropped.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "(left out at this width: {}; --wide shows every column)\n",
-            dropped.join(", ")
-        )
-    };
+    let dropped_note = dropped_note(&dropped);
     Ok(table + &wrap(&(parts.legend + &dropped_note + &parts.findings), width) + &parts.passage)
 }
 
