@@ -1,8 +1,11 @@
 //! The trade-off study's work–precision diagram: settling-time error against
-//! cost (RHS calls and wall time), one line per fidelity through its tolerances.
+//! cost (RHS calls and wall time), one line per fidelity through its
+//! tolerances, each point the median error over the runs with a whisker up
+//! to the largest.
 
 use super::PlotError;
 use super::style::{self, Figure, Swatch, TICK, draw_line, log_ticks, series_style, text};
+use crate::stats::quantile::{Interpolation, quantile_sorted};
 use crate::study::io::read_parquet;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -17,8 +20,11 @@ pub struct TradeoffPoint {
     pub fidelity: String,
     /// Relative tolerance of the solve.
     pub rtol: f64,
-    /// Settling-time error against the reference (revolutions).
-    pub error_revs: f64,
+    /// Upper median of the settling-time errors against the reference over
+    /// the runs (revolutions), as in the trade-off table.
+    pub median_error_revs: f64,
+    /// Largest settling-time error over the runs (revolutions): the figure a budget is checked against.
+    pub max_error_revs: f64,
     /// Right-hand-side evaluations (the machine-independent cost).
     pub rhs_calls: f64,
     /// Wall-clock time (s).
@@ -100,7 +106,8 @@ pub fn read_tradeoff(path: &Path) -> Result<Vec<TradeoffPoint>, PlotError> {
                     None => fidelity[i].clone(),
                 },
                 rtol: rtol[i],
-                error_revs: error[i]?,
+                median_error_revs: error[i]?,
+                max_error_revs: error[i]?,
                 rhs_calls: rhs[i],
                 wall_time_s: wall[i],
             })
@@ -109,33 +116,46 @@ pub fn read_tradeoff(path: &Path) -> Result<Vec<TradeoffPoint>, PlotError> {
     Ok(aggregate(rows))
 }
 
-/// One point per series and tolerance: the largest error over the runs (the
-/// figure a budget is checked against) at the mean cost. Tables with one row
-/// per setting pass through unchanged.
+/// One point per series and tolerance at the mean cost: the upper median of
+/// the runs' errors (as the trade-off table reports it) and the largest (the
+/// figure a budget is checked against). Tables with one row per setting pass
+/// through unchanged.
 fn aggregate(rows: Vec<TradeoffPoint>) -> Vec<TradeoffPoint> {
-    let mut out: Vec<(TradeoffPoint, usize)> = Vec::new();
+    let mut out: Vec<(TradeoffPoint, Vec<f64>)> = Vec::new();
     for r in rows {
         match out
             .iter_mut()
             .find(|(p, _)| p.fidelity == r.fidelity && p.rtol == r.rtol)
         {
-            Some((p, n)) => {
-                p.error_revs = p.error_revs.max(r.error_revs);
+            Some((p, errors)) => {
+                errors.push(r.max_error_revs);
                 p.rhs_calls += r.rhs_calls;
                 p.wall_time_s += r.wall_time_s;
-                *n += 1;
             }
-            None => out.push((r, 1)),
+            None => {
+                let first = r.max_error_revs;
+                out.push((r, vec![first]));
+            }
         }
     }
     out.into_iter()
-        .map(|(mut p, n)| {
-            p.rhs_calls /= n as f64;
-            p.wall_time_s /= n as f64;
+        .map(|(mut p, mut errors)| {
+            if errors.len() > 1 {
+                errors.sort_by(f64::total_cmp);
+                p.median_error_revs = quantile_sorted(&errors, 0.5, Interpolation::Higher)
+                    .unwrap_or(p.max_error_revs);
+                p.max_error_revs = errors[errors.len() - 1];
+            }
+            let n = errors.len() as f64;
+            p.rhs_calls /= n;
+            p.wall_time_s /= n;
             p
         })
         .collect()
 }
+
+/// How to read a point (written under its legend).
+const READING: &str = "marker: median |Δt_s| over the measured runs, on the line; whisker: up to the largest (what a budget is checked against)";
 
 /// What the figure does not show, and why (written under its legend).
 const LEFT_OUT: &str = "not shown: the analytic and linear rungs (no RHS calls: no place on a log cost axis) and runs whose outcome differs from the reference's";
@@ -161,14 +181,25 @@ pub fn plot_work_precision(
     }
     for p in points {
         let bad = |v: f64| !v.is_finite() || v < 0.0;
-        if bad(p.error_revs) || bad(p.wall_time_s) || bad(p.rhs_calls) || p.rhs_calls == 0.0 {
+        if bad(p.median_error_revs)
+            || bad(p.max_error_revs)
+            || bad(p.wall_time_s)
+            || bad(p.rhs_calls)
+            || p.rhs_calls == 0.0
+        {
             return Err(PlotError::invalid(
                 format!("{} at rtol {}", p.fidelity, p.rtol),
-                "error and wall time must be finite and ≥ 0, RHS calls > 0",
+                "errors and wall time must be finite and ≥ 0, RHS calls > 0",
+            ));
+        }
+        if p.median_error_revs > p.max_error_revs {
+            return Err(PlotError::invalid(
+                format!("{} at rtol {}", p.fidelity, p.rtol),
+                "the median error exceeds the largest",
             ));
         }
     }
-    if !points.iter().any(|p| p.error_revs > 0.0) {
+    if !points.iter().any(|p| p.max_error_revs > 0.0) {
         return Err(PlotError::NoData(
             "every error is zero: nothing to show on a log axis".into(),
         ));
@@ -202,12 +233,13 @@ impl Figure for WorkPrecision<'_> {
             .enumerate()
             .map(|(k, f)| (f.clone(), Swatch::Series(series_style(k))))
             .collect();
-        if self.points.iter().any(|p| p.error_revs == 0.0) {
+        if self.points.iter().any(|p| p.median_error_revs == 0.0) {
             entries.push(("error 0 (drawn on the floor)".into(), Swatch::Ring(BLACK)));
         }
         let body = style::legend(&body, &entries)?;
         // read_tradeoff drops them before the figure sees them: say so, so
         // that a reader does not take their absence for a missing result.
+        let body = style::text_block(&body, READING, TICK)?;
         let body = style::text_block(&body, LEFT_OUT, TICK)?;
         let panels = body.split_evenly((1, 2));
         self.panel(
@@ -236,7 +268,11 @@ impl WorkPrecision<'_> {
     ) -> Result<(), PlotError> {
         let (x_lo, x_hi) = style::log_extent(self.points.iter().map(&cost), 1.1)
             .ok_or_else(|| PlotError::NoData(format!("{caption}: no positive cost")))?;
-        let errors = || self.points.iter().map(|p| p.error_revs);
+        let errors = || {
+            self.points
+                .iter()
+                .flat_map(|p| [p.median_error_revs, p.max_error_revs])
+        };
         let smallest = errors().filter(|e| *e > 0.0).fold(f64::INFINITY, f64::min);
         // Zero errors get a floor a factor of four below the smallest real one.
         let floor = smallest / 4.0;
@@ -262,7 +298,7 @@ impl WorkPrecision<'_> {
         chart
             .configure_mesh()
             .x_desc(x_desc)
-            .y_desc("max |Δt_s| over the measured runs  (rev, log scale)")
+            .y_desc("|Δt_s| over the measured runs  (rev, log scale)")
             .axis_desc_style(text(style::AXIS))
             .label_style(text(TICK))
             .x_label_formatter(&style::log_formatter(x_lo, x_hi))
@@ -284,7 +320,7 @@ impl WorkPrecision<'_> {
                 .collect();
             // Loose to tight tolerance: the line walks towards higher cost.
             mine.sort_by(|a, b| b.rtol.total_cmp(&a.rtol));
-            let xy = |p: &TradeoffPoint| (cost(p).max(x_lo), p.error_revs.max(floor));
+            let xy = |p: &TradeoffPoint| (cost(p).max(x_lo), p.median_error_revs.max(floor));
             let line: Vec<(f64, f64)> = mine.iter().map(|p| xy(p)).collect();
             // Every point is marked here, so the line itself carries no markers.
             let plain = style::SeriesStyle {
@@ -297,7 +333,23 @@ impl WorkPrecision<'_> {
                 m => m,
             };
             for p in &mine {
-                if p.error_revs > 0.0 {
+                let (x, median) = xy(p);
+                if p.max_error_revs > median {
+                    let top = p.max_error_revs;
+                    chart.draw_series([PathElement::new(
+                        vec![(x, median), (x, top)],
+                        c.stroke_width(1),
+                    )])?;
+                    chart.draw_series([EmptyElement::at((x, top))
+                        + PathElement::new(vec![(-4, 0), (4, 0)], c.stroke_width(1))])?;
+                    // No rtol label may cover a whisker either.
+                    let (low, high) = (
+                        chart.backend_coord(&(x, median)),
+                        chart.backend_coord(&(x, top)),
+                    );
+                    placer.reserve((high.0 - 4, high.1 - 1, high.0 + 4, low.1));
+                }
+                if p.median_error_revs > 0.0 {
                     chart.draw_series([
                         EmptyElement::at(xy(p)) + style::marker(marker, 5, c.filled())
                     ])?;

@@ -559,14 +559,17 @@ fn tradeoff_points() -> Vec<TradeoffPoint> {
     {
         for k in 3..=9 {
             let rtol = 10f64.powi(-k);
+            let error = if k == 9 && f == 1 {
+                0.0
+            } else {
+                scale * 50.0 * rtol.powf(0.6)
+            };
             points.push(TradeoffPoint {
                 fidelity: fidelity.into(),
                 rtol,
-                error_revs: if k == 9 && f == 1 {
-                    0.0
-                } else {
-                    scale * 50.0 * rtol.powf(0.6)
-                },
+                // One row per setting: its median and its largest are its one error.
+                median_error_revs: error,
+                max_error_revs: error,
                 rhs_calls: (2000.0 * (f + 1) as f64) * 10f64.powf(0.2 * k as f64),
                 wall_time_s: 1e-3 * (f + 1) as f64 * 10f64.powf(0.2 * k as f64),
             });
@@ -579,7 +582,7 @@ fn write_tradeoff(path: &Path, points: &[TradeoffPoint]) {
     let mut df = df!(
         "fidelity" => points.iter().map(|p| p.fidelity.clone()).collect::<Vec<_>>(),
         "rtol" => points.iter().map(|p| p.rtol).collect::<Vec<_>>(),
-        "settling_error_revs" => points.iter().map(|p| p.error_revs).collect::<Vec<_>>(),
+        "settling_error_revs" => points.iter().map(|p| p.max_error_revs).collect::<Vec<_>>(),
         "rhs_calls" => points.iter().map(|p| p.rhs_calls as u64).collect::<Vec<_>>(),
         "wall_time_s" => points.iter().map(|p| p.wall_time_s).collect::<Vec<_>>(),
         "extra" => points.iter().map(|_| 1i32).collect::<Vec<_>>(),
@@ -614,7 +617,8 @@ fn tradeoff_table_round_trips_and_plots() {
             "Work–precision test",
             "RHS calls  (count, log scale)",
             "wall time  (s, log scale)",
-            "max |Δt_s| over the measured runs  (rev, log scale)",
+            "|Δt_s| over the measured runs  (rev, log scale)",
+            "marker: median |Δt_s| over the measured runs",
             "not shown: the analytic and linear rungs",
             "dop853",
             "radau5",
@@ -623,6 +627,50 @@ fn tradeoff_table_round_trips_and_plots() {
     let png = dir.path.join("wp.png");
     plot_work_precision(&read, "Work–precision test", &png).unwrap();
     check_png(&png, 20_000, (1200, 600));
+}
+
+#[test]
+fn tradeoff_points_are_the_median_with_the_largest_of_their_runs() {
+    // A per-run table, as `study tradeoff` writes it: three runs at one
+    // setting, four at another; the figure shows the upper median (as the
+    // trade-off table does) with a whisker up to the largest, at the mean cost.
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("runs.parquet");
+    let rows = [
+        ("dp5", 1e-6, 0.2, 100u64),
+        ("dp5", 1e-6, 5.0, 300),
+        ("dp5", 1e-6, 0.1, 200),
+        ("dp5", 1e-8, 0.01, 400),
+        ("dp5", 1e-8, 0.04, 400),
+        ("dp5", 1e-8, 0.03, 400),
+        ("dp5", 1e-8, 0.02, 400),
+    ];
+    let mut df = df!(
+        "fidelity" => rows.iter().map(|r| r.0).collect::<Vec<_>>(),
+        "rtol" => rows.iter().map(|r| r.1).collect::<Vec<_>>(),
+        "settling_error_revs" => rows.iter().map(|r| r.2).collect::<Vec<_>>(),
+        "rhs_calls" => rows.iter().map(|r| r.3).collect::<Vec<_>>(),
+        "wall_time_s" => rows.iter().map(|r| r.3 as f64 * 1e-5).collect::<Vec<_>>(),
+    )
+    .unwrap();
+    write_parquet(&table, &mut df, &Provenance::new("per run", 0, "all")).unwrap();
+    let points = read_tradeoff(&table).unwrap();
+    assert_eq!(points.len(), 2);
+    let loose = &points[0];
+    assert_eq!((loose.median_error_revs, loose.max_error_revs), (0.2, 5.0));
+    assert!((loose.rhs_calls - 200.0).abs() < 1e-12);
+    let tight = &points[1];
+    assert_eq!(
+        (tight.median_error_revs, tight.max_error_revs),
+        (0.03, 0.04)
+    );
+    // A median above the largest is a broken table, not a figure.
+    let mut broken = points.clone();
+    broken[0].median_error_revs = 6.0;
+    assert!(matches!(
+        plot_work_precision(&broken, "t", &dir.path().join("wp.svg")),
+        Err(PlotError::Invalid { .. })
+    ));
 }
 
 #[test]

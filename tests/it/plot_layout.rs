@@ -356,7 +356,8 @@ fn every_figure_keeps_its_text_inside_and_apart() {
             points.push(TradeoffPoint {
                 fidelity: format!("fidelity_{f}/method_with_a_long_name"),
                 rtol,
-                error_revs: (1.0 + f as f64) * 50.0 * rtol.powf(0.6),
+                median_error_revs: (1.0 + f as f64) * 20.0 * rtol.powf(0.6),
+                max_error_revs: (1.0 + f as f64) * 50.0 * rtol.powf(0.6),
                 rhs_calls: 2000.0 * (1.0 + 0.1 * f as f64) * 10f64.powf(0.2 * k as f64),
                 wall_time_s: 1e-3 * (1.0 + 0.1 * f as f64) * 10f64.powf(0.2 * k as f64),
             });
@@ -500,6 +501,58 @@ fn study_figures_name_every_varying_parameter_and_colour_each_drive() {
             "{a:?} shares its colour"
         );
     }
+}
+
+#[test]
+fn one_geometry_rows_take_a_colour_per_stall_torque() {
+    // A Sommerfeld study: five designs alike but for the motor's stall
+    // torque. Each row of the per-design figures has its own colour, named
+    // by its torque, as its band in settling vs unbalance.
+    let mut data = crowded_study(1, 5, 14);
+    let torque = |id: u32| 0.2 * f64::from(id + 1);
+    for d in &mut data.designs {
+        d.drag = 2.0;
+        d.stall_torque = Some(torque(d.design_id));
+    }
+    for r in &mut data.runs {
+        r.drag = 2.0;
+        r.stall_torque = Some(torque(r.design_id));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for figure in [
+        StudyFigure::SettlingTime,
+        StudyFigure::SettledFraction,
+        StudyFigure::SettlingVsUnbalance,
+    ] {
+        let path = dir.path().join(format!("{}.svg", figure.file_stem()));
+        figure.plot(&data, &path).unwrap();
+        let looks = legend_styles();
+        let names: Vec<&str> = looks.iter().map(|(l, _)| l.as_str()).collect();
+        let expected: Vec<String> = (0..5)
+            .map(|id| format!("M_s = {} N·m", short_number(torque(id))))
+            .collect();
+        for e in &expected {
+            assert!(
+                names.contains(&e.as_str()),
+                "{}: {names:?}",
+                figure.file_stem()
+            );
+        }
+        let torques: Vec<&(String, SeriesStyle)> =
+            looks.iter().filter(|(l, _)| l.starts_with("M_s")).collect();
+        for (i, (label, a)) in torques.iter().enumerate() {
+            assert!(
+                torques[i + 1..].iter().all(|(_, b)| b.colour != a.colour),
+                "{}: {label} shares its colour",
+                figure.file_stem()
+            );
+        }
+    }
+}
+
+/// A number as the figures print it (three significant digits, no trailing zeros).
+fn short_number(v: f64) -> String {
+    autobal::plot::style::short(v)
 }
 
 #[test]

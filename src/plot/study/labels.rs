@@ -1,5 +1,6 @@
 //! How a study's designs are told apart in its figures: labels naming only
-//! the parameters that vary, colours or panels shared by one geometry, and
+//! the parameters that vary, colours or panels shared by one geometry (or
+//! by one drive where the geometry is shared), and
 //! the category axis that lists designs top to bottom.
 
 use super::DesignStats;
@@ -121,6 +122,20 @@ pub(super) fn geometries(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
         })
         .collect();
     (index, names)
+}
+
+/// The colour group of each design's row in a one-row-per-design figure,
+/// with a legend name per group: its geometry (kind, n, ρ) where
+/// geometries differ, else its drive and damping (β, M_s) where those
+/// differ, so that the colours tell apart what varies (in a Sommerfeld
+/// study, each stall torque its own colour, as in settling vs unbalance).
+pub(super) fn row_colours(designs: &[DesignStats]) -> (Vec<usize>, Vec<String>) {
+    let geometry = geometries(designs);
+    if geometry.1.len() > 1 {
+        return geometry;
+    }
+    let drive = drives(designs);
+    if drive.1.len() > 1 { drive } else { geometry }
 }
 
 /// Index of each design's drive and damping (β, M_s), the parameters a
@@ -252,6 +267,10 @@ mod tests {
         assert_eq!(names[1], "β = 2 N·s/m, M_s = 1 N·m");
         let (index, names) = drives(&designs[..2]);
         assert_eq!((index, names[0].as_str()), (vec![0, 1], "M_s = 0.5 N·m"));
+        // One geometry: the rows' colours follow the drive, one per design.
+        let (index, names) = row_colours(&designs);
+        assert_eq!(index, vec![0, 1, 2]);
+        assert_eq!(names[2], "β = 5 N·s/m, M_s = 0.5 N·m");
     }
 
     #[test]
@@ -282,5 +301,7 @@ mod tests {
         let (index, names) = geometries(&designs);
         assert_eq!(index, vec![0, 1]);
         assert_eq!(names, vec!["2/3 balls, ρ = 0.1", "2/4 balls, ρ = 0.1"]);
+        // Geometries differ: the rows' colours follow them.
+        assert_eq!(row_colours(&designs), (index, names));
     }
 }

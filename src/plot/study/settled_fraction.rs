@@ -2,7 +2,7 @@
 
 use super::StudyData;
 use super::labels::{
-    Labels, category_height, category_label, category_y, geometries, label_width, labels,
+    Labels, category_height, category_label, category_y, label_width, labels, row_colours,
 };
 use crate::plot::PlotError;
 use crate::plot::style::{self, Figure, TICK, linear_label, point_style, text};
@@ -103,7 +103,7 @@ impl Figure for SettledFraction<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
-        let (group, names) = geometries(designs);
+        let (group, names) = row_colours(designs);
         for (i, d) in designs.iter().enumerate() {
             let y = category_y(i, count);
             let look = point_style(group[i]);

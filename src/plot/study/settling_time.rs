@@ -4,7 +4,7 @@
 
 use super::StudyData;
 use super::labels::{
-    Labels, category_height, category_label, category_y, geometries, label_width, labels,
+    Labels, category_height, category_label, category_y, label_width, labels, row_colours,
 };
 use crate::plot::PlotError;
 use crate::plot::style::{self, Figure, TICK, draw_line, log_ticks, point_style, text};
@@ -152,7 +152,7 @@ impl Figure for SettlingBoxes<'_> {
             .light_line_style(WHITE.mix(0.0))
             .bold_line_style(BLACK.mix(0.08))
             .draw()?;
-        let (group, names) = geometries(designs);
+        let (group, names) = row_colours(designs);
         for (i, b) in boxes.iter().enumerate() {
             let y = category_y(i, count);
             let look = point_style(group[i]);
@@ -171,7 +171,7 @@ impl Figure for SettlingBoxes<'_> {
                 continue;
             };
             let h = 0.32;
-            // Past seven geometries the colours come round again; the outlines
+            // Past seven colour groups the colours come round again; the outlines
             // then turn dashed (outline_style), the outlier marks change shape.
             let outline_look = style::outline_style(group[i]);
             style::note_series(names[group[i]].clone(), outline_look);
