@@ -212,23 +212,25 @@ fn draw_figures(dir: &Path, leading: &[u32], scratch: &Path) -> Result<Vec<Figur
         .map(|(path, figure)| (caption(*figure), path))
         .collect();
     if !leading.is_empty() {
-        let curves = leading
+        let sides = leading
             .iter()
-            .enumerate()
-            .map(|(rank, &id)| {
-                let side =
-                    Side::load(dir, Some(id)).map_err(|e| PlotError::NoData(e.to_string()))?;
-                Ok(KmCurve {
-                    label: format!("#{} (design {id}): {}", rank + 1, side.label),
-                    observations: side.runs.settling.clone(),
-                    horizon: side.horizon,
-                })
-            })
+            .map(|&id| Side::load(dir, Some(id)).map_err(|e| PlotError::NoData(e.to_string())))
             .collect::<Result<Vec<_>, PlotError>>()?;
+        let curves: Vec<KmCurve> = sides
+            .iter()
+            .zip(leading)
+            .enumerate()
+            .map(|(rank, (side, id))| KmCurve {
+                label: format!("#{} (design {id}): {}", rank + 1, side.label),
+                observations: side.runs.settling.clone(),
+                horizon: side.horizon,
+            })
+            .collect();
         let path = scratch.join("kaplan_meier.svg");
         plot_kaplan_meier(
             &curves,
             "Fraction of runs settled by t: the leading designs",
+            sides[0].constant_rev_seconds(),
             &path,
         )?;
         paths.push((

@@ -88,10 +88,25 @@ struct Fitted<'a> {
 struct KmFigure<'a> {
     fitted: Vec<Fitted<'a>>,
     title: &'a str,
+    seconds_per_rev: Option<f64>,
 }
 
-/// Write the Kaplan–Meier curves of `curves` to `path` (.svg or .png).
-pub fn plot_kaplan_meier(curves: &[KmCurve], title: &str, path: &Path) -> Result<(), PlotError> {
+/// Write the Kaplan–Meier curves of `curves` to `path` (.svg or .png); with
+/// `seconds_per_rev` (a constant speed, every curve's), a top axis in seconds.
+pub fn plot_kaplan_meier(
+    curves: &[KmCurve],
+    title: &str,
+    seconds_per_rev: Option<f64>,
+    path: &Path,
+) -> Result<(), PlotError> {
+    if let Some(s) = seconds_per_rev
+        && !(s.is_finite() && s > 0.0)
+    {
+        return Err(PlotError::invalid(
+            "seconds per revolution",
+            "must be finite and > 0",
+        ));
+    }
     if curves.is_empty() {
         return Err(PlotError::NoData("no design to draw".into()));
     }
@@ -119,7 +134,14 @@ pub fn plot_kaplan_meier(curves: &[KmCurve], title: &str, path: &Path) -> Result
             Ok(Fitted { curve, km, end })
         })
         .collect::<Result<Vec<_>, PlotError>>()?;
-    style::render(&KmFigure { fitted, title }, path)
+    style::render(
+        &KmFigure {
+            fitted,
+            title,
+            seconds_per_rev,
+        },
+        path,
+    )
 }
 
 impl Figure for KmFigure<'_> {
@@ -161,11 +183,56 @@ impl Figure for KmFigure<'_> {
             .margin_top(4)
             .margin_right(30)
             .x_label_area_size(52)
+            .top_x_label_area_size(if self.seconds_per_rev.is_some() {
+                52
+            } else {
+                0
+            })
             .y_label_area_size(80)
             .build_cartesian_2d(
                 (lo..hi).log_scale().with_key_points(log_ticks(lo, hi)),
                 0.0..1.02,
             )?;
+        match self.seconds_per_rev {
+            Some(s) => {
+                // The same log axis scaled by a constant: its ticks line up
+                // with the revolutions below. Set before the primary mesh,
+                // which would otherwise label the top axis too.
+                let (s_lo, s_hi) = (lo * s, hi * s);
+                let mut dual = chart.set_secondary_coord(
+                    (s_lo..s_hi)
+                        .log_scale()
+                        .with_key_points(log_ticks(s_lo, s_hi)),
+                    0.0..1.02,
+                );
+                dual.configure_secondary_axes()
+                    .x_desc("settling time t  (s at the constant speed, log scale)")
+                    .axis_desc_style(text(style::AXIS))
+                    .label_style(text(TICK))
+                    .x_label_formatter(&style::log_formatter(s_lo, s_hi))
+                    .draw()?;
+                self.draw_curves(&mut dual, lo, hi)
+            }
+            None => self.draw_curves(&mut chart, lo, hi),
+        }
+    }
+}
+
+/// The figure's plotting coordinates: log settling time by fraction settled.
+type KmCoord = Cartesian2d<
+    plotters::coord::combinators::WithKeyPoints<LogCoord<f64>>,
+    plotters::coord::types::RangedCoordf64,
+>;
+
+impl KmFigure<'_> {
+    /// The mesh, bands, horizons, curves and censoring ticks on `chart`,
+    /// spanning `lo`..`hi` revolutions.
+    fn draw_curves<DB: DrawingBackend>(
+        &self,
+        chart: &mut ChartContext<'_, DB, KmCoord>,
+        lo: f64,
+        hi: f64,
+    ) -> Result<(), PlotError> {
         chart
             .configure_mesh()
             .x_desc("settling time t  (revolutions, log scale)")
@@ -228,7 +295,7 @@ impl Figure for KmFigure<'_> {
                 .into_iter()
                 .map(|(t, y)| (x(t), y))
                 .collect();
-            draw_line(&mut chart, &steps, look, 2)?;
+            draw_line(chart, &steps, look, 2)?;
             chart.draw_series(censoring_times(&f.curve.observations).into_iter().map(|t| {
                 EmptyElement::at((x(t), f.km.settled_by(t)))
                     + PathElement::new(vec![(0, -6), (0, 6)], c.stroke_width(2))

@@ -506,6 +506,8 @@ fn compare_plot_writes_kaplan_meier_figure() {
             // The title names the study folder, the legend gives β its unit.
             "s: fraction of runs settled by t",
             "settling time t  (revolutions, log scale)",
+            // The study turns at a constant 300 rad/s: a top axis in seconds.
+            "settling time t  (s at the constant speed, log scale)",
             "settled by t, 1 − S(t)",
             "A: ball n=3",
             " N·s/m",

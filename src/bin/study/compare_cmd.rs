@@ -368,7 +368,11 @@ fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
     };
     let curves = [curve("A", a), curve("B", b)];
     let title = compare_title(a, b);
-    plot_kaplan_meier(&curves, &title, path).map_err(|e| {
+    // Seconds only where both sides turn at the same constant speed.
+    let seconds = a
+        .constant_rev_seconds()
+        .filter(|s| b.constant_rev_seconds() == Some(*s));
+    plot_kaplan_meier(&curves, &title, seconds, path).map_err(|e| {
         let UserError(message, code) = plot_error(e);
         UserError(format!("--plot {}: {message}", path.display()), code)
     })
