@@ -22,7 +22,7 @@ pub fn read_map(path: &Path) -> Result<Vec<MapPoint>, PlotError> {
     if !path.is_file() {
         return Err(PlotError::invalid(shown, "not found"));
     }
-    let df = read_parquet(path).map_err(|e| PlotError::invalid(shown.clone(), e.to_string()))?;
+    let df = read_parquet(path).map_err(|e| PlotError::unreadable(path, e))?;
     let column = |name: &str| {
         df.column(name).map_err(|_| {
             PlotError::invalid(

@@ -103,4 +103,16 @@ impl PlotError {
             reason: reason.into(),
         }
     }
+
+    /// A results table at `path` that could not be read, named once
+    /// (`read_parquet`'s message already starts with the path).
+    pub fn unreadable(path: &std::path::Path, e: polars::error::PolarsError) -> Self {
+        let shown = path.display().to_string();
+        let text = e.to_string();
+        let reason = match text.strip_prefix(&format!("{shown}: ")) {
+            Some(rest) => rest.to_string(),
+            None => text,
+        };
+        PlotError::invalid(shown, reason)
+    }
 }

@@ -48,8 +48,7 @@ pub fn read_tradeoff(path: &Path) -> Result<Vec<TradeoffPoint>, PlotError> {
     if !path.is_file() {
         return Err(PlotError::invalid(path.display().to_string(), "not found"));
     }
-    let df = read_parquet(path)
-        .map_err(|e| PlotError::invalid(path.display().to_string(), e.to_string()))?;
+    let df = read_parquet(path).map_err(|e| PlotError::unreadable(path, e))?;
     let shown = path.display();
     let column = |name: &str| {
         df.column(name).map_err(|_| {

@@ -68,18 +68,29 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// What a file that is not Parquet (truncated, overwritten, another format)
+/// is called in messages.
+const NOT_PARQUET: &str = "not a readable Parquet file";
+
+/// Whether `e` (from [`about`]) says a file is not readable Parquet: the
+/// user's file is damaged, an input error rather than a fault of the tool.
+pub fn is_not_parquet(e: &PolarsError) -> bool {
+    matches!(e, PolarsError::ComputeError(m) if m.contains(NOT_PARQUET))
+}
+
 /// `e` (met while reading or writing `path`) with the path in front of its
 /// message: polars and the OS name neither the file nor the folder.
 pub fn about(path: &Path, e: PolarsError) -> PolarsError {
     let text = e.to_string();
-    let text = if text.contains("out of specification") || text.contains("magic") {
-        format!("not a readable Parquet file ({text})")
+    let damaged = text.contains("out of specification") || text.contains("magic");
+    let text = if damaged {
+        format!("{NOT_PARQUET} ({text})")
     } else {
         text
     };
     let message = format!("{}: {text}", path.display());
     match e {
-        PolarsError::IO { error, .. } => PolarsError::IO {
+        PolarsError::IO { error, .. } if !damaged => PolarsError::IO {
             error,
             msg: Some(message.into()),
         },

@@ -255,7 +255,7 @@ impl RunError {
                 | RunError::Locked(_)
                 | RunError::NotOwned { .. }
                 | RunError::AdaptiveSharded
-        )
+        ) || matches!(self, RunError::Polars(e) if super::io::is_not_parquet(e))
     }
 }
 

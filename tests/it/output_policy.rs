@@ -282,14 +282,34 @@ fn a_corrupt_runs_file_is_reported_with_its_path() {
     assert!(study_cmd(&["run", p, "--quiet"]).status.success());
     let runs = folder.join("runs.parquet");
     std::fs::write(&runs, b"not parquet at all").unwrap();
+    let figures = tmp.path().join("figs");
+    let report = tmp.path().join("report.html");
+    // A damaged results file is the user's input: exit 2, named once.
     for args in [
         vec!["run", p, "--quiet", "--resume"],
         vec!["compare", folder.to_str().unwrap(), "--designs", "0,0"],
+        vec![
+            "plot",
+            "study",
+            folder.to_str().unwrap(),
+            "--out",
+            figures.to_str().unwrap(),
+        ],
+        vec![
+            "report",
+            folder.to_str().unwrap(),
+            "--out",
+            report.to_str().unwrap(),
+        ],
     ] {
         let out = study_cmd(&args);
         let err = stderr(&out);
-        assert_ne!(out.status.code(), Some(0), "{args:?}");
-        assert!(err.contains(runs.to_str().unwrap()), "{args:?}: {err}");
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(
+            err.matches(runs.to_str().unwrap()).count(),
+            1,
+            "{args:?}: {err}"
+        );
         assert!(
             !err.contains("out of specification") || err.contains("Parquet"),
             "{err}"

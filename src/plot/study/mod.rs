@@ -170,8 +170,7 @@ impl StudyData {
                     "not found: give the output folder of `study run`",
                 ));
             }
-            read_parquet(&path)
-                .map_err(|e| PlotError::invalid(path.display().to_string(), e.to_string()))
+            read_parquet(&path).map_err(|e| PlotError::unreadable(&path, e))
         };
         let runs = from_dataframe(&open("runs.parquet")?)?;
         let designs = design_stats(&open("summary.parquet")?)?;
