@@ -13,7 +13,8 @@
 # their documented semantics. The image is the local localhost/autobal (the
 # manifests' registry.example.org/autobal:latest maps to it); when absent it
 # is built with deploy/container/build-prebuilt.sh (cargo). Needs root and
-# podman (installed with runc from apt when missing). One command:
+# podman (installed with runc from apt when missing) and PyYAML
+# (python3-yaml, likewise). One command:
 #
 #   deploy/k8s/local-test.sh
 #   deploy/k8s/local-test.sh --fail-shard
@@ -34,7 +35,7 @@
 # each run of the block. Containers it starts are named
 # autobal-k8s-test-PID-…; they and its temporary folder are removed on exit.
 set -euo pipefail
-usage() { sed -n '2,35p' "$0" >&2; exit 2; }
+usage() { sed -n '2,36p' "$0" >&2; exit 2; }
 fail_shard=
 case $# in
   0) ;;
@@ -86,6 +87,10 @@ for tool in podman runc; do
     break
   fi
 done
+if ! python3 -c 'import yaml' 2> /dev/null; then
+  apt-get update > /dev/null
+  apt-get install -y python3-yaml > /dev/null
+fi
 # crun fails on these machines (setrlimit, cgroups); runc with no default
 # ulimits and the cgroupfs manager works (as in deploy/container/local-test.sh).
 cat > "$work/containers.conf" <<'CONF'
