@@ -230,6 +230,8 @@ PY
   # shellcheck disable=SC2001 # a prefix on every line
   sed 's/^/  /' <<< "$facts"
   [ "$status" -ne 124 ] || problems+=("$1: the block did not end within ${K8S_TEST_TIMEOUT:-1800} s")
+  [ "$status" -eq 124 ] || [ "$status" -eq 1 ] \
+    || problems+=("$1: the block exited $status, not 1 (wait-job.sh's answer for a failed Job)")
   grep -q "job/$shards failed (failed indexes: $index)" "$work/$1/block.log" \
     || problems+=("$1: wait-job.sh did not report job/$shards failed with index $index")
   if grep -q "apply -f .*merge-job.yaml" "$state/calls.log" || [ -d "$state/jobs/$merge" ]; then
