@@ -29,16 +29,8 @@ for tool in podman runc mmdebstrap strip; do
     break
   fi
 done
-# crun fails on these machines (setrlimit, cgroups); runc with no default
-# ulimits and the cgroupfs manager works.
-cat > "$work/containers.conf" <<'CONF'
-[containers]
-default_ulimits = []
-[engine]
-cgroup_manager = "cgroupfs"
-runtime = "runc"
-CONF
-export CONTAINERS_CONF=$work/containers.conf
+# runc instead of crun, which fails on these machines (see the file).
+export CONTAINERS_CONF=$repo/deploy/container/runc.conf
 base=localhost/debian-bookworm-min:local
 if ! podman image exists "$base"; then
   step "making the base image $base with mmdebstrap"

@@ -91,16 +91,8 @@ if ! python3 -c 'import yaml' 2> /dev/null; then
   apt-get update > /dev/null
   apt-get install -y python3-yaml > /dev/null
 fi
-# crun fails on these machines (setrlimit, cgroups); runc with no default
-# ulimits and the cgroupfs manager works (as in deploy/container/local-test.sh).
-cat > "$work/containers.conf" <<'CONF'
-[containers]
-default_ulimits = []
-[engine]
-cgroup_manager = "cgroupfs"
-runtime = "runc"
-CONF
-export CONTAINERS_CONF=$work/containers.conf
+# runc instead of crun, which fails on these machines (see the file).
+export CONTAINERS_CONF=$repo/deploy/container/runc.conf
 image=localhost/autobal
 if ! podman image exists "$image"; then
   step "no image $image: building it with deploy/container/build-prebuilt.sh"
