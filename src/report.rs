@@ -6,7 +6,7 @@
 
 use crate::plot::Format;
 use crate::plot::PlotError;
-use crate::plot::km::{KmCurve, plot_kaplan_meier};
+use crate::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use crate::plot::study::{StudyData, StudyFigure, plot_study};
 use crate::study::compare_designs::Side;
 use std::path::{Path, PathBuf};
@@ -230,7 +230,10 @@ fn draw_figures(dir: &Path, leading: &[u32], scratch: &Path) -> Result<Vec<Figur
         plot_kaplan_meier(
             &curves,
             "Fraction of runs settled by t: the leading designs",
-            sides[0].constant_rev_seconds(),
+            Some(SecondsAxis::for_clock(
+                sides[0].clock,
+                sides[0].scale.rev_seconds,
+            )),
             &path,
         )?;
         paths.push((

@@ -8,7 +8,7 @@ use super::style::{
     self, Figure, REFERENCE, Swatch, TICK, draw_line, linear_label, log_ticks, series_style, text,
 };
 use crate::stats::survival::{Interval, KaplanMeier, Observation, Transform};
-use crate::study::verdict::LEVEL;
+use crate::study::verdict::{LEVEL, SettlingClock};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -84,22 +84,72 @@ struct Fitted<'a> {
     end: f64,
 }
 
+/// The log time axis: from below the first settling after t = 0 to past
+/// every curve's end. Runs that settled at t = 0 (a run-up whose balancer
+/// had settled by the operating speed) are drawn at the left edge; they
+/// must not push the axis out to the horizon.
+fn time_extent(fitted: &[Fitted]) -> Option<(f64, f64)> {
+    let first = fitted
+        .iter()
+        .filter_map(|f| f.km.steps().iter().map(|s| s.time).find(|t| *t > 0.0));
+    let ends = fitted.iter().map(|f| f.end);
+    style::log_extent(first.chain(ends), 1.15)
+}
+
+/// Whether some run settled at t = 0, which the log axis draws at its left edge.
+fn settled_at_zero(fitted: &[Fitted]) -> bool {
+    fitted.iter().any(|f| {
+        f.curve
+            .observations
+            .iter()
+            .any(|o| o.settled && o.time == 0.0)
+    })
+}
+
+/// A top axis giving the settling times in seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SecondsAxis {
+    /// Seconds per revolution of the operating speed, the curves' unit.
+    pub per_rev: f64,
+    /// Whether the clock starts when the rotor reached the operating speed
+    /// (a run-up) rather than at t = 0.
+    pub from_operating_speed: bool,
+}
+
+impl SecondsAxis {
+    /// The axis for settling times measured on `clock`, in revolutions of `rev_seconds`.
+    pub fn for_clock(clock: SettlingClock, rev_seconds: f64) -> Self {
+        SecondsAxis {
+            per_rev: rev_seconds,
+            from_operating_speed: matches!(clock, SettlingClock::FromOperatingSpeed(_)),
+        }
+    }
+
+    fn description(self) -> &'static str {
+        if self.from_operating_speed {
+            "settling time t  (s after reaching the operating speed, log scale)"
+        } else {
+            "settling time t  (s at the constant speed, log scale)"
+        }
+    }
+}
+
 /// The Kaplan–Meier comparison figure.
 struct KmFigure<'a> {
     fitted: Vec<Fitted<'a>>,
     title: &'a str,
-    seconds_per_rev: Option<f64>,
+    seconds: Option<SecondsAxis>,
 }
 
 /// Write the Kaplan–Meier curves of `curves` to `path` (.svg or .png); with
-/// `seconds_per_rev` (a constant speed, every curve's), a top axis in seconds.
+/// `seconds` (the same clock for every curve), a top axis in seconds.
 pub fn plot_kaplan_meier(
     curves: &[KmCurve],
     title: &str,
-    seconds_per_rev: Option<f64>,
+    seconds: Option<SecondsAxis>,
     path: &Path,
 ) -> Result<(), PlotError> {
-    if let Some(s) = seconds_per_rev
+    if let Some(s) = seconds.map(|s| s.per_rev)
         && !(s.is_finite() && s > 0.0)
     {
         return Err(PlotError::invalid(
@@ -138,7 +188,7 @@ pub fn plot_kaplan_meier(
         &KmFigure {
             fitted,
             title,
-            seconds_per_rev,
+            seconds,
         },
         path,
     )
@@ -152,13 +202,7 @@ impl Figure for KmFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         // Settling times span decades (a few to hundreds of revolutions):
         // a log axis, from below the first settling to past the horizon.
-        let first = self
-            .fitted
-            .iter()
-            .filter_map(|f| f.km.steps().first().map(|s| s.time))
-            .filter(|t| *t > 0.0);
-        let ends = self.fitted.iter().map(|f| f.end);
-        let (lo, hi) = style::log_extent(first.chain(ends), 1.15)
+        let (lo, hi) = time_extent(&self.fitted)
             .ok_or_else(|| PlotError::NoData("no positive time".into()))?;
         let body = style::titled(root, self.title)?;
         let legend: Vec<(String, Swatch)> = self
@@ -173,8 +217,13 @@ impl Figure for KmFigure<'_> {
             })
             .collect();
         let caption = format!(
-            "every run counted; shaded: {:.0} % pointwise band (log-log); ticks: runs censored unsettled; dashed: ½, where the median reads off",
-            100.0 * LEVEL
+            "every run counted; shaded: {:.0} % pointwise band (log-log); ticks: runs censored unsettled; dashed: ½, where the median reads off{}",
+            100.0 * LEVEL,
+            if settled_at_zero(&self.fitted) {
+                "; runs settled at t = 0: the rise at the left edge"
+            } else {
+                ""
+            }
         );
         let area = style::legend(&body, &legend)?;
         let area = style::text_block(&area, &caption, TICK)?;
@@ -183,18 +232,15 @@ impl Figure for KmFigure<'_> {
             .margin_top(4)
             .margin_right(30)
             .x_label_area_size(52)
-            .top_x_label_area_size(if self.seconds_per_rev.is_some() {
-                52
-            } else {
-                0
-            })
+            .top_x_label_area_size(if self.seconds.is_some() { 52 } else { 0 })
             .y_label_area_size(80)
             .build_cartesian_2d(
                 (lo..hi).log_scale().with_key_points(log_ticks(lo, hi)),
                 0.0..1.02,
             )?;
-        match self.seconds_per_rev {
-            Some(s) => {
+        match self.seconds {
+            Some(axis) => {
+                let s = axis.per_rev;
                 // The same log axis scaled by a constant: its ticks line up
                 // with the revolutions below. Set before the primary mesh,
                 // which would otherwise label the top axis too.
@@ -206,7 +252,7 @@ impl Figure for KmFigure<'_> {
                     0.0..1.02,
                 );
                 dual.configure_secondary_axes()
-                    .x_desc("settling time t  (s at the constant speed, log scale)")
+                    .x_desc(axis.description())
                     .axis_desc_style(text(style::AXIS))
                     .label_style(text(TICK))
                     .x_label_formatter(&style::log_formatter(s_lo, s_hi))
@@ -308,6 +354,33 @@ impl KmFigure<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn runs_settled_at_zero_keep_the_axis_at_the_first_later_settling() {
+        // A run-up: most runs had settled when the operating speed was
+        // reached. The axis must still start below the first later settling
+        // (it started near the horizon, hiding every step).
+        let o = |time, settled| Observation { time, settled };
+        let curve = KmCurve {
+            label: "A".into(),
+            observations: vec![
+                o(0.0, true),
+                o(0.0, true),
+                o(0.0, true),
+                o(2.0, true),
+                o(7.0, true),
+            ],
+            horizon: 3000.0,
+        };
+        let fitted = [Fitted {
+            curve: &curve,
+            km: KaplanMeier::fit(&curve.observations).unwrap(),
+            end: curve.horizon,
+        }];
+        let (lo, hi) = time_extent(&fitted).unwrap();
+        assert!(lo < 2.0 && hi >= 3000.0, "{lo}..{hi}");
+        assert!(settled_at_zero(&fitted));
+    }
 
     #[test]
     fn censoring_times_are_distinct_and_sorted() {

@@ -202,12 +202,11 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let abs_sorted = sorted_values(simulated.column("residual_abs")?.f64()?);
         rows.res_abs_p95
             .push(quantile_sorted(&abs_sorted, 0.95, Interpolation::Linear));
-        rows.seconds_per_rev.push(match plan.file.scene.speed {
-            crate::model::speed::SpeedLaw::Constant { omega } => {
-                Some(std::f64::consts::TAU / omega)
-            }
-            _ => None,
-        });
+        // The revolution every `*_revs` column counts in: one turn at the
+        // operating speed, whatever the speed law.
+        rows.seconds_per_rev.push(Some(
+            std::f64::consts::TAU / plan.file.scene.speed.nominal_speed(),
+        ));
         rows.censored.push(count("censored"));
         rows.not_settled.push(count("not_settled"));
         rows.diverged.push(count("diverged"));

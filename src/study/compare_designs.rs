@@ -66,13 +66,6 @@ pub struct Side {
 }
 
 impl Side {
-    /// How long one revolution takes when the side's study turns at a
-    /// constant speed (its settling times then convert to seconds); `None`
-    /// under a speed law, whose clock starts at the operating speed.
-    pub fn constant_rev_seconds(&self) -> Option<f64> {
-        matches!(self.clock, SettlingClock::FromStart).then_some(self.scale.rev_seconds)
-    }
-
     /// Load design `design` of the study in `dir` (`None`: its only design).
     pub fn load(dir: &Path, design: Option<u32>) -> Result<Side, CompareError> {
         let shown = dir.display().to_string();

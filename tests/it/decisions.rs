@@ -195,4 +195,18 @@ fn a_run_up_is_timed_from_the_operating_speed() {
     // The ramp takes 0.5 s = 23.9 rev of 300 rad/s, and settling is only
     // judged at speed: the two clocks differ by the ramp.
     assert!(from_start - from_speed > 23.0, "{from_start} {from_speed}");
+    // Revolutions of the operating speed, in seconds after reaching it.
+    let period = summary
+        .column("seconds_per_rev")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .get(0)
+        .unwrap();
+    assert_eq!(period, std::f64::consts::TAU / 300.0);
+    assert!(
+        stdout.contains("(at the operating speed one revolution takes 20.94 ms"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("s after the rotor reached it)"), "{stdout}");
 }

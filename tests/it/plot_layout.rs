@@ -16,7 +16,7 @@ use autobal::design::Shape;
 use autobal::metrics::observer::Series;
 use autobal::metrics::{Outcome, RunMetrics};
 use autobal::plot::design::plot_design;
-use autobal::plot::km::{KmCurve, plot_kaplan_meier};
+use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use autobal::plot::map::plot_stability_map;
 use autobal::plot::run::{RunFigure, plot_run};
 use autobal::plot::study::{DesignStats, StudyData, StudyFigure};
@@ -406,7 +406,10 @@ fn every_figure_keeps_its_text_inside_and_apart() {
         plot_kaplan_meier(
             &curves,
             "Kaplan–Meier: fraction of runs settled by t",
-            Some(0.0209),
+            Some(SecondsAxis {
+                per_rev: 0.0209,
+                from_operating_speed: true,
+            }),
             p,
         )
     });

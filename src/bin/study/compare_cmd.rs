@@ -4,7 +4,7 @@
 use crate::UserError;
 use crate::output::{p_value_text, say, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
-use autobal::plot::km::{KmCurve, plot_kaplan_meier};
+use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use autobal::stats::holm::holm_adjust;
 use autobal::study::compare_designs::{Side, common_scale, compare_sides, median_with_interval};
 use autobal::study::criterion::Criterion;
@@ -368,10 +368,9 @@ fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
     };
     let curves = [curve("A", a), curve("B", b)];
     let title = compare_title(a, b);
-    // Seconds only where both sides turn at the same constant speed.
-    let seconds = a
-        .constant_rev_seconds()
-        .filter(|s| b.constant_rev_seconds() == Some(*s));
+    // Seconds only where both sides count on the same clock.
+    let axis = |s: &Side| SecondsAxis::for_clock(s.clock, s.scale.rev_seconds);
+    let seconds = Some(axis(a)).filter(|x| *x == axis(b));
     plot_kaplan_meier(&curves, &title, seconds, path).map_err(|e| {
         let UserError(message, code) = plot_error(e);
         UserError(format!("--plot {}: {message}", path.display()), code)

@@ -385,7 +385,8 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
             0
         )
     );
-    // At a constant speed, revolutions are a clock: say what they are in seconds.
+    // Revolutions of the operating speed are a clock: say what they are in
+    // seconds (under a run-up, seconds after the rotor reached that speed).
     let seconds_note = match (seconds_per_rev, order.first()) {
         (Some(period), Some(&best)) => {
             let value = match criterion {
@@ -393,16 +394,26 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
                 _ => rmst[best],
             };
             format!(
-                "(at the constant speed one revolution takes {:.2} ms{})\n",
+                "({} one revolution takes {:.2} ms{})\n",
+                if run_up {
+                    "at the operating speed"
+                } else {
+                    "at the constant speed"
+                },
                 1e3 * period,
                 value.map_or(String::new(), |v| format!(
-                    ": #1's {} {v:.1} rev is {:.3} s",
+                    ": #1's {} {v:.1} rev is {:.3} s{}",
                     if criterion == Criterion::Median {
                         "median"
                     } else {
                         "restricted mean"
                     },
-                    v * period
+                    v * period,
+                    if run_up {
+                        " after the rotor reached it"
+                    } else {
+                        ""
+                    }
                 ))
             )
         }
