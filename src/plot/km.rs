@@ -220,7 +220,7 @@ impl Figure for KmFigure<'_> {
             "every run counted; shaded: {:.0} % pointwise band (log-log); ticks: runs censored unsettled; dashed: ½, where the median reads off{}",
             100.0 * LEVEL,
             if settled_at_zero(&self.fitted) {
-                "; runs settled at t = 0: the rise at the left edge"
+                "; runs settled at t\u{a0}=\u{a0}0: the rise at the left edge"
             } else {
                 ""
             }
