@@ -308,7 +308,7 @@ struct SummaryColumns {
     res_p95: Vec<Option<f64>>,
     /// 95th percentile of the residual whirl in metres.
     res_abs_p95: Vec<Option<f64>>,
-    /// Seconds per revolution at a constant speed (null under a speed law).
+    /// Seconds per revolution of the operating speed (the unit of every `*_revs` column).
     seconds_per_rev: Vec<Option<f64>>,
     censored: Vec<u64>,
     not_settled: Vec<u64>,

@@ -39,6 +39,7 @@ mod plot;
 mod plot_layout;
 mod race_eccentricity;
 mod report;
+mod results_columns;
 mod results_folder;
 mod rolling_resistance;
 mod sample_bounds;
