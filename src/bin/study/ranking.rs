@@ -393,27 +393,22 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
                 Criterion::Median => median[best],
                 _ => rmst[best],
             };
+            let (speed, since) = if run_up {
+                ("at the operating speed", " after the rotor reached it")
+            } else {
+                ("at the constant speed", "")
+            };
             format!(
-                "({} one revolution takes {:.2} ms{})\n",
-                if run_up {
-                    "at the operating speed"
-                } else {
-                    "at the constant speed"
-                },
+                "({speed} one revolution takes {:.2} ms{})\n",
                 1e3 * period,
                 value.map_or(String::new(), |v| format!(
-                    ": #1's {} {v:.1} rev is {:.3} s{}",
+                    ": #1's {} {v:.1} rev is {:.3} s{since}",
                     if criterion == Criterion::Median {
                         "median"
                     } else {
                         "restricted mean"
                     },
                     v * period,
-                    if run_up {
-                        " after the rotor reached it"
-                    } else {
-                        ""
-                    }
                 ))
             )
         }
