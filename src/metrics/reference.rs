@@ -14,12 +14,15 @@ pub use crate::model::unbalance::{balancing_error, plane_balancing_errors, refer
 /// A_ref at speed ω: the largest orbit radius over the watched planes
 /// (balancer planes, and the rotor's own unbalance planes) of the locked
 /// response to the rotor's own unbalance (to U in plane 0 when it has none),
-/// with the cargoes' masses but not their unbalance. For the plane rotor this
-/// is U ω² / |k_x − M_Σ ω² + i b_x ω| (its x amplitude, the orbit radius for
-/// isotropic supports), evaluated in that closed form.
+/// with the cargoes' masses but not their unbalance. The orbit radius is its
+/// peak, the measure of r: on anisotropic supports the orbit is an ellipse
+/// and A_ref its major semi-axis. For the plane rotor on isotropic supports
+/// this is U ω² / |k − M_Σ ω² + i b ω|, evaluated in that closed form.
 pub fn a_ref(system: &RotorSystem, omega: f64) -> f64 {
-    if is_plane_translation(system) {
-        return plane_a_ref(system, omega);
+    if is_plane_translation(system)
+        && let Some(a) = isotropic_plane_a_ref(system, omega)
+    {
+        return a;
     }
     plane_a_refs(system, omega).into_iter().fold(0.0, f64::max)
 }
@@ -55,19 +58,25 @@ pub fn plane_whirls(system: &RotorSystem, q: &[f64], out: &mut [f64]) {
     }
 }
 
-/// A_ref = U ω² / |k_x − M_Σ ω² + i b_x ω| for the plane rotor.
-fn plane_a_ref(system: &RotorSystem, omega: f64) -> f64 {
+/// A_ref = U ω² / |k − M_Σ ω² + i b ω| for the plane rotor on isotropic
+/// supports; `None` when x and y differ (the orbit is then an ellipse).
+fn isotropic_plane_a_ref(system: &RotorSystem, omega: f64) -> Option<f64> {
     let rotor = system.rotor();
     let m_total = rotor.mass_matrix()[0][0] + system.cargo().iter().map(|c| c.mass).sum::<f64>();
-    let mut f = [0.0; MAX_DOF];
-    let mut unit = [0.0; MAX_DOF];
-    unit[0] = 1.0;
-    rotor.forces(&unit, &[0.0; MAX_DOF], omega, &mut f);
-    let kx = -f[0];
-    let mut f = [0.0; MAX_DOF];
-    rotor.forces(&[0.0; MAX_DOF], &unit, omega, &mut f);
-    let bx = -f[0];
-    reference_unbalance(system) * omega * omega / (kx - m_total * omega * omega).hypot(bx * omega)
+    // Stiffness and damping along axis i, read off the rotor's forces.
+    let axis = |i: usize| {
+        let mut unit = [0.0; MAX_DOF];
+        unit[i] = 1.0;
+        let (mut fk, mut fb) = ([0.0; MAX_DOF], [0.0; MAX_DOF]);
+        rotor.forces(&unit, &[0.0; MAX_DOF], omega, &mut fk);
+        rotor.forces(&[0.0; MAX_DOF], &unit, omega, &mut fb);
+        (-fk[i], -fb[i])
+    };
+    let (kx, bx) = axis(0);
+    (axis(1) == (kx, bx)).then(|| {
+        reference_unbalance(system) * omega * omega
+            / (kx - m_total * omega * omega).hypot(bx * omega)
+    })
 }
 
 /// Vibration r: the largest displacement |(u_p, v_p)| over the balancer

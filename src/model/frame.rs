@@ -84,7 +84,9 @@ impl RotatingSystem {
         };
         let me = r.mass * r.eccentricity;
         let (s, c) = super::trig::sin_cos(r.unbalance_angle);
-        let effects = scene.effects.build(&cargo, omega);
+        let effects = scene
+            .effects
+            .build(&super::effect::BuildSetup::plane(&cargo, omega));
         Ok(RotatingSystem {
             omega,
             m_total: r.mass + cargo.iter().map(|c| c.mass).sum::<f64>(),

@@ -7,6 +7,7 @@
 //! - [`effect`]: drag, gravity, contact … (one file each, one registry line).
 //! - [`system::RotorSystem`]: the assembled equations (O(n) per call).
 //! - [`forced`]: steady forced response with the cargoes locked.
+//! - [`critical_speeds`]: undamped natural frequencies and critical speeds.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
 //! - [`linear`]: linear stability of the balanced state (rotating frame).
@@ -17,6 +18,7 @@
 pub mod balancer;
 pub mod cargo;
 pub mod coupling;
+pub mod critical_speeds;
 pub mod effect;
 pub mod forced;
 pub mod frame;

@@ -3,8 +3,8 @@
 
 use super::balancer::{self, Geometry, Kind};
 use super::cargo::Cargo;
-use super::effect::{Effects, SceneFacts};
-use super::rotor::{PlaneRotor, RotorModel};
+use super::effect::{BuildSetup, Effects, SceneFacts};
+use super::rotor::RotorModel;
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
 use super::validate::{
@@ -176,7 +176,7 @@ impl Scene {
             });
         }
         self.effects.validate(&SceneFacts {
-            plane_rotor: self.rotor.downcast_ref::<PlaneRotor>().is_some(),
+            planes: self.rotor.as_rotor().planes(),
             prescribed_speed: self.speed.is_prescribed(),
         })?;
         let designs: Vec<(String, &DesignSpec)> = self
@@ -272,12 +272,14 @@ impl Scene {
     pub fn build(&self) -> Result<RotorSystem, SceneError> {
         self.validate()?;
         let cargo = self.cargoes()?;
-        let effects = self.effects.build(&cargo, self.speed.nominal_speed());
-        Ok(RotorSystem::new(
-            self.rotor.build(),
-            cargo,
-            self.speed.clone(),
-            effects,
-        ))
+        let rotor = self.rotor.build();
+        let plane_maps: Vec<_> = (0..rotor.planes()).map(|p| rotor.plane_map(p)).collect();
+        let effects = self.effects.build(&BuildSetup {
+            cargo: &cargo,
+            omega: self.speed.nominal_speed(),
+            plane_maps: &plane_maps,
+            gravity: 0.0,
+        });
+        Ok(RotorSystem::new(rotor, cargo, self.speed.clone(), effects))
     }
 }

@@ -52,7 +52,9 @@ pub fn initial_state(system: &RotorSystem, mode: StartMode, psi0: &[f64]) -> Vec
             y[nq] = xd;
             y[nq + 1] = yd;
         } else {
-            let (fc, fs) = unbalance_forcing(system, psi0, true);
+            let (mut fc, mut fs) = unbalance_forcing(system, psi0, true);
+            // An off-centre race carries the weights' mass off the axis too.
+            system.effects_locked_forcing(&mut fc, &mut fs);
             if let Some(h) = harmonic_response(system, &fc, &fs, rate) {
                 // At t = 0: q = a, q̇ = ω b.
                 for i in 0..lay.rotor_dof {
@@ -78,12 +80,14 @@ pub fn is_plane_translation(system: &RotorSystem) -> bool {
 /// unbalance U e^{i(ωt+θ)} as M_Σ ẍ + b ẋ + k x = ω² U cos(ωt + θ).
 pub fn locked_response(system: &RotorSystem, psi0: &[f64], omega: f64) -> [f64; 4] {
     let (ux, uy) = total_unbalance(system, psi0);
-    // With an off-centre race the weights' own mass is carried at e_r too.
-    let (ex, ey) = system.effects_locked_unbalance();
-    let (ux, uy) = if (ex, ey) == (0.0, 0.0) {
+    // With an off-centre race the weights' own mass is carried at e_r too
+    // (on the plane rotor the cos φ part is (U_x, U_y) itself).
+    let (mut extra, mut turned) = ([0.0; super::rotor::MAX_DOF], [0.0; super::rotor::MAX_DOF]);
+    system.effects_locked_forcing(&mut extra, &mut turned);
+    let (ux, uy) = if extra[..2] == [0.0, 0.0] {
         (ux, uy)
     } else {
-        (ux + ex, uy + ey)
+        (ux + extra[0], uy + extra[1])
     };
     let rotor = system.rotor();
     let m_total = rotor.mass_matrix()[0][0] + system.cargo().iter().map(|c| c.mass).sum::<f64>();

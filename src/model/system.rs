@@ -170,13 +170,13 @@ impl RotorSystem {
         &self.speed
     }
 
-    /// The unbalance (kg·m, (U_x, U_y) at φ = 0) the enabled effects add
-    /// with the weights locked (the race's mass carried off the axis).
-    pub fn effects_locked_unbalance(&self) -> (f64, f64) {
-        self.effects
-            .iter()
-            .map(|e| e.locked_unbalance())
-            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y))
+    /// The rotating force per φ̇² (cos φ and sin φ parts, generalised on the
+    /// rotor coordinates) the enabled effects add with the weights locked
+    /// (the race's mass carried off the axis), added into both.
+    pub fn effects_locked_forcing(&self, cos_part: &mut DofVec, sin_part: &mut DofVec) {
+        for e in &self.effects {
+            e.locked_forcing(cos_part, sin_part);
+        }
     }
 
     /// Names of the enabled effects.

@@ -546,11 +546,7 @@ impl StudyFile {
             .map_err(|(k, v, r)| invalid(&k, v, &r))?;
         if let Some(t) = &s.tolerances {
             let facts = crate::model::effect::SceneFacts {
-                plane_rotor: self
-                    .scene
-                    .rotor
-                    .downcast_ref::<crate::model::rotor::PlaneRotor>()
-                    .is_some(),
+                planes: self.scene.rotor.as_rotor().planes(),
                 prescribed_speed: self.scene.speed.is_prescribed(),
             };
             super::tolerance::validate(t, &designs, &facts)

@@ -56,6 +56,10 @@ pub fn speed_grid(lo: f64, hi: f64, points: usize) -> Vec<f64> {
 /// The closed-form prediction of seed 003 for a two-support rotor at ω.
 fn closed_form(rotor: &RotorModel, omega: f64) -> Option<bool> {
     let r = rotor.downcast_ref::<TwoSupportRotor>()?;
+    // Seed 003's criterion is derived for isotropic supports.
+    if !r.is_isotropic() {
+        return None;
+    }
     let p = r.criterion_params();
     let ranges = if r.planes.len() == 1 {
         static_ranges(&p, r.planes[0]).ok()?

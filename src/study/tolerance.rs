@@ -139,11 +139,11 @@ pub fn validate(
                 "an offset has no nominal size to be relative to: give sigma in m".into(),
             ));
         }
-        if !(facts.plane_rotor && facts.prescribed_speed) {
+        if !facts.prescribed_speed {
             return Err((
                 key("sigma"),
                 tol.sigma.to_string(),
-                "race eccentricity is modelled for the plane rotor at a prescribed speed only"
+                "race eccentricity is modelled at a prescribed speed (constant or ramp) only"
                     .into(),
             ));
         }
@@ -330,18 +330,17 @@ pub fn apply(
             tol.sigma * truncated(&mut rng, tol.limit),
             tol.sigma * truncated(&mut rng, tol.limit),
         );
-        let (x0, y0) = scene
-            .effects
-            .race_eccentricity
-            .as_ref()
-            .map_or((0.0, 0.0), |e| {
-                let a = e.angle_deg.to_radians();
-                (e.offset * a.cos(), e.offset * a.sin())
-            });
+        let nominal = scene.effects.race_eccentricity.as_ref();
+        let (x0, y0) = nominal.map_or((0.0, 0.0), |e| {
+            let a = e.angle_deg.to_radians();
+            (e.offset * a.cos(), e.offset * a.sin())
+        });
+        let plane = nominal.and_then(|e| e.plane);
         let (x, y) = (x0 + dx, y0 + dy);
         scene.effects.race_eccentricity = Some(RaceEccentricity {
             offset: x.hypot(y),
             angle_deg: y.atan2(x).to_degrees(),
+            plane,
         });
     }
     let weights = SampledWeights {

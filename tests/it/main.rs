@@ -18,6 +18,7 @@ mod decisions;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;
+mod every_rotor;
 mod extremes;
 mod fixtures;
 mod fuzz_cli;

@@ -318,7 +318,9 @@ fn vertical_axis_gravity_adds_no_term() {
         ..Effects::default()
     };
     // Weights without drag, so that gravity is the only candidate.
-    assert!(effects.build(&balls(2, 0.01, 0.0), 2.0).is_empty());
+    let weights = balls(2, 0.01, 0.0);
+    let setup = autobal::model::effect::BuildSetup::plane(&weights, 2.0);
+    assert!(effects.build(&setup).is_empty());
     let g = autobal::model::effect::gravity::Gravity {
         g: 9.81,
         axis_inclination_deg: 0.0,
@@ -328,7 +330,7 @@ fn vertical_axis_gravity_adds_no_term() {
             gravity: Some(g),
             ..Effects::default()
         }
-        .build(&balls(2, 0.01, 0.0), 2.0)
+        .build(&setup)
         .len(),
         1
     );

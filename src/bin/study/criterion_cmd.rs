@@ -61,6 +61,14 @@ pub fn run(args: &CriterionArgs) -> Result<(), UserError> {
         ));
     };
     rotor.validate()?;
+    if !rotor.is_isotropic() {
+        return Err(UserError(
+            format!(
+                "{shown}: rotor.k1y, k2y, b1y, b2y: the closed-form criterion (seed 003) is derived for isotropic supports; `study sweep` simulates an anisotropic rotor"
+            ),
+            2,
+        ));
+    }
     let p = rotor.criterion_params();
     let res = resonances(&p)?;
     let planes = rotor

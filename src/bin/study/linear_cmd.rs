@@ -38,7 +38,16 @@ pub fn run(args: &LinearArgs) -> Result<(), UserError> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", describe(&report, simulation.metrics.delta));
+        let critical = autobal::model::critical_speeds::critical_speeds_in_range(&system);
+        let text = format!(
+            "{}{}",
+            describe(&report, simulation.metrics.delta),
+            crate::simulate_cmd::critical_speeds_line(critical.as_deref())
+        );
+        print!(
+            "{}",
+            crate::output::wrap(&text, crate::output::text_width())
+        );
     }
     Ok(())
 }

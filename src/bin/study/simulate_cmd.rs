@@ -2,6 +2,7 @@
 
 use crate::UserError;
 use autobal::metrics::RunMetrics;
+use autobal::model::critical_speeds::critical_speeds_in_range;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
 use autobal::study::io::{Provenance, write_series};
@@ -40,6 +41,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     if let Some(path) = &args.series {
         prepare("--series", path, WhenExists::from_overwrite(args.overwrite))?;
     }
+    let critical = simulation
+        .scene
+        .build()
+        .ok()
+        .and_then(|system| critical_speeds_in_range(&system));
     let result = simulation.run(args.series.is_some())?;
     if let (Some(path), Some(series)) = (&args.series, &result.series) {
         let text = autobal::input_file::read_text(&args.scene)?;
@@ -51,10 +57,39 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     } else {
         print!(
             "{}",
-            crate::output::wrap(&describe(&result.metrics), crate::output::text_width())
+            crate::output::wrap(
+                &format!(
+                    "{}{}",
+                    describe(&result.metrics),
+                    critical_speeds_line(critical.as_deref())
+                ),
+                crate::output::text_width()
+            )
         );
     }
     Ok(())
+}
+
+/// The model's undamped critical speeds, to compare with a rig's measured
+/// resonances before trusting the rest.
+pub fn critical_speeds_line(speeds: Option<&[f64]>) -> String {
+    let text = match speeds {
+        Some([]) => "none (no spin equals a natural frequency)".to_string(),
+        Some(speeds) => {
+            let list = |scale: f64| {
+                let each: Vec<String> =
+                    speeds.iter().map(|s| format!("{:.4}", s * scale)).collect();
+                each.join(", ")
+            };
+            format!(
+                "{} rad/s = {} rpm",
+                list(1.0),
+                list(60.0 / std::f64::consts::TAU)
+            )
+        }
+        None => "– (not computed: singular mass matrix)".to_string(),
+    };
+    format!("critical speeds    {text} (undamped, weights locked)\n")
 }
 
 fn describe(m: &RunMetrics) -> String {

@@ -12,7 +12,7 @@
 //! keeps a call O(n log n) instead of O(n²): two weights can only overlap if
 //! no third sits between them, short of a third weight already sunk into both.
 
-use super::{Effect, EffectContext, EffectSpec, Forces};
+use super::{BuildSetup, Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
 use crate::model::race_ring::{MAX_RING, for_each_neighbour_pair};
 use crate::model::validate::{SceneError, invalid};
@@ -84,8 +84,8 @@ impl EffectSpec for ContactSpec {
         Ok(())
     }
 
-    fn build(&self, cargo: &[Cargo], omega: f64) -> Option<Box<dyn Effect>> {
-        Contact::new(self, cargo, omega).map(|c| Box::new(c) as Box<dyn Effect>)
+    fn build(&self, setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>> {
+        Contact::new(self, setup.cargo, setup.omega).map(|c| Box::new(c) as Box<dyn Effect>)
     }
 }
 

@@ -3,8 +3,7 @@
 //! the static equilibrium, so only the cargoes and, at variable speed, the
 //! rotor's own unbalance feel it.
 
-use super::{Effect, EffectContext, EffectSpec, Forces};
-use crate::model::cargo::Cargo;
+use super::{BuildSetup, Effect, EffectContext, EffectSpec, Forces};
 use crate::model::validate::{SceneError, invalid, non_negative};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -50,7 +49,7 @@ impl EffectSpec for Gravity {
         Ok(())
     }
 
-    fn build(&self, _cargo: &[Cargo], _omega: f64) -> Option<Box<dyn Effect>> {
+    fn build(&self, _setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>> {
         (self.in_plane() != 0.0).then(|| Box::new(self.clone()) as Box<dyn Effect>)
     }
 

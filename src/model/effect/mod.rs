@@ -66,19 +66,50 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn rotor_forces_from_weights(&self) -> bool {
         true
     }
-    /// The unbalance (kg·m, rotor axes at φ = 0, as (U_x, U_y)) the effect
-    /// adds when the weights are locked to the rotor: what a locked start's
-    /// forced response must include. None by default.
-    fn locked_unbalance(&self) -> (f64, f64) {
-        (0.0, 0.0)
+    /// The rotating force per φ̇² the effect adds when the weights are
+    /// locked to the rotor, as generalised forces on the rotor coordinates:
+    /// `cos_part`·cos φ + `sin_part`·sin φ (added into both). What a locked
+    /// start's forced response must include; nothing by default.
+    fn locked_forcing(&self, _cos_part: &mut DofVec, _sin_part: &mut DofVec) {}
+}
+
+/// What an effect is built from: the weights, the nominal speed and where
+/// each balancer plane sits on the rotor.
+pub struct BuildSetup<'a> {
+    /// The cargoes, each tagged with its plane.
+    pub cargo: &'a [Cargo],
+    /// Nominal spin speed ω (rad/s).
+    pub omega: f64,
+    /// Map (G_u, G_v) of each balancer plane
+    /// ([`crate::model::rotor::Rotor::plane_map`]).
+    pub plane_maps: &'a [[DofVec; 2]],
+    /// Gravity in the rotor plane, g cos α along −Y (m/s²; 0 without the
+    /// gravity effect): what presses a weight on its race besides its
+    /// centripetal load, for effects that need the contact force.
+    pub gravity: f64,
+}
+
+/// The plane rotor's one plane: its centre is the rotor's (x, y).
+const PLANE_ROTOR_MAP: [[DofVec; 2]; 1] = [[[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]];
+
+impl<'a> BuildSetup<'a> {
+    /// The set-up on a rotor with one balancer plane at its (x, y) (the
+    /// plane rotor, and the rotating frame written for it).
+    pub fn plane(cargo: &'a [Cargo], omega: f64) -> Self {
+        BuildSetup {
+            cargo,
+            omega,
+            plane_maps: &PLANE_ROTOR_MAP,
+            gravity: 0.0,
+        }
     }
 }
 
 /// What an effect may need to know of the rest of the scene to accept it.
 #[derive(Debug, Clone, Copy)]
 pub struct SceneFacts {
-    /// The rotor is the plane (Jeffcott) rotor: one race, (x, y) coordinates.
-    pub plane_rotor: bool,
+    /// Number of balancer planes (races) the rotor carries.
+    pub planes: usize,
     /// The speed law is prescribed (constant or ramp), not a motor or free.
     pub prescribed_speed: bool,
 }
@@ -93,9 +124,9 @@ pub trait EffectSpec {
     fn check_scene(&self, _key: &str, _facts: &SceneFacts) -> Result<(), SceneError> {
         Ok(())
     }
-    /// The effect for these cargoes at nominal speed `omega`; `None` when it
-    /// would add nothing, so the right-hand side skips it altogether.
-    fn build(&self, cargo: &[Cargo], omega: f64) -> Option<Box<dyn Effect>>;
+    /// The effect for this set-up; `None` when it would add nothing, so the
+    /// right-hand side skips it altogether.
+    fn build(&self, setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>>;
     /// Why the rotating-frame formulation cannot include this effect, if so.
     fn rotating_frame_obstacle(&self) -> Option<&'static str> {
         None
@@ -206,15 +237,19 @@ impl Effects {
         Ok(())
     }
 
-    /// Build the effects for these cargoes at nominal speed `omega`, intrinsic
-    /// ones first; an effect that would add nothing is left out.
-    pub fn build(&self, cargo: &[Cargo], omega: f64) -> Vec<Box<dyn Effect>> {
+    /// Build the effects for this set-up, intrinsic ones first; an effect
+    /// that would add nothing is left out.
+    pub fn build(&self, setup: &BuildSetup<'_>) -> Vec<Box<dyn Effect>> {
+        let setup = &BuildSetup {
+            gravity: self
+                .gravity
+                .as_ref()
+                .map_or(0.0, gravity::Gravity::in_plane),
+            ..*setup
+        };
         let mut list = Vec::new();
-        build_intrinsic(cargo, omega, &mut list);
-        list.extend(
-            self.enabled()
-                .filter_map(|(_, spec)| spec.build(cargo, omega)),
-        );
+        build_intrinsic(setup.cargo, setup.omega, &mut list);
+        list.extend(self.enabled().filter_map(|(_, spec)| spec.build(setup)));
         list
     }
 

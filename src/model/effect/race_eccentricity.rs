@@ -16,14 +16,20 @@
 //! whirling at exactly r = e_r whatever the weights' mass (derivation in
 //! docs/model.md, test in tests/it/race_eccentricity.rs).
 //!
-//! The terms above are complete for a prescribed speed on the plane rotor. A
-//! motor or free rotor would also need the ψ-dependent moment of inertia
-//! about the axis, m(e_r² + 2 e_r l cos(ψ − θ)), in the mass matrix, which an
-//! effect (a force) cannot add; a rotor with several planes would need to
-//! know which race is off-centre. Both are refused.
+//! On any rotor the race centre is its plane's centre, z = G q (the plane map
+//! of [`crate::model::rotor::Rotor::plane_map`]), so the rotor force above is
+//! the plane's force mapped by Gᵀ: the same kinetic energy, nothing else
+//! changes. `plane` picks one race; absent, every race is off-centre by the
+//! same offset and angle (one balancer plane: its race).
+//!
+//! The terms above are complete for a prescribed speed. A motor or free
+//! rotor would also need the ψ-dependent moment of inertia about the axis,
+//! m(e_r² + 2 e_r l cos(ψ − θ)), in the mass matrix, which an effect (a
+//! force) cannot add: refused.
 
-use super::{Effect, EffectContext, EffectSpec, Forces, SceneFacts};
+use super::{BuildSetup, Effect, EffectContext, EffectSpec, Forces, SceneFacts};
 use crate::model::cargo::Cargo;
+use crate::model::rotor::{DofVec, MAX_DOF};
 use crate::model::validate::{SceneError, invalid, non_negative};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -38,6 +44,10 @@ pub struct RaceEccentricity {
     /// `rotor.unbalance_angle` and the weights' angles (degrees).
     #[serde(default)]
     pub angle_deg: f64,
+    /// The balancer plane whose race is off-centre (index into the rotor's
+    /// planes); absent, every race.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<usize>,
 }
 
 impl EffectSpec for RaceEccentricity {
@@ -64,8 +74,17 @@ impl EffectSpec for RaceEccentricity {
                 reason: why.to_string(),
             })
         };
-        if !facts.plane_rotor {
-            return refuse("race eccentricity is modelled for the plane rotor only (one race)");
+        if let Some(p) = self.plane
+            && p >= facts.planes
+        {
+            return Err(SceneError::Invalid {
+                field: format!("{key}.plane"),
+                value: p.to_string(),
+                reason: format!(
+                    "the rotor has {} balancer plane(s), numbered from 0",
+                    facts.planes
+                ),
+            });
         }
         if !facts.prescribed_speed {
             return refuse(
@@ -75,27 +94,53 @@ impl EffectSpec for RaceEccentricity {
         Ok(())
     }
 
-    fn build(&self, cargo: &[Cargo], _omega: f64) -> Option<Box<dyn Effect>> {
-        (self.offset > 0.0).then(|| {
+    fn build(&self, setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>> {
+        let off_centre = |c: &Cargo| self.plane.is_none_or(|p| p == c.plane);
+        let cargo = setup.cargo;
+        (self.offset > 0.0 && cargo.iter().any(off_centre)).then(|| {
             let angle = self.angle_deg.to_radians();
+            // Σ over the off-centre planes of m_Σ,p e_r Gᵀ(cos θ, sin θ)
+            // and Gᵀ(−sin θ, cos θ): the rotor force's two directions.
+            let (mut along, mut across) = ([0.0; MAX_DOF], [0.0; MAX_DOF]);
+            for c in cargo.iter().filter(|c| off_centre(c)) {
+                let [gu, gv] = setup.plane_maps[c.plane];
+                let (s, co) = angle.sin_cos();
+                let me = c.mass * self.offset;
+                for i in 0..MAX_DOF {
+                    along[i] += me * (co * gu[i] + s * gv[i]);
+                    across[i] += me * (co * gv[i] - s * gu[i]);
+                }
+            }
             Box::new(OffCentreRace {
                 angle,
                 mass_offset_track: cargo
                     .iter()
-                    .map(|c| c.mass * self.offset * c.track_radius)
+                    .map(|c| {
+                        if off_centre(c) {
+                            c.mass * self.offset * c.track_radius
+                        } else {
+                            0.0
+                        }
+                    })
                     .collect(),
-                mass_offset: cargo.iter().map(|c| c.mass).sum::<f64>() * self.offset,
+                along,
+                across,
             }) as Box<dyn Effect>
         })
     }
 }
 
-/// The built effect, with m_j e_r l_j and m_Σ e_r once per run.
+/// The built effect, with m_j e_r l_j per weight (0 on a centred race) and
+/// the rotor force's generalised directions once per run.
 #[derive(Debug, Clone, PartialEq)]
 struct OffCentreRace {
     angle: f64,
     mass_offset_track: Vec<f64>,
-    mass_offset: f64,
+    /// Gᵀ m_Σ e_r e^{iθ} summed over the off-centre races: the force per φ̇²
+    /// at φ = 0 (cos φ part).
+    along: DofVec,
+    /// Gᵀ of i m_Σ e_r e^{iθ}: the sin φ part.
+    across: DofVec,
 }
 
 impl Effect for OffCentreRace {
@@ -103,10 +148,12 @@ impl Effect for OffCentreRace {
         "race_eccentricity"
     }
 
-    /// The weights' own mass m_Σ carried at e_r e^{iθ}.
-    fn locked_unbalance(&self) -> (f64, f64) {
-        let (s, c) = self.angle.sin_cos();
-        (self.mass_offset * c, self.mass_offset * s)
+    /// The weights' own mass m_Σ carried at e_r e^{iθ} in each off-centre plane.
+    fn locked_forcing(&self, cos_part: &mut DofVec, sin_part: &mut DofVec) {
+        for i in 0..MAX_DOF {
+            cos_part[i] += self.along[i];
+            sin_part[i] += self.across[i];
+        }
     }
 
     fn apply(&self, ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
@@ -120,11 +167,16 @@ impl Effect for OffCentreRace {
             let (s, c) = crate::model::trig::sin_cos(psi - self.angle);
             *f -= mel * (rate * rate * s + accel * c);
         }
-        // ctx.phi is 0 in the rotating frame: the force is then in rotor axes.
-        let (s, c) = crate::model::trig::sin_cos(ctx.phi + self.angle);
-        let (radial, tangential) = (self.mass_offset * rate * rate, self.mass_offset * accel);
-        forces.rotor[0] += radial * c + tangential * s;
-        forces.rotor[1] += radial * s - tangential * c;
+        // m_Σ e_r (φ̇² − iφ̈) e^{i(φ+θ)} mapped by Gᵀ: the plane force at
+        // angle φ is cos φ·along + sin φ·across per φ̇², and the φ̈ part is
+        // that force turned back by a quarter turn. ctx.phi is 0 in the
+        // rotating frame: the force is then in rotor axes.
+        let (s, c) = crate::model::trig::sin_cos(ctx.phi);
+        let (w2, a) = (rate * rate, accel);
+        for i in 0..MAX_DOF {
+            let (p, q) = (self.along[i], self.across[i]);
+            forces.rotor[i] += w2 * (c * p + s * q) + a * (s * p - c * q);
+        }
     }
 }
 
@@ -137,10 +189,11 @@ mod tests {
         let spec = RaceEccentricity {
             offset: 0.0,
             angle_deg: 30.0,
+            plane: None,
         };
-        assert!(spec.build(&[], 300.0).is_none());
+        assert!(spec.build(&BuildSetup::plane(&[], 300.0)).is_none());
         let facts = SceneFacts {
-            plane_rotor: false,
+            planes: 1,
             prescribed_speed: false,
         };
         assert!(
@@ -154,28 +207,36 @@ mod tests {
         let spec = RaceEccentricity {
             offset: 1e-5,
             angle_deg: 0.0,
+            plane: None,
         };
         let key = "effects.race_eccentricity";
-        for facts in [
-            SceneFacts {
-                plane_rotor: false,
+        let refused = |spec: &RaceEccentricity, planes, prescribed_speed| match spec.check_scene(
+            key,
+            &SceneFacts {
+                planes,
+                prescribed_speed,
+            },
+        ) {
+            Err(SceneError::Invalid { field, .. }) => field,
+            other => panic!("expected a refusal, got {other:?}"),
+        };
+        assert_eq!(refused(&spec, 1, false), format!("{key}.offset"));
+        let third = RaceEccentricity {
+            plane: Some(2),
+            ..spec.clone()
+        };
+        assert_eq!(refused(&third, 2, true), format!("{key}.plane"));
+        for planes in [1, 2] {
+            let facts = SceneFacts {
+                planes,
                 prescribed_speed: true,
-            },
-            SceneFacts {
-                plane_rotor: true,
-                prescribed_speed: false,
-            },
-        ] {
-            match spec.check_scene(key, &facts) {
-                Err(SceneError::Invalid { field, .. }) => {
-                    assert_eq!(field, format!("{key}.offset"))
-                }
-                other => panic!("expected a refusal, got {other:?}"),
-            }
+            };
+            assert!(spec.check_scene(key, &facts).is_ok());
         }
         let negative = RaceEccentricity {
             offset: -1e-5,
             angle_deg: 0.0,
+            plane: None,
         };
         assert!(negative.validate(key).is_err());
     }

@@ -1,10 +1,14 @@
-//! The rigid axisymmetric rotor on two isotropic elastic supports of seed 003
-//! (eqs 2–3), carrying auto-balancers in any number of planes z_p.
+//! The rigid axisymmetric rotor on two elastic supports of seed 003
+//! (eqs 2–3), carrying auto-balancers in any number of planes z_p. Seed 003's
+//! supports are isotropic; each support may also be stiffer (or more damped)
+//! along x than along y, as real bearing pedestals are: the x–β and y–α
+//! planes then have their own k11, k14, k33 (below).
 //!
 //! Coordinates q = (x, y, α, β): the centre of mass G's displacement and the
 //! small Resal angles of the axis about x and y, so that the axis point at z
 //! moves by (x + zβ, y − zα) (eq 24). Supports of stiffness k1 at z = −l1
-//! and k2 at z = +l2, viscous dampers b1, b2 beside them.
+//! and k2 at z = +l2, viscous dampers b1, b2 beside them; `k1y`, `k2y`,
+//! `b1y`, `b2y`, when given, are the y values and k1, k2, b1, b2 the x ones.
 //!
 //! Kinetic energy (derived, small tilts):
 //! T = ½M(ẋ² + ẏ²) + ½A(α̇² + β̇²) + ½Cφ̇² + ½Cφ̇(α̇β − αβ̇),
@@ -13,7 +17,9 @@
 //! Cφ̇α̇β by d/dt(½Cφ̇αβ) and a term φ̈αβ of third order). Lagrange gives eq 2
 //! at constant speed (gyroscopic terms ±Cφ̇β̇, ∓Cφ̇α̇), a φ̈ coupling
 //! ½C(β, −α) at variable speed, and conserves the angular momentum about the
-//! axis. Potential: ½k11(x² + y²) + ½k33(α² + β²) + k14(xβ − yα).
+//! axis. Potential: ½k11(x² + y²) + ½k33(α² + β²) + k14(xβ − yα), or with
+//! anisotropic supports ½Σ_s k_sx (x + z_s β)² + ½Σ_s k_sy (y − z_s α)² over
+//! the supports at z_s, i.e. the x and y coefficient sets of eq 3 apart.
 //!
 //! Cargoes are point masses in their plane: by default they see the plane
 //! centre's displacement only. With `weights_tilt_inertia` their motion
@@ -68,6 +74,18 @@ pub struct TwoSupportRotor {
     /// Damping at support 2 (N·s/m).
     #[serde(default)]
     pub b2: f64,
+    /// Stiffness of support 1 along y (N/m); absent: `k1` (isotropic).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k1y: Option<f64>,
+    /// Stiffness of support 2 along y (N/m); absent: `k2` (isotropic).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k2y: Option<f64>,
+    /// Damping at support 1 along y (N·s/m); absent: `b1`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub b1y: Option<f64>,
+    /// Damping at support 2 along y (N·s/m); absent: `b2`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub b2y: Option<f64>,
     /// Axial positions z_p of the balancer planes (m), plane p = index.
     pub planes: Vec<f64>,
     /// Static unbalance |S| (kg·m), added to the point unbalances.
@@ -121,7 +139,22 @@ impl TwoSupportRotor {
         ((self.l2 * s - i) / span, (self.l1 * s + i) / span)
     }
 
-    /// The parameters of seed 003's criterion for this rotor.
+    /// Stiffnesses (k1, k2) and dampings (b1, b2) of the supports along y.
+    fn y_supports(&self) -> ((f64, f64), (f64, f64)) {
+        (
+            (self.k1y.unwrap_or(self.k1), self.k2y.unwrap_or(self.k2)),
+            (self.b1y.unwrap_or(self.b1), self.b2y.unwrap_or(self.b2)),
+        )
+    }
+
+    /// True when both supports are the same along x and y (seed 003's
+    /// rotor, whose criterion and rotating frame assume it).
+    pub fn is_isotropic(&self) -> bool {
+        self.y_supports() == ((self.k1, self.k2), (self.b1, self.b2))
+    }
+
+    /// The parameters of seed 003's criterion for this rotor (isotropic
+    /// supports: the x values).
     pub fn criterion_params(&self) -> crate::design::criterion::TwoSupportParams {
         crate::design::criterion::TwoSupportParams {
             mass: self.mass,
@@ -187,14 +220,18 @@ impl Rotor for TwoSupportRotor {
     }
 
     fn forces(&self, q: &[f64], qd: &[f64], spin_rate: f64, f: &mut DofVec) {
+        // x–β plane with the x supports, y–α plane with the y supports.
         let (k11, k14, k33) = self.combine(self.k1, self.k2);
         let (c11, c14, c33) = self.combine(self.b1, self.b2);
+        let ((k1y, k2y), (b1y, b2y)) = self.y_supports();
+        let (k11y, k14y, k33y) = self.combine(k1y, k2y);
+        let (c11y, c14y, c33y) = self.combine(b1y, b2y);
         let (x, y, a, b) = (q[0], q[1], q[2], q[3]);
         let (xd, yd, ad, bd) = (qd[0], qd[1], qd[2], qd[3]);
         let gyro = self.polar_inertia * spin_rate;
         f[0] -= k11 * x + k14 * b + c11 * xd + c14 * bd;
-        f[1] -= k11 * y - k14 * a + c11 * yd - c14 * ad;
-        f[2] -= k33 * a - k14 * y + c33 * ad - c14 * yd + gyro * bd;
+        f[1] -= k11y * y - k14y * a + c11y * yd - c14y * ad;
+        f[2] -= k33y * a - k14y * y + c33y * ad - c14y * yd + gyro * bd;
         f[3] -= k33 * b + k14 * x + c33 * bd + c14 * xd - gyro * ad;
     }
 
@@ -262,6 +299,12 @@ impl RotorParams for TwoSupportRotor {
         positive("rotor.k2", self.k2)?;
         non_negative("rotor.b1", self.b1)?;
         non_negative("rotor.b2", self.b2)?;
+        for (name, k) in [("rotor.k1y", self.k1y), ("rotor.k2y", self.k2y)] {
+            k.map_or(Ok(()), |k| positive(name, k))?;
+        }
+        for (name, b) in [("rotor.b1y", self.b1y), ("rotor.b2y", self.b2y)] {
+            b.map_or(Ok(()), |b| non_negative(name, b))?;
+        }
         non_negative("rotor.static_unbalance", self.static_unbalance)?;
         non_negative("rotor.moment_unbalance", self.moment_unbalance)?;
         for (name, v) in [
