@@ -249,3 +249,22 @@ fn a_ref_on_anisotropic_supports_is_the_orbit_s_major_semi_axis() {
     assert!(axis(ky) > 1.5 * axis(kx));
     assert!((got / want - 1.0).abs() < 1e-12, "{got} vs {want}");
 }
+
+#[test]
+fn the_shipped_bristol_rig_has_the_measured_resonances() {
+    // Rodrigues et al. (2011) measured 1415, 1675, 1944 and 2310 rpm; the
+    // scene's supports are calibrated to them (scripts/calibrate-bristol-rig.py)
+    // and this checks the calibration with autobal's own eigen-analysis.
+    let text = std::fs::read_to_string("scenes/bristol_rig.toml").expect("shipped scene");
+    let speeds = autobal::model::critical_speeds::critical_speeds_in_range(&system(&text))
+        .expect("computed");
+    let rpm: Vec<f64> = speeds
+        .iter()
+        .map(|w| w * 60.0 / std::f64::consts::TAU)
+        .collect();
+    let measured = [1415.0, 1675.0, 1944.0, 2310.0];
+    assert_eq!(rpm.len(), 4, "{rpm:?}");
+    for (got, want) in rpm.iter().zip(measured) {
+        assert!((got - want).abs() < 1.0, "{rpm:?} vs {measured:?}");
+    }
+}
