@@ -32,7 +32,7 @@ MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",
      "tilt_inertia", "sommerfeld"},
     {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "quasi_static", "start",
-     "unbalance", "zero_approx"},
+     "unbalance", "zero_approx", "critical_speeds"},
 ]
 STUDY_LAYERS = [
     # Plain data and helpers: streams, distributions, a resolved design, a

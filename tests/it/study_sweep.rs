@@ -233,3 +233,42 @@ fn study_sweep_writes_one_row_per_speed() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
 }
+
+#[test]
+fn a_sweep_never_says_none_for_an_analysis_that_did_not_run() {
+    // Anisotropic supports: the rotating frame, and so the linear analysis,
+    // does not hold; the old summary said "linearly stable: none".
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tmp.path().join("aniso.toml");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/three_balls.toml"
+    ))
+    .unwrap()
+    .replace("ky = 1.0", "ky = 1.3")
+    .replace("t_end_revs = 1000", "t_end_revs = 100");
+    std::fs::write(&scene, text).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .args([
+            "sweep",
+            scene.to_str().unwrap(),
+            "--omega",
+            "3..4",
+            "--points",
+            "2",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("balanced state linearly stable"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("not analysed"), "{line}");
+    assert!(!line.contains("none"), "{line}");
+}

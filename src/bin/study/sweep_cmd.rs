@@ -134,9 +134,14 @@ fn describe(points: &[SweepPoint]) -> String {
             show(ranges(points, |p| p.closed_form == Some(true)))
         );
     }
+    // "none" would claim an analysis that never ran: say so instead.
+    let linear = if points.iter().any(|p| p.linear_stable.is_some()) {
+        show(ranges(points, |p| p.linear_stable == Some(true)))
+    } else {
+        "– (not analysed at any speed: the rotating frame does not hold for this scene; `study linear` says why)".to_string()
+    };
     s += &format!(
-        "balanced state linearly stable         {}\nbalancing simulated (settled)          {}\n",
-        show(ranges(points, |p| p.linear_stable == Some(true))),
+        "balanced state linearly stable         {linear}\nbalancing simulated (settled)          {}\n",
         show(ranges(points, |p| p.settled))
     );
     s
