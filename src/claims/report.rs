@@ -5,7 +5,7 @@ use super::{ClaimsOutput, DesignResult};
 use crate::design::geometry::{rho_half_race, sector_angle};
 use crate::design::optimum::optimal_rho;
 use crate::model::balancer::Kind;
-use crate::model::rotor::{PlaneRotor, RotorModel};
+use crate::model::rotor::RotorModel;
 use crate::stats::holm::holm_adjust;
 use crate::study::config::StudyPlan;
 use crate::study::criterion::Criterion;
@@ -174,12 +174,15 @@ fn disagreement(c: &Comparison, holm: &[f64], alpha: f64, a: &str, b: &str) -> S
 
 /// One line describing the rotor of the study.
 fn rotor_description(rotor: &RotorModel) -> String {
-    match rotor.downcast_ref::<PlaneRotor>() {
-        Some(r) => format!(
-            "plane, M = {} kg, k = {:.3e} N/m, b = {} N·s/m",
-            r.mass, r.kx, r.bx
+    match rotor.as_rotor().isotropic_plane() {
+        Ok(r) => format!(
+            "{}, M = {} kg, k = {:.3e} N/m, b = {} N·s/m",
+            rotor.name(),
+            r.mass,
+            r.stiffness,
+            r.damping
         ),
-        None => rotor.name().to_string(),
+        Err(_) => rotor.name().to_string(),
     }
 }
 

@@ -113,12 +113,35 @@ pub fn harmonic_response_with(
 /// Largest radius of plane p's orbit (the larger singular value of the
 /// 2 × 2 map from (cos ωt, sin ωt) to the plane's (u, v)).
 pub fn plane_orbit_radius(h: &Harmonic, map: &[DofVec; 2]) -> f64 {
+    plane_orbit_axes(h, map).0
+}
+
+/// Semi-axes (major, minor) of plane p's elliptic orbit: the singular
+/// values of the 2 × 2 map from (cos ωt, sin ωt) to the plane's (u, v).
+pub fn plane_orbit_axes(h: &Harmonic, map: &[DofVec; 2]) -> (f64, f64) {
     let dot = |g: &DofVec, v: &DofVec| g.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
     let (au, bu) = (dot(&map[0], &h.cos), dot(&map[0], &h.sin));
     let (av, bv) = (dot(&map[1], &h.cos), dot(&map[1], &h.sin));
     let t = au * au + bu * bu + av * av + bv * bv;
     let d = au * bv - bu * av;
-    (0.5 * (t + (t * t - 4.0 * d * d).max(0.0).sqrt())).sqrt()
+    let root = (t * t - 4.0 * d * d).max(0.0).sqrt();
+    (
+        (0.5 * (t + root)).sqrt(),
+        (0.5 * (t - root)).max(0.0).sqrt(),
+    )
+}
+
+/// How far a unit unbalance (1 kg·m) turning with the rotor in balancer
+/// plane `plane` moves that plane's centre at speed ω, the rotor alone (no
+/// weights' mass): the orbit's minor semi-axis (m per kg·m), so that the
+/// unbalance needed to hold the plane centre a distance e off its orbit is
+/// at most e over it. On the plane rotor it is ω²/|k − Mω² + ibω| per axis.
+/// `None` at an undamped resonance.
+pub fn plane_compliance(system: &RotorSystem, plane: usize, omega: f64) -> Option<f64> {
+    let rotor = system.rotor();
+    let [gu, gv] = rotor.plane_map(plane);
+    let h = harmonic_response_with(system, &rotor.mass_matrix(), &gu, &gv, omega)?;
+    Some(plane_orbit_axes(&h, &[gu, gv]).1)
 }
 
 /// Gaussian elimination with partial pivoting on an augmented matrix.

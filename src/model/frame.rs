@@ -16,7 +16,6 @@
 
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
-use super::rotor::PlaneRotor;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
@@ -25,11 +24,8 @@ use std::cell::RefCell;
 
 /// Why a scene cannot use the rotating frame.
 pub fn rotating_frame_obstacle(scene: &Scene) -> Option<&'static str> {
-    let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
-        return Some("only the plane rotor has a rotating-frame formulation");
-    };
-    if r.kx != r.ky || r.bx != r.by {
-        return Some("anisotropic supports make the rotating-frame equations time-dependent");
+    if let Err(why) = scene.rotor.as_rotor().isotropic_plane() {
+        return Some(why);
     }
     if !matches!(scene.speed, SpeedLaw::Constant { .. }) {
         return Some("the speed is not constant");
@@ -79,10 +75,10 @@ impl RotatingSystem {
             unreachable!("checked above")
         };
         let cargo = scene.cargoes()?;
-        let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
+        let Ok(r) = scene.rotor.as_rotor().isotropic_plane() else {
             unreachable!("checked above")
         };
-        let me = r.mass * r.eccentricity;
+        let me = r.unbalance;
         let (s, c) = super::trig::sin_cos(r.unbalance_angle);
         let effects = scene
             .effects
@@ -90,8 +86,8 @@ impl RotatingSystem {
         Ok(RotatingSystem {
             omega,
             m_total: r.mass + cargo.iter().map(|c| c.mass).sum::<f64>(),
-            k: r.kx,
-            b: r.bx,
+            k: r.stiffness,
+            b: r.damping,
             unbalance_force: (me * omega * omega * c, me * omega * omega * s),
             inertia: cargo.iter().map(Cargo::inertia).collect(),
             inv_inertia: cargo.iter().map(|c| 1.0 / c.inertia()).collect(),

@@ -13,7 +13,6 @@
 //! overdamped limit, λ ≈ −(1 − p) m n b_cr²/(4 b̃). The n − 2 zero roots are
 //! the neutral family of balanced positions.
 
-use super::rotor::PlaneRotor;
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::start::balanced_fan;
@@ -42,8 +41,8 @@ pub enum AnalyticError {
     /// The cargoes cannot cancel the unbalance.
     #[error("the unbalance exceeds what the cargoes can cancel")]
     NotBalanceable,
-    /// The closed form is derived for the plane rotor.
-    #[error("the analytic estimate is derived for the plane rotor")]
+    /// The closed form is derived for a plane rotor on isotropic supports.
+    #[error("the analytic estimate is derived for the plane rotor on isotropic supports")]
     NotPlane,
     /// The closed form needs drag.
     #[error("the analytic estimate needs a positive drag")]
@@ -65,15 +64,15 @@ pub fn slow_mode(scene: &Scene) -> Result<SlowMode, AnalyticError> {
     if first.drag <= 0.0 {
         return Err(AnalyticError::NoDrag);
     }
-    let Some(r) = scene.rotor.downcast_ref::<PlaneRotor>() else {
+    let Ok(r) = scene.rotor.as_rotor().isotropic_plane() else {
         return Err(AnalyticError::NotPlane);
     };
     let m_total = r.mass + cargo.iter().map(|c| c.mass).sum::<f64>();
-    let unbalance = r.mass * r.eccentricity;
+    let unbalance = r.unbalance;
     let angles = balanced_fan(cargo.len(), first.unbalance(), unbalance, r.unbalance_angle)
         .ok_or(AnalyticError::NotBalanceable)?;
     let p = position_parameter(&angles);
-    let (dre, dim) = (r.kx - m_total * omega * omega, r.bx * omega);
+    let (dre, dim) = (r.stiffness - m_total * omega * omega, r.damping * omega);
     let h_abs = omega * omega / dre.hypot(dim);
     let theta = (-dim).atan2(dre);
     let c = first.mass * first.mass * omega * omega * h_abs / first.drag;

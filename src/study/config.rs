@@ -552,7 +552,7 @@ impl StudyFile {
             super::tolerance::validate(t, &designs, &facts)
                 .map_err(|(k, v, r)| invalid(&format!("sampling.tolerances.{k}"), v, &r))?;
         }
-        let demand = self.eccentricity_demand();
+        let demand = self.effects_capacity_demand();
         if demand > 0.0 && s.require_balanceable {
             // The weights must also hold the race centred: the unbalance they
             // supply grows by up to e_r·|M − (k + ibω)/ω²| (docs/model.md).
@@ -563,10 +563,13 @@ impl StudyFile {
             };
             if let Some(d) = designs.iter().find(|d| d.capacity < drawn(d) + demand) {
                 return Err(invalid(
-                    "sampling.unbalance.max",
+                    &format!(
+                        "sampling.unbalance.{}",
+                        s.unbalance.distribution.upper_key()
+                    ),
                     upper.to_string(),
                     &format!(
-                        "the largest unbalance drawn, {:.4e} kg·m, plus the {demand:.4e} kg·m the weights must add to centre the off-centre race (effects.race_eccentricity: e_r·|M − (k + ibω)/ω²|) exceeds the capacity {:.4e} kg·m of design {} ({}); lower it or set require_balanceable = false",
+                        "the largest unbalance drawn, {:.4e} kg·m, plus the {demand:.4e} kg·m the weights must add to centre the off-centre race (effects.race_eccentricity: e_r over the plane's compliance, e_r·|M − (k + ibω)/ω²| on the plane rotor) exceeds the capacity {:.4e} kg·m of design {} ({}); lower it or set require_balanceable = false",
                         drawn(d),
                         d.capacity,
                         d.id,
@@ -598,13 +601,12 @@ impl StudyFile {
                 }
             };
             if absolute && let Some(d) = designs.iter().find(|d| d.capacity < worst(d)) {
-                let key = if couple.unbalance.is_some() {
-                    "sampling.couple.unbalance.max"
-                } else {
-                    "sampling.couple.follows_static"
+                let key = match &couple.unbalance {
+                    Some(u) => format!("sampling.couple.unbalance.{}", u.distribution.upper_key()),
+                    None => "sampling.couple.follows_static".to_string(),
                 };
                 return Err(invalid(
-                    key,
+                    &key,
                     format!("{:.4e} kg·m in the worse plane", worst(d)),
                     &format!(
                         "the largest static plus couple unbalance a plane can take exceeds the capacity {:.4e} kg·m of design {} ({}); lower them or set require_balanceable = false",
@@ -619,7 +621,10 @@ impl StudyFile {
             let upper = s.unbalance.distribution.upper();
             if let Some(d) = designs.iter().find(|d| d.capacity < upper) {
                 return Err(invalid(
-                    "sampling.unbalance.max",
+                    &format!(
+                        "sampling.unbalance.{}",
+                        s.unbalance.distribution.upper_key()
+                    ),
                     upper.to_string(),
                     &format!(
                         "exceeds the capacity {:.4e} kg·m of design {} ({}); lower it or set require_balanceable = false",
@@ -651,23 +656,21 @@ impl StudyFile {
     }
 
     /// The unbalance (kg·m) the weights must add, besides cancelling the
-    /// rotor's, to hold an off-centre race on the axis:
-    /// e_r·|M − (k + ibω)/ω²| on the plane rotor at its nominal speed (the
-    /// larger of the two axes); 0 without race eccentricity.
-    pub fn eccentricity_demand(&self) -> f64 {
-        let Some(e) = self.scene.effects.race_eccentricity.as_ref() else {
-            return 0.0;
-        };
-        let Some(r) = self
-            .scene
-            .rotor
-            .downcast_ref::<crate::model::rotor::PlaneRotor>()
-        else {
-            return 0.0;
-        };
-        let w = self.scene.speed.nominal_speed();
-        let axis = |k: f64, b: f64| (r.mass - k / (w * w)).hypot(b / w);
-        e.offset * axis(r.kx, r.bx).max(axis(r.ky, r.by))
+    /// rotor's, for the scene's effects (an off-centre race held on the
+    /// axis) at the nominal speed, on any rotor: each effect says what it
+    /// asks, given the planes' compliance ([`crate::model::forced::plane_compliance`]).
+    pub fn effects_capacity_demand(&self) -> f64 {
+        let system = crate::model::system::RotorSystem::new(
+            self.scene.rotor.build(),
+            Vec::new(),
+            self.scene.speed.clone(),
+            Vec::new(),
+        );
+        let omega = self.scene.speed.nominal_speed();
+        let compliance = |p: usize| crate::model::forced::plane_compliance(&system, p, omega);
+        self.scene
+            .effects
+            .capacity_demand(system.rotor().planes(), &compliance)
     }
 
     /// Validate one design of this study's scene and compute its mass and capacity.

@@ -13,8 +13,8 @@
 
 use super::config::StudyPlan;
 use super::design::Design;
+use crate::model::critical_speeds::critical_speeds_in_range;
 use crate::model::linear::analyse;
-use crate::model::rotor::{MAX_DOF, PlaneRotor};
 
 /// What the checks measured for one design (every length in m).
 #[derive(Debug, Clone, PartialEq)]
@@ -74,9 +74,14 @@ fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String
         );
     }
     let omega = plan.file.scene.speed.nominal_speed();
-    if let Some(critical) = critical_speed(plan, design).filter(|&w| omega <= w) {
+    if let Some((critical, several)) = critical_speed(plan, design).filter(|&(w, _)| omega <= w) {
+        let which = if several {
+            "lowest critical speed"
+        } else {
+            "critical speed"
+        };
         return format!(
-            "the speed ω = {omega:.1} rad/s is at or below the rotor's critical speed {critical:.1} rad/s: a passive balancer only balances above it"
+            "the speed ω = {omega:.1} rad/s is at or below the rotor's {which} {critical:.1} rad/s: a passive balancer only balances above it"
         );
     }
     if let Some(g) = plan.file.scene.effects.gravity.as_ref() {
@@ -120,21 +125,10 @@ fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String
     "none of the usual causes applies (dead band, capacity, critical speed, gravity, horizon): look at single runs with `study simulate` or `study plot run`".to_string()
 }
 
-/// The plane rotor's natural frequency with the weights' mass carried,
-/// √(k_min/(M + Σ m)); `None` for other rotor models.
-fn critical_speed(plan: &StudyPlan, design: &Design) -> Option<f64> {
-    let scene = plan.scene(design, 0.0, 0.0);
-    scene.rotor.downcast_ref::<PlaneRotor>()?;
-    let built = scene.rotor.build();
-    let weights: f64 = scene.cargoes().ok()?.iter().map(|c| c.mass).sum();
-    let mass = built.mass_matrix()[0][0] + weights;
-    let stiffness = |axis: usize| {
-        let mut unit = [0.0; MAX_DOF];
-        unit[axis] = 1.0;
-        let mut f = [0.0; MAX_DOF];
-        built.forces(&unit, &[0.0; MAX_DOF], 0.0, &mut f);
-        -f[axis]
-    };
-    let k = stiffness(0).min(stiffness(1));
-    (k > 0.0).then(|| (k / mass).sqrt())
+/// The rotor's lowest critical speed with the weights' mass carried (any
+/// rotor model), and whether it has more than one; `None` when it has none.
+fn critical_speed(plan: &StudyPlan, design: &Design) -> Option<(f64, bool)> {
+    let system = plan.scene(design, 0.0, 0.0).build().ok()?;
+    let speeds = critical_speeds_in_range(&system)?;
+    Some((*speeds.first()?, speeds.len() > 1))
 }

@@ -142,6 +142,14 @@ impl Distribution {
             | Distribution::NormalTruncated { max, .. } => max,
         }
     }
+
+    /// The key that holds [`Distribution::upper`]: `value` or `max`.
+    pub fn upper_key(&self) -> &'static str {
+        match self {
+            Distribution::Fixed { .. } => "value",
+            _ => "max",
+        }
+    }
 }
 
 /// Unbalance direction.

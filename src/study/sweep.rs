@@ -6,7 +6,7 @@
 use crate::design::criterion::{dynamic_ranges, static_ranges};
 use crate::metrics::Outcome;
 use crate::model::linear::analyse;
-use crate::model::rotor::{RotorModel, TwoSupportRotor};
+use crate::model::rotor::RotorModel;
 use crate::model::scene::SceneError;
 use crate::model::speed::SpeedLaw;
 use crate::model::zero_approx::criterion_margin;
@@ -55,14 +55,10 @@ pub fn speed_grid(lo: f64, hi: f64, points: usize) -> Vec<f64> {
 
 /// The closed-form prediction of seed 003 for a two-support rotor at ω.
 fn closed_form(rotor: &RotorModel, omega: f64) -> Option<bool> {
-    let r = rotor.downcast_ref::<TwoSupportRotor>()?;
-    // Seed 003's criterion is derived for isotropic supports.
-    if !r.is_isotropic() {
-        return None;
-    }
-    let p = r.criterion_params();
-    let ranges = if r.planes.len() == 1 {
-        static_ranges(&p, r.planes[0]).ok()?
+    let c = rotor.as_rotor().closed_form_criterion().ok()?;
+    let p = c.params;
+    let ranges = if c.planes.len() == 1 {
+        static_ranges(&p, c.planes[0]).ok()?
     } else {
         dynamic_ranges(&p).ok()?
     };

@@ -119,6 +119,12 @@ pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
         "[scene.effects.race_eccentricity]\noffset = 1e-3\n[sampling]",
         "to centre the off-centre race",
     ),
+    // The same refusal names the key a `fixed` draw has (`value`), not `max`.
+    (
+        "[sampling]\nsamples = 2\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8",
+        "[scene.effects.race_eccentricity]\noffset = 1e-3\n[sampling]\nsamples = 2\nunbalance = { distribution = \"fixed\", value = 0.95",
+        "sampling.unbalance.value = 0.95",
+    ),
     ("mass = 10.0", "mass = -1.0", "mass"),
     ("mass = 10.0", "mass = 0.0", "mass"),
     ("mass = 10.0", "mass = \"heavy\"", "rotor.mass"),

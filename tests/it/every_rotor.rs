@@ -268,3 +268,47 @@ fn the_shipped_bristol_rig_has_the_measured_resonances() {
         assert!((got - want).abs() < 1.0, "{rpm:?} vs {measured:?}");
     }
 }
+
+/// The extra unbalance an off-centre race asks of the weights, from the
+/// effect and the planes' compliance: on the plane rotor the closed form
+/// e_r·|M − (k + ibω)/ω²| (the stiffer axis when anisotropic), and the same
+/// on the two-support rotor that reduces to it. Before, only the plane rotor
+/// had a demand (0 elsewhere, so an over-capacity study ran).
+#[test]
+fn an_off_centre_race_asks_the_same_capacity_on_every_rotor_that_is_the_plane_rotor() {
+    use autobal::model::effect::EffectSpec;
+    use autobal::model::effect::race_eccentricity::RaceEccentricity;
+    use autobal::model::forced::plane_compliance;
+    let offset = 2e-4;
+    let effect = RaceEccentricity {
+        offset,
+        angle_deg: 40.0,
+        plane: None,
+    };
+    let demand = |text: &str| {
+        let s = system(text);
+        let omega = 4.0;
+        effect.capacity_demand(s.rotor().planes(), &|p| plane_compliance(&s, p, omega))
+    };
+    let closed = |kx: f64, ky: f64, bx: f64, by: f64| {
+        let axis = |k: f64, b: f64| (1.0 - k / 16.0).hypot(b / 4.0);
+        offset * axis(kx, bx).max(axis(ky, by))
+    };
+    for (kx, ky, bx, by) in [
+        (3.0, 3.0, 0.2, 0.2),
+        (3.0, 7.0, 0.0, 0.0),
+        (40.0, 25.0, 0.0, 0.0),
+    ] {
+        let want = closed(kx, ky, bx, by);
+        for (name, text) in [
+            ("plane", plane(kx, ky, bx, by)),
+            ("two-support", decoupled_two_support(kx, ky, bx, by)),
+        ] {
+            let got = demand(&text);
+            assert!(
+                (got / want - 1.0).abs() < 1e-9,
+                "{name} k = ({kx}, {ky}), b = ({bx}, {by}): demand {got:e}, closed form {want:e}"
+            );
+        }
+    }
+}

@@ -6,7 +6,6 @@ use autobal::design::criterion::{
     RotorShape, SpeedRanges, dynamic_ranges, extra_speed, partial_frequencies, resonances,
     static_ranges, z_max,
 };
-use autobal::model::rotor::{RotorParams, TwoSupportRotor};
 use autobal::scene_file::SceneFile;
 use clap::Args;
 use serde::Serialize;
@@ -51,27 +50,20 @@ struct Report {
 pub fn run(args: &CriterionArgs) -> Result<(), UserError> {
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
-    let Some(rotor) = file.rotor.downcast_ref::<TwoSupportRotor>() else {
-        return Err(UserError(
-            format!(
-                "{shown}: the closed-form criterion is for `model = \"two_support\"` (this is \"{}\"); `study sweep` computes it for any rotor",
-                file.rotor.name()
-            ),
-            2,
-        ));
-    };
-    rotor.validate()?;
-    if !rotor.is_isotropic() {
-        return Err(UserError(
-            format!(
-                "{shown}: rotor.k1y, k2y, b1y, b2y: the closed-form criterion (seed 003) is derived for isotropic supports; `study sweep` simulates an anisotropic rotor"
-            ),
-            2,
-        ));
-    }
-    let p = rotor.criterion_params();
+    let criterion = file
+        .rotor
+        .as_rotor()
+        .closed_form_criterion()
+        .map_err(|why| {
+            UserError(
+                format!("{shown}: rotor (model \"{}\"): {why}", file.rotor.name()),
+                2,
+            )
+        })?;
+    file.rotor.validate()?;
+    let p = criterion.params;
     let res = resonances(&p)?;
-    let planes = rotor
+    let planes = criterion
         .planes
         .iter()
         .map(|&z| {

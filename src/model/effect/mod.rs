@@ -131,6 +131,13 @@ pub trait EffectSpec {
     fn rotating_frame_obstacle(&self) -> Option<&'static str> {
         None
     }
+    /// The unbalance (kg·m) the weights must supply besides the rotor's own,
+    /// given each plane's compliance (m of plane-centre motion per kg·m of
+    /// unbalance turning in that plane, `None` at an undamped resonance);
+    /// 0 for an effect that asks nothing of the weights' capacity.
+    fn capacity_demand(&self, _planes: usize, _compliance: &dyn Fn(usize) -> Option<f64>) -> f64 {
+        0.0
+    }
     /// True when the effect makes the equations stiff by construction, so
     /// that the `auto` method starts implicit instead of waiting for a
     /// stiffness test to notice.
@@ -256,6 +263,14 @@ impl Effects {
     /// Whether an enabled effect is stiff by construction.
     pub fn stiff(&self) -> bool {
         self.enabled().any(|(_, spec)| spec.stiff())
+    }
+
+    /// The unbalance (kg·m) the enabled effects ask of the weights besides
+    /// the rotor's own (see [`EffectSpec::capacity_demand`]).
+    pub fn capacity_demand(&self, planes: usize, compliance: &dyn Fn(usize) -> Option<f64>) -> f64 {
+        self.enabled()
+            .map(|(_, spec)| spec.capacity_demand(planes, compliance))
+            .sum()
     }
 
     /// Why an enabled effect rules out the rotating-frame formulation, if one does.

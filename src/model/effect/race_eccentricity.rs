@@ -63,6 +63,27 @@ impl EffectSpec for RaceEccentricity {
         Ok(())
     }
 
+    /// To hold an off-centre race on the axis the weights must move its
+    /// plane's centre by e_r: at most e_r over the plane's compliance, the
+    /// largest over the races that are off-centre (e_r·|M − (k + ibω)/ω²| on
+    /// the plane rotor, the stiffer axis on anisotropic supports). Several
+    /// off-centre races are taken one at a time, an estimate: each plane's
+    /// weights also move the others.
+    fn capacity_demand(&self, planes: usize, compliance: &dyn Fn(usize) -> Option<f64>) -> f64 {
+        if self.offset == 0.0 {
+            return 0.0;
+        }
+        let races: Vec<usize> = match self.plane {
+            Some(p) => vec![p],
+            None => (0..planes).collect(),
+        };
+        races
+            .into_iter()
+            // No steady response (an undamped resonance): any force moves the plane.
+            .map(|p| compliance(p).map_or(0.0, |c| self.offset / c))
+            .fold(0.0, f64::max)
+    }
+
     fn check_scene(&self, key: &str, facts: &SceneFacts) -> Result<(), SceneError> {
         if self.offset == 0.0 {
             return Ok(());

@@ -20,6 +20,7 @@ pub use flexible::FlexibleShaft;
 pub use plane::PlaneRotor;
 pub use two_support::TwoSupportRotor;
 
+use crate::design::criterion::TwoSupportParams;
 use crate::model::validate::SceneError;
 use serde::{Deserialize, Serialize};
 use std::any::Any;
@@ -32,6 +33,31 @@ pub const MAX_DOF: usize = 4;
 
 /// A fixed-size vector over the rotor coordinates (only the first `dof()` used).
 pub type DofVec = [f64; MAX_DOF];
+
+/// A rotor that is one mass on isotropic supports in a single plane: what
+/// the rotating-frame equations and the slow-mode closed form are written for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IsotropicPlane {
+    /// Rotor mass M (kg).
+    pub mass: f64,
+    /// Support stiffness k, the same along x and y (N/m).
+    pub stiffness: f64,
+    /// Support damping b, the same along x and y (N·s/m).
+    pub damping: f64,
+    /// The rotor's own unbalance M e (kg·m).
+    pub unbalance: f64,
+    /// Direction of that unbalance relative to the rotor at φ = 0 (rad).
+    pub unbalance_angle: f64,
+}
+
+/// What seed 003's closed-form balancing criterion needs of a rotor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClosedFormCriterion {
+    /// Mass, inertias and supports in the criterion's terms.
+    pub params: TwoSupportParams,
+    /// Axial positions z_p of the balancer planes (m).
+    pub planes: Vec<f64>,
+}
 
 /// What a rotor model contributes to the equations of motion.
 ///
@@ -94,6 +120,19 @@ pub trait Rotor: Any + Send + Sync + std::fmt::Debug {
     /// elsewhere.
     fn plane_unbalance_sizes(&self, _f: &DofVec) -> Option<Vec<f64>> {
         None
+    }
+    /// The rotor as one mass on isotropic supports, or why it is not one.
+    /// The rotating-frame formulation and the analytic slow mode are
+    /// granted by this alone, so a new model that is such a plane gets them.
+    fn isotropic_plane(&self) -> Result<IsotropicPlane, &'static str> {
+        Err("only the plane rotor has a rotating-frame formulation")
+    }
+    /// The parameters of seed 003's closed-form balancing criterion, or why
+    /// the criterion does not cover this rotor.
+    fn closed_form_criterion(&self) -> Result<ClosedFormCriterion, &'static str> {
+        Err(
+            "seed 003's closed-form criterion is derived for the rigid rotor on two supports (`model = \"two_support\"`); `study sweep` finds where any rotor balances",
+        )
     }
 }
 
@@ -228,13 +267,6 @@ impl RotorModel {
     /// The model's name as written in files.
     pub fn name(&self) -> &'static str {
         self.as_rotor().name()
-    }
-
-    /// The model as its concrete type `T`, or `None` when it is another
-    /// model: how code that only applies to one model asks for it without
-    /// naming the registry's variants.
-    pub fn downcast_ref<T: Rotor>(&self) -> Option<&T> {
-        (self.as_rotor() as &dyn Any).downcast_ref::<T>()
     }
 
     /// Check every parameter (field names prefixed `rotor.`).

@@ -2,7 +2,7 @@
 //! viscoelastic supports (k_x, k_y, b_x, b_y); one balancer plane at the
 //! shaft centre. Coordinates x, y of the shaft centre from static equilibrium.
 
-use super::{DofVec, MAX_DOF, Rotor, RotorParams};
+use super::{DofVec, IsotropicPlane, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, invalid, non_negative, positive};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -106,6 +106,19 @@ impl Rotor for PlaneRotor {
 
     fn own_unbalance(&self) -> f64 {
         self.mass * self.eccentricity
+    }
+
+    fn isotropic_plane(&self) -> Result<IsotropicPlane, &'static str> {
+        if self.kx != self.ky || self.bx != self.by {
+            return Err("anisotropic supports make the rotating-frame equations time-dependent");
+        }
+        Ok(IsotropicPlane {
+            mass: self.mass,
+            stiffness: self.kx,
+            damping: self.bx,
+            unbalance: self.mass * self.eccentricity,
+            unbalance_angle: self.unbalance_angle,
+        })
     }
 
     fn unbalance_size(&self, f: &DofVec) -> f64 {

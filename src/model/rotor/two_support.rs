@@ -30,7 +30,7 @@
 //! The rotor's own unbalance: static S and moment I (eq 6) as point
 //! unbalances s at z and angle θ, or directly as |S|, arg S, |I|, arg I.
 
-use super::{DofVec, MAX_DOF, Rotor, RotorParams};
+use super::{ClosedFormCriterion, DofVec, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, finite, invalid, non_negative, positive};
 use num_complex::Complex64;
 use schemars::JsonSchema;
@@ -171,6 +171,18 @@ impl TwoSupportRotor {
 impl Rotor for TwoSupportRotor {
     fn name(&self) -> &'static str {
         "two_support"
+    }
+
+    fn closed_form_criterion(&self) -> Result<ClosedFormCriterion, &'static str> {
+        if !self.is_isotropic() {
+            return Err(
+                "rotor.k1y, k2y, b1y, b2y: seed 003's closed-form criterion is derived for isotropic supports; `study sweep` simulates an anisotropic rotor",
+            );
+        }
+        Ok(ClosedFormCriterion {
+            params: self.criterion_params(),
+            planes: self.planes.clone(),
+        })
     }
 
     fn dof(&self) -> usize {

@@ -14,7 +14,6 @@ use super::threads::edited_main_job;
 use autobal::metrics::reference::a_ref;
 use autobal::model::effect::contact::Contact;
 use autobal::model::frame::RotatingSystem;
-use autobal::model::rotor::PlaneRotor;
 use autobal::simulation::{Fidelity, Simulation, scaled_atol};
 use autobal::study::config::{Design, StudyPlan};
 use autobal::study::run::{run_design_sample, sample_simulation};
@@ -181,10 +180,7 @@ pub fn lean_row(
     let err = |e: autobal::model::scene::SceneError| format!("run {run_id}: {e}");
     let system = scene.build().map_err(err)?;
     let rotating = RotatingSystem::new(scene).map_err(err)?;
-    let rotor = scene
-        .rotor
-        .downcast_ref::<PlaneRotor>()
-        .ok_or("not a plane rotor")?;
+    let rotor = scene.rotor.as_rotor().isotropic_plane()?;
     let cargo = scene.cargoes().map_err(err)?;
     let omega = rotating.omega();
 
@@ -195,7 +191,7 @@ pub fn lean_row(
     (y0[0], y0[1], y0[nq], y0[nq + 1]) = (u, v, ud, vd);
 
     // As RotatingSystem::new forms it.
-    let me = rotor.mass * rotor.eccentricity;
+    let me = rotor.unbalance;
     let (s, c) = autobal::model::trig::sin_cos(rotor.unbalance_angle);
     let unbalance_force = (me * omega * omega * c, me * omega * omega * s);
 
@@ -231,8 +227,8 @@ pub fn lean_row(
         sample_id,
         omega,
         rotor_mass: rotor.mass,
-        k: rotor.kx,
-        b: rotor.bx,
+        k: rotor.stiffness,
+        b: rotor.damping,
         unbalance_force,
         mass: cargo.iter().map(|c| c.mass).collect(),
         track_radius: cargo.iter().map(|c| c.track_radius).collect(),
