@@ -109,7 +109,7 @@ ky = 1.0e5
 bx = 100.0
 by = 100.0
 eccentricity = 8.072869486338834e-5
-unbalance_angle = 0.05381263
+unbalance_angle_deg = 3.083236583499079
 
 [balancer]
 kind = "ball"

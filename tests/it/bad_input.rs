@@ -125,6 +125,12 @@ pub(crate) const STUDY_CASES: &[(&str, &str, &str)] = &[
         "[scene.effects.race_eccentricity]\noffset = 1e-3\n[sampling]\nsamples = 2\nunbalance = { distribution = \"fixed\", value = 0.95",
         "sampling.unbalance.value = 0.95",
     ),
+    // The rotor's angles are degrees: a retired radian key names its successor.
+    (
+        "bx = 100.0",
+        "bx = 100.0\nunbalance_angle = 1.5",
+        "rotor.unbalance_angle: this key (radians) is now `unbalance_angle_deg`",
+    ),
     ("mass = 10.0", "mass = -1.0", "mass"),
     ("mass = 10.0", "mass = 0.0", "mass"),
     ("mass = 10.0", "mass = \"heavy\"", "rotor.mass"),

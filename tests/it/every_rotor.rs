@@ -16,7 +16,7 @@ use autobal::simulation::RunResult;
 /// point weights of radius 0.15 on a unit track, at ω = 4.
 fn plane(kx: f64, ky: f64, bx: f64, by: f64) -> String {
     format!(
-        "[rotor]\nmass = 1.0\neccentricity = 0.01\nunbalance_angle = 0.3\nkx = {kx}\nky = {ky}\nbx = {bx}\nby = {by}\n{}",
+        "[rotor]\nmass = 1.0\neccentricity = 0.01\nunbalance_angle_deg = 17.188733853924695\nkx = {kx}\nky = {ky}\nbx = {bx}\nby = {by}\n{}",
         tail()
     )
 }
@@ -28,7 +28,7 @@ fn plane(kx: f64, ky: f64, bx: f64, by: f64) -> String {
 fn decoupled_two_support(kx: f64, ky: f64, bx: f64, by: f64) -> String {
     let (a, b) = (0.6, 0.4);
     format!(
-        "[rotor]\nmodel = \"two_support\"\nmass = 1.0\ntransverse_inertia = 0.5\npolar_inertia = 0.3\nl1 = 0.5\nl2 = 0.75\nk1 = {}\nk2 = {}\nb1 = {}\nb2 = {}\nk1y = {}\nk2y = {}\nb1y = {}\nb2y = {}\nplanes = [0.0]\nstatic_unbalance = 0.01\nstatic_angle = 0.3\n{}",
+        "[rotor]\nmodel = \"two_support\"\nmass = 1.0\ntransverse_inertia = 0.5\npolar_inertia = 0.3\nl1 = 0.5\nl2 = 0.75\nk1 = {}\nk2 = {}\nb1 = {}\nb2 = {}\nk1y = {}\nk2y = {}\nb1y = {}\nb2y = {}\nplanes = [0.0]\nstatic_unbalance = 0.01\nstatic_angle_deg = 17.188733853924695\n{}",
         a * kx,
         b * kx,
         a * bx,

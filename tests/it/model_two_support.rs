@@ -395,7 +395,7 @@ z = -1.0
 [[rotor.unbalances]]
 s = 0.01
 z = 1.0
-angle = 2.0
+angle_deg = 114.59155902616465
 
 [balancer]
 kind = "ball"

@@ -22,10 +22,7 @@ fn scene(coefficient: f64, static_ratio: f64, angles_deg: [f64; 3], direction_de
     );
     text = text.replace(
         "eccentricity = 0.01",
-        &format!(
-            "eccentricity = 0.01\nunbalance_angle = {}",
-            direction_deg.to_radians()
-        ),
+        &format!("eccentricity = 0.01\nunbalance_angle_deg = {direction_deg}"),
     );
     text = text.replace(
         "t_end_revs = 1000",

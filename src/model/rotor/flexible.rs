@@ -47,8 +47,10 @@ pub struct FlexibleShaft {
     /// Eccentricity ε of the disc's centre of mass (m).
     #[serde(default)]
     pub eccentricity: f64,
-    /// Direction of the eccentricity at φ = 0 (rad).
-    #[serde(default)]
+    /// Direction of the eccentricity at φ = 0 (degrees in files;
+    /// the field holds radians).
+    #[serde(default, rename = "unbalance_angle_deg", with = "super::angle_deg")]
+    #[schemars(rename = "unbalance_angle_deg", with = "f64")]
     pub unbalance_angle: f64,
     /// Model the weights' tilt inertia, the m R² terms of seed 002's eqs
     /// 22–23: a weight at radius l adds m l² (α̇ sin φ_j − β̇ cos φ_j)²/2 and

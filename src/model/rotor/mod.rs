@@ -12,6 +12,7 @@
 //! declare it (`pub mod …;`) and add one line
 //! to the `rotor_registry!` call below.
 
+mod angle_deg;
 pub mod flexible;
 pub mod plane;
 pub mod two_support;
@@ -350,6 +351,7 @@ impl<'de> Deserialize<'de> for RotorModel {
                 )));
             }
         };
+        angle_deg::refuse_radian_keys(&table).map_err(D::Error::custom)?;
         let text = table.to_string();
         let Some(result) = RotorModel::from_toml(&model, &text) else {
             return Err(D::Error::custom(format!(
@@ -379,6 +381,36 @@ mod tests {
 
     fn parse(text: &str) -> Result<RotorModel, String> {
         toml::from_str::<RotorModel>(text).map_err(|e| e.message().to_string())
+    }
+
+    #[test]
+    fn angles_are_degrees_and_the_radian_keys_are_refused_by_their_new_names() {
+        let plane =
+            parse("mass = 1.0\nkx = 1.0\nky = 1.0\nbx = 0.0\nby = 0.0\nunbalance_angle_deg = 90.0")
+                .unwrap();
+        let r = plane.as_rotor().isotropic_plane().unwrap();
+        assert_eq!(r.unbalance_angle, std::f64::consts::FRAC_PI_2);
+        let two = "model = \"two_support\"\nmass = 1.0\ntransverse_inertia = 0.5\npolar_inertia = 0.3\nk1 = 1.0\nk2 = 1.0\nl1 = 0.5\nl2 = 0.5\nplanes = [0.0]\n";
+        for (old, new) in [
+            (
+                "mass = 1.0\nkx = 1.0\nky = 1.0\nbx = 0.0\nby = 0.0\nunbalance_angle = 1.0"
+                    .to_string(),
+                "`unbalance_angle_deg`",
+            ),
+            (format!("{two}static_angle = 1.0"), "`static_angle_deg`"),
+            (format!("{two}moment_angle = 1.0"), "`moment_angle_deg`"),
+            (
+                format!("{two}[[unbalances]]\ns = 0.1\nangle = 1.0"),
+                "`angle_deg`",
+            ),
+            (
+                "model = \"flexible\"\nunbalance_angle = 1.0".to_string(),
+                "`unbalance_angle_deg`",
+            ),
+        ] {
+            let err = parse(&old).expect_err(new);
+            assert!(err.contains(new) && err.contains("degrees"), "{new}: {err}");
+        }
     }
 
     #[test]

@@ -17,8 +17,10 @@ pub struct PlaneRotor {
     /// sampled unbalance sets it.
     #[serde(default)]
     pub eccentricity: f64,
-    /// Direction ψ₀ of the unbalance relative to the rotor at φ = 0 (rad).
-    #[serde(default)]
+    /// Direction ψ₀ of the unbalance relative to the rotor at φ = 0
+    /// (degrees in files; the field holds radians).
+    #[serde(default, rename = "unbalance_angle_deg", with = "super::angle_deg")]
+    #[schemars(rename = "unbalance_angle_deg", with = "f64")]
     pub unbalance_angle: f64,
     /// Polar moment of inertia J_C about the rotor's centre of mass (kg·m²);
     /// J_P = J_C + M e² enters at variable speed only.

@@ -45,8 +45,10 @@ pub struct PointUnbalance {
     /// Axial position z from the centre of mass (m).
     #[serde(default)]
     pub z: f64,
-    /// Direction relative to the rotor at φ = 0 (rad).
-    #[serde(default)]
+    /// Direction relative to the rotor at φ = 0 (degrees in files;
+    /// the field holds radians).
+    #[serde(default, rename = "angle_deg", with = "super::angle_deg")]
+    #[schemars(rename = "angle_deg", with = "f64")]
     pub angle: f64,
 }
 
@@ -91,14 +93,18 @@ pub struct TwoSupportRotor {
     /// Static unbalance |S| (kg·m), added to the point unbalances.
     #[serde(default)]
     pub static_unbalance: f64,
-    /// Direction of the static unbalance at φ = 0 (rad).
-    #[serde(default)]
+    /// Direction of the static unbalance at φ = 0 (degrees in files;
+    /// the field holds radians).
+    #[serde(default, rename = "static_angle_deg", with = "super::angle_deg")]
+    #[schemars(rename = "static_angle_deg", with = "f64")]
     pub static_angle: f64,
     /// Moment unbalance |I| (kg·m²), added to the point unbalances.
     #[serde(default)]
     pub moment_unbalance: f64,
-    /// Direction of the moment unbalance at φ = 0 (rad).
-    #[serde(default)]
+    /// Direction of the moment unbalance at φ = 0 (degrees in files;
+    /// the field holds radians).
+    #[serde(default, rename = "moment_angle_deg", with = "super::angle_deg")]
+    #[schemars(rename = "moment_angle_deg", with = "f64")]
     pub moment_angle: f64,
     /// Point unbalances.
     #[serde(default)]
