@@ -68,6 +68,40 @@ pub fn stiffness_and_damping(
     (km, cm)
 }
 
+/// True when the rotor's supports look the same from every direction about
+/// the spin axis at speed ω: its stiffness and velocity matrices commute with
+/// the quarter turn J of each coordinate pair (x, y), (α, β), within a
+/// relative 10⁻¹² of their size. Otherwise its equations in the rotating
+/// frame depend on time, and no balanced state there is steady.
+pub fn supports_isotropic(system: &RotorSystem, omega: f64) -> bool {
+    let k = system.rotor().dof();
+    let (km, cm) = stiffness_and_damping(system, omega);
+    // (J A)[r][c] with J(a, b) = (−b, a) on each pair.
+    let turn_rows = |a: &[DofVec; MAX_DOF], r: usize, c: usize| {
+        if r.is_multiple_of(2) {
+            -a[r + 1][c]
+        } else {
+            a[r - 1][c]
+        }
+    };
+    let turn_cols = |a: &[DofVec; MAX_DOF], r: usize, c: usize| {
+        if c.is_multiple_of(2) {
+            a[r][c + 1]
+        } else {
+            -a[r][c - 1]
+        }
+    };
+    [km, cm].iter().all(|a| {
+        let size = (0..k)
+            .flat_map(|r| (0..k).map(move |c| (r, c)))
+            .map(|(r, c)| a[r][c].abs())
+            .fold(0.0, f64::max);
+        (0..k).all(|r| {
+            (0..k).all(|c| (turn_rows(a, r, c) - turn_cols(a, r, c)).abs() <= 1e-12 * size)
+        })
+    })
+}
+
 /// The steady response to the unbalance forcing (f_c, f_s) at speed ω;
 /// `None` when the dynamic stiffness is singular (undamped resonance).
 pub fn harmonic_response(

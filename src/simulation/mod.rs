@@ -101,7 +101,12 @@ impl Simulation {
             Fidelity::Full | Fidelity::Auto => self.integrate(&system, &system, &y0, None, record),
         };
         metrics.fidelity = fidelity.name().to_string();
-        if self.scene.effects.rolling_resistance.is_some()
+        if self
+            .scene
+            .effects
+            .rolling_resistance
+            .as_ref()
+            .is_some_and(|r| r.coefficient > 0.0)
             && !metrics.final_rel_angles_deg.is_empty()
         {
             metrics.balance_angle_error_deg =
@@ -177,11 +182,16 @@ impl Simulation {
 /// found by [`crate::metrics::balance_angle`]. At rest the friction torque
 /// vanishes, so the balanced states are those of the scene without it; it
 /// is left out because its regularised sign has a slope that no
-/// finite-difference Jacobian resolves. `None` at variable speed or with no
-/// balanced state near.
+/// finite-difference Jacobian resolves. Gravity is left out too: in the
+/// rotor's frame it turns once a revolution, so the weights swing about the
+/// balanced state by about g/(l ω²) rather than move it, while the rotating
+/// frame's steady state would take its value at one instant as a constant
+/// load (41° of error reported for balls 0.1° from balance, before
+/// 2026-11-27). `None` at variable speed or with no balanced state near.
 fn balance_angle_error(scene: &Scene, final_deg: &[f64]) -> Option<f64> {
     let mut frictionless = scene.clone();
     frictionless.effects.rolling_resistance = None;
+    frictionless.effects.gravity = None;
     let system = frictionless.build().ok()?;
     let frame = crate::model::linear::RotatingFrame::new(&system).ok()?;
     let psi: Vec<f64> = final_deg.iter().map(|d| d.to_radians()).collect();

@@ -1,6 +1,7 @@
 //! A stability map: the linear stability of a scene's balanced state over a
 //! grid of speeds and rotor unbalances (seed 002's map over (ω/ω0, ε/R)).
 
+use crate::model::forced::supports_isotropic;
 use crate::model::linear::analyse;
 use crate::model::scene::{Scene, SceneError};
 use crate::model::speed::SpeedLaw;
@@ -31,6 +32,7 @@ pub fn stability_map(
     unbalances: &[f64],
 ) -> Result<Vec<MapPoint>, SceneError> {
     template.validate()?;
+    refuse_time_dependent(template, omegas)?;
     let grid: Vec<(f64, f64)> = unbalances
         .iter()
         .flat_map(|&u| omegas.iter().map(move |&w| (w, u)))
@@ -51,6 +53,34 @@ pub fn stability_map(
             })
         })
         .collect()
+}
+
+/// Refuse a scene whose rotating-frame equations depend on time (gravity,
+/// anisotropic supports): it has no steady balanced state to linearise, and
+/// every cell would read "beyond capacity" (as `study map` printed with exit
+/// 0 before 2026-11-27, where `study linear` refused the same scene).
+fn refuse_time_dependent(template: &Scene, omegas: &[f64]) -> Result<(), SceneError> {
+    let refuse = |field: &str, value: &str, why: &str| SceneError::Invalid {
+        field: field.to_string(),
+        value: value.to_string(),
+        reason: format!(
+            "{why}, so the balanced state has no linear stability to map; `study sweep` simulates this scene"
+        ),
+    };
+    if let Some(why) = template.effects.rotating_frame_obstacle() {
+        return Err(refuse("effects", "enabled", why));
+    }
+    let mut probe = template.clone();
+    let omega = omegas.first().copied().unwrap_or(1.0);
+    probe.speed = SpeedLaw::Constant { omega };
+    if !supports_isotropic(&probe.build()?, omega) {
+        return Err(refuse(
+            "rotor",
+            probe.rotor.name(),
+            "anisotropic supports make the equations in the rotating frame depend on time",
+        ));
+    }
+    Ok(())
 }
 
 /// The map as a table, one row per grid point.

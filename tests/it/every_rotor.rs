@@ -312,3 +312,46 @@ fn an_off_centre_race_asks_the_same_capacity_on_every_rotor_that_is_the_plane_ro
         }
     }
 }
+
+/// `study map` linearises in the rotating frame, like `study linear`: a
+/// scene whose equations there depend on time is refused (exit 2, the key
+/// named, no file written) instead of a map of "beyond capacity" with exit 0.
+#[test]
+fn the_stability_map_refuses_what_the_rotating_frame_cannot_hold() {
+    let map = |text: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let (scene, out) = (
+            dir.path().join("scene.toml"),
+            dir.path().join("map.parquet"),
+        );
+        std::fs::write(&scene, text).unwrap();
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["map", scene.to_str().unwrap(), "--omega", "3..5"])
+            .args(["--unbalance", "0.005..0.02", "--points", "3x2"])
+            .args(["--out", out.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&run.stderr).to_string();
+        (run.status.code(), err, out.exists())
+    };
+    let (code, err, wrote) = map(&plane(3.0, 3.0, 0.2, 0.2));
+    assert_eq!((code, wrote), (Some(0), true), "{err}");
+    for (text, key) in [
+        (
+            plane(3.0, 7.0, 0.2, 0.2),
+            "rotor = plane: anisotropic supports",
+        ),
+        (
+            decoupled_two_support(3.0, 7.0, 0.2, 0.2),
+            "rotor = two_support: anisotropic",
+        ),
+        (
+            plane(3.0, 3.0, 0.2, 0.2) + "[effects.gravity]\ng = 0.8\n",
+            "effects = enabled: gravity",
+        ),
+    ] {
+        let (code, err, wrote) = map(&text);
+        assert_eq!((code, wrote), (Some(2), false), "{err}");
+        assert!(err.contains(key), "{key}: {err}");
+    }
+}

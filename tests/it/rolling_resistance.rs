@@ -149,3 +149,43 @@ fn no_run_of_the_friction_study_fails_in_the_solver() {
     assert!(plan.total_runs() >= 360);
     assert!(failed.is_empty(), "solver failures in runs {failed:?}");
 }
+
+/// Two balls on a horizontal shaft: the angular error is the closed-form
+/// distance to the two balanced positions π ± acos(M e/(2 m l)), computed
+/// here from the final angles alone. Gravity swings the balls by about
+/// g/(l ω²) = 0.29° each revolution and leaves the balanced state where it
+/// is; before, the rotating frame took gravity at one instant as a constant
+/// load and reported tens of degrees (or nothing) for balls at balance.
+#[test]
+fn two_balls_under_gravity_are_measured_against_their_closed_form_balance() {
+    let text = |coefficient: f64| {
+        format!(
+            "[rotor]\nmass = 1.0\neccentricity = 0.01\nkx = 1.0\nky = 1.0\nbx = 0.1\nby = 0.1\n\
+             [[cargo]]\nmass = 0.01\ntrack_radius = 1.0\ndrag = 0.01\nkappa = 1.4\n\
+             [[cargo]]\nmass = 0.01\ntrack_radius = 1.0\ndrag = 0.01\nkappa = 1.4\n\
+             [speed]\nmode = \"constant\"\nomega = 4.0\n\
+             [effects.gravity]\ng = 0.08\n\
+             [effects.rolling_resistance]\ncoefficient = {coefficient}\n\
+             [start]\nmode = \"locked_steady\"\nangles_deg = [100, 150]\n\
+             [metrics]\nt_end_revs = 400\nstop_when_settled = false\n[solver]\nrtol = 1e-9\n"
+        )
+    };
+    let m = scene_metrics(&text(1e-6));
+    let half = (0.01f64 / (2.0 * 0.01)).acos().to_degrees();
+    let psi = &m.final_rel_angles_deg;
+    let off = |a: f64, b: f64| ((a - b + 540.0).rem_euclid(360.0) - 180.0).abs();
+    let want = [(180.0 - half, 180.0 + half), (180.0 + half, 180.0 - half)]
+        .iter()
+        .map(|&(a, b)| off(psi[0], a).max(off(psi[1], b)))
+        .fold(f64::INFINITY, f64::min);
+    let got = m
+        .balance_angle_error_deg
+        .expect("two balls have a balanced state");
+    assert!(
+        (got - want).abs() < 1e-6,
+        "reported {got}°, closed form {want}° at {psi:?}"
+    );
+    assert!(got < 1.0, "the balls end {got}° from balance");
+    // A zero coefficient is no rolling resistance: no angle error either.
+    assert_eq!(scene_metrics(&text(0.0)).balance_angle_error_deg, None);
+}

@@ -133,6 +133,14 @@ fn describe(points: &[SweepPoint]) -> String {
             "closed form of seed 003                {}\n",
             show(ranges(points, |p| p.closed_form == Some(true)))
         );
+        // The closed form is undamped, the criterion uses the damped
+        // response: where they part, say why rather than leave a puzzle.
+        if points
+            .iter()
+            .any(|p| p.closed_form.is_some_and(|c| c != p.criterion))
+        {
+            s += "  (they differ where the supports' damping moves an edge: the closed form is the undamped limit)\n";
+        }
     }
     // "none" would claim an analysis that never ran: say so instead.
     let linear = if points.iter().any(|p| p.linear_stable.is_some()) {
