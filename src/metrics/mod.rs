@@ -31,6 +31,7 @@
 //! the ramp's final speed or the motor's synchronous speed).
 
 pub mod balance_angle;
+pub mod bearing_orbit;
 pub mod certify;
 pub mod never_settles;
 pub mod observer;
@@ -110,6 +111,16 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// True for the outcomes whose run reached a residual the metrics
+    /// describe (settled, censored, not settled), false for a run that
+    /// failed, diverged or merged.
+    pub fn has_residual(self) -> bool {
+        matches!(
+            self,
+            Outcome::Settled | Outcome::Censored | Outcome::NotSettled
+        )
+    }
+
     /// snake_case name used in files.
     pub fn name(self) -> &'static str {
         match self {
@@ -211,6 +222,14 @@ pub struct RunMetrics {
     /// planes on two supports; `None` elsewhere).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plane_balancing_error: Option<Vec<f64>>,
+    /// Peak radial displacement of each bearing over the revolution after
+    /// the run (m; rotors with bearings of their own, in support order;
+    /// `src/metrics/bearing_orbit.rs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing_orbit_peak: Option<Vec<f64>>,
+    /// RMS radial displacement of each bearing over the same revolution (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing_orbit_rms: Option<Vec<f64>>,
 }
 
 /// As derived, but the per-plane fields are shown only for rotors with
@@ -258,6 +277,12 @@ impl std::fmt::Debug for RunMetrics {
         if let Some(e) = &self.plane_balancing_error {
             s.field("plane_balancing_error", e);
         }
+        if let Some(p) = &self.bearing_orbit_peak {
+            s.field("bearing_orbit_peak", p);
+        }
+        if let Some(r) = &self.bearing_orbit_rms {
+            s.field("bearing_orbit_rms", r);
+        }
         s.finish()
     }
 }
@@ -299,6 +324,8 @@ impl RunMetrics {
             plane_residual_abs: None,
             plane_settling_revs: None,
             plane_balancing_error: None,
+            bearing_orbit_peak: None,
+            bearing_orbit_rms: None,
         }
     }
 }

@@ -991,6 +991,9 @@ impl<'a> SettlingObserver<'a> {
                 .planes
                 .as_ref()
                 .map(|p| p.rings.iter().map(SquareRing::rms).collect()),
+            // Measured after the run, by the simulation (it needs the solver).
+            bearing_orbit_peak: None,
+            bearing_orbit_rms: None,
             plane_balancing_error: self
                 .planes
                 .as_ref()

@@ -11,6 +11,7 @@ pub mod settings;
 pub use settings::{Fidelity, MethodChoice, SolverSettings, scaled_atol};
 
 use crate::integrate::{IMPLICIT_FALLBACK, OdeSystem, SolverOptions, Stiffness, solve};
+use crate::metrics::bearing_orbit::bearing_orbits;
 use crate::metrics::observer::{Series, SettlingObserver};
 use crate::metrics::{MetricOptions, RunMetrics};
 use crate::model::frame::{RotatingSystem, rotating_frame_obstacle};
@@ -163,6 +164,27 @@ impl Simulation {
         };
         let report = solve(method, ode, 0.0, y0, t_end, &options, &mut observer);
         let (mut metrics, series) = observer.finish(&report);
+        if metrics.outcome.has_residual() {
+            let continued = if report.switched.is_some() {
+                IMPLICIT_FALLBACK
+            } else {
+                method
+            };
+            let orbits = bearing_orbits(
+                continued,
+                ode,
+                system,
+                report.t,
+                &report.y,
+                omega,
+                self.metrics.samples_per_rev,
+                &options,
+            );
+            if let Some(orbits) = orbits {
+                metrics.bearing_orbit_peak = Some(orbits.iter().map(|o| o.peak).collect());
+                metrics.bearing_orbit_rms = Some(orbits.iter().map(|o| o.rms).collect());
+            }
+        }
         metrics.method = method.name().to_string();
         if let Some(switch) = &report.switched {
             metrics.method = format!("{}→{}", switch.from.name(), IMPLICIT_FALLBACK.name());

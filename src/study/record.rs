@@ -118,6 +118,11 @@ pub const PLANE_COLUMNS: [&str; 4] = [
     "plane_balancing_error",
 ];
 
+/// Columns of each bearing's orbit over the revolution after the run: peak
+/// and RMS radial displacement (m), in support order; written only for
+/// rotors with bearings of their own (two supports).
+pub const BEARING_COLUMNS: [&str; 2] = ["bearing_orbit_peak", "bearing_orbit_rms"];
+
 /// Columns of the race centre's offset (m) and direction (degrees), written
 /// with the weight columns; null when neither sampled nor set by the scene.
 pub const RACE_COLUMNS: [&str; 2] = ["race_offset", "race_angle_deg"];
@@ -244,6 +249,20 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             eps,
             rows.iter()
                 .map(|r| r.metrics.plane_balancing_error.clone().unwrap_or_default()),
+        ));
+    }
+    // Every row of a study has the same rotor: bearings for all or none.
+    if rows.iter().any(|r| r.metrics.bearing_orbit_peak.is_some()) {
+        let [peak, rms] = BEARING_COLUMNS;
+        columns.push(list_column(
+            peak,
+            rows.iter()
+                .map(|r| r.metrics.bearing_orbit_peak.clone().unwrap_or_default()),
+        ));
+        columns.push(list_column(
+            rms,
+            rows.iter()
+                .map(|r| r.metrics.bearing_orbit_rms.clone().unwrap_or_default()),
         ));
     }
     // All rows of a study sample a couple or none do.
@@ -451,6 +470,8 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let plane_a_ref = optional_lists(PLANE_COLUMNS[0])?;
     let plane_residual = optional_lists(PLANE_COLUMNS[1])?;
     let plane_eps = optional_lists(PLANE_COLUMNS[3])?;
+    let bearing_peak = optional_lists(BEARING_COLUMNS[0])?;
+    let bearing_rms = optional_lists(BEARING_COLUMNS[1])?;
     // Nulls inside: a plane that did not settle.
     let plane_settling = nullable_lists(df, PLANE_COLUMNS[2])?;
     let couple: Option<Vec<SampledCouple>> = if df.column(COUPLE_COLUMNS[0]).is_ok() {
@@ -530,6 +551,14 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                     .map(|v| v[i].clone())
                     .filter(|v| !v.is_empty()),
                 plane_balancing_error: plane_eps
+                    .as_ref()
+                    .map(|v| v[i].clone())
+                    .filter(|v| !v.is_empty()),
+                bearing_orbit_peak: bearing_peak
+                    .as_ref()
+                    .map(|v| v[i].clone())
+                    .filter(|v| !v.is_empty()),
+                bearing_orbit_rms: bearing_rms
                     .as_ref()
                     .map(|v| v[i].clone())
                     .filter(|v| !v.is_empty()),

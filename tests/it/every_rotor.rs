@@ -355,3 +355,46 @@ fn the_stability_map_refuses_what_the_rotating_frame_cannot_hold() {
         assert!(err.contains(key), "{key}: {err}");
     }
 }
+
+/// The bearings' orbit after a run, against the frequency-domain answer:
+/// below the first critical speed the weights gather on the heavy side and
+/// stay, so the rotor whirls in the steady forced response to its own
+/// unbalance plus the weights locked where they ended. On isotropic supports
+/// each bearing's orbit is then a circle of radius |G_b q| (peak = RMS),
+/// found here by the harmonic solver, a formulation the run does not use.
+#[test]
+fn the_bearing_orbits_after_a_run_are_the_forced_response_at_the_bearings() {
+    use autobal::model::forced::{harmonic_response, plane_orbit_axes, unbalance_forcing};
+    let text = std::fs::read_to_string("scenes/two_support_long.toml")
+        .expect("shipped scene")
+        .replace("omega = 6.32", "omega = 0.9")
+        .replace(
+            "t_end_revs = 1000",
+            "t_end_revs = 150\nstop_when_settled = false\n[solver]\nrtol = 1e-10",
+        );
+    let m = run(&text).metrics;
+    let (peak, rms) = (
+        m.bearing_orbit_peak.clone().expect("two bearings"),
+        m.bearing_orbit_rms.clone().expect("two bearings"),
+    );
+    let s = system(&text);
+    let psi: Vec<f64> = m
+        .final_rel_angles_deg
+        .iter()
+        .map(|d| d.to_radians())
+        .collect();
+    let (fc, fs) = unbalance_forcing(&s, &psi, true);
+    let h = harmonic_response(&s, &fc, &fs, 0.9).expect("off resonance");
+    let (l1, l2) = (2.0, 2.0);
+    for (b, z) in [-l1, l2].into_iter().enumerate() {
+        let map = [[1.0, 0.0, 0.0, z], [0.0, 1.0, -z, 0.0]];
+        let (major, minor) = plane_orbit_axes(&h, &map);
+        assert!((major / minor - 1.0).abs() < 1e-9, "isotropic: a circle");
+        for (name, got) in [("peak", peak[b]), ("RMS", rms[b])] {
+            assert!(
+                (got / major - 1.0).abs() < 2e-3,
+                "bearing {b} {name}: run {got:e}, forced response {major:e}"
+            );
+        }
+    }
+}

@@ -287,6 +287,8 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     plane_residual_abs: None,
                     plane_settling_revs: None,
                     plane_balancing_error: None,
+                    bearing_orbit_peak: None,
+                    bearing_orbit_rms: None,
                 },
                 method: "dp5".into(),
                 contact: true,

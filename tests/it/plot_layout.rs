@@ -240,6 +240,8 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         plane_residual_abs: None,
         plane_settling_revs: None,
         plane_balancing_error: None,
+        bearing_orbit_peak: None,
+        bearing_orbit_rms: None,
     }
 }
 

@@ -82,6 +82,8 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             plane_residual_abs: None,
             plane_settling_revs: None,
             plane_balancing_error: None,
+            bearing_orbit_peak: None,
+            bearing_orbit_rms: None,
         },
         method: "dp5".into(),
         contact: true,

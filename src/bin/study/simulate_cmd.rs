@@ -59,8 +59,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
             "{}",
             crate::output::wrap(
                 &format!(
-                    "{}{}",
+                    "{}{}{}",
                     describe(&result.metrics),
+                    bearing_orbits_line(&result.metrics),
                     critical_speeds_line(critical.as_deref())
                 ),
                 crate::output::text_width()
@@ -68,6 +69,25 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
         );
     }
     Ok(())
+}
+
+/// Each bearing's orbit over the revolution after the run (rotors with
+/// bearings of their own), as a rig measures vibration; empty otherwise.
+fn bearing_orbits_line(m: &autobal::metrics::RunMetrics) -> String {
+    let (Some(peak), Some(rms)) = (&m.bearing_orbit_peak, &m.bearing_orbit_rms) else {
+        return String::new();
+    };
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.4e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!(
+        "bearing orbits     peak [{}] m, RMS [{}] m\n  (each support, over the revolution after the run)\n",
+        list(peak),
+        list(rms)
+    )
 }
 
 /// The model's undamped critical speeds, to compare with a rig's measured

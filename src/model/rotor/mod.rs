@@ -84,6 +84,13 @@ pub trait Rotor: Any + Send + Sync + std::fmt::Debug {
     fn watch_maps(&self) -> Vec<[DofVec; 2]> {
         (0..self.planes()).map(|p| self.plane_map(p)).collect()
     }
+    /// Maps (G_u, G_v) from rotor coordinates to the displacement of each
+    /// bearing (support) of its own, in support order: where a rig measures
+    /// vibration. None by default (a rotor whose support is the watched
+    /// plane itself, or a clamped shaft).
+    fn bearing_maps(&self) -> Vec<[DofVec; 2]> {
+        Vec::new()
+    }
     /// Rows T_α, T_β of the map from rotor coordinates to the tilt (α, β) of
     /// balancer plane `plane` (axis direction (β, −α, 1)), when the weights'
     /// tilt inertia (the m R² terms, `src/model/tilt_inertia.rs`) is

@@ -179,6 +179,13 @@ impl Rotor for TwoSupportRotor {
         "two_support"
     }
 
+    /// The axis at z moves by (x + zβ, y − zα): supports at z = −l1, +l2.
+    fn bearing_maps(&self) -> Vec<[DofVec; 2]> {
+        [-self.l1, self.l2]
+            .map(|z| [[1.0, 0.0, 0.0, z], [0.0, 1.0, -z, 0.0]])
+            .to_vec()
+    }
+
     fn closed_form_criterion(&self) -> Result<ClosedFormCriterion, &'static str> {
         if !self.is_isotropic() {
             return Err(
