@@ -18,17 +18,50 @@ use crate::model::rotor::DofVec;
 use crate::model::system::RotorSystem;
 use std::f64::consts::PI;
 
-/// Peak and RMS of one bearing's radial displacement over a revolution (m).
+/// Peak and RMS of one place's radial displacement over a revolution (m).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BearingOrbit {
+pub struct Orbit {
     /// Largest radial displacement.
     pub peak: f64,
     /// Root mean square of the radial displacement.
     pub rms: f64,
 }
 
-/// Samples each bearing's radius at evenly spaced times.
-struct OrbitSampler<'a> {
+/// One revolution integrated and sampled: the radius of every mapped place
+/// at each sample, and where the revolution ended.
+#[derive(Debug, Clone)]
+pub struct Revolution {
+    /// `radii[s][m]`: map m's radius at sample s (samples at the end of each
+    /// 1/samples of the revolution).
+    pub radii: Vec<Vec<f64>>,
+    /// Time at the end of the revolution.
+    pub t: f64,
+    /// State at the end of the revolution.
+    pub y: Vec<f64>,
+}
+
+impl Revolution {
+    /// Peak and RMS of map m's radius over the revolution.
+    pub fn orbit(&self, m: usize) -> Orbit {
+        self.orbit_of(|r| r[m])
+    }
+
+    /// Peak and RMS over the revolution of a radius built from each sample's radii.
+    pub fn orbit_of(&self, radius: impl Fn(&[f64]) -> f64) -> Orbit {
+        let (mut peak, mut sum_sq) = (0.0f64, 0.0);
+        for r in self.radii.iter().map(|s| radius(s)) {
+            peak = peak.max(r);
+            sum_sq += r * r;
+        }
+        Orbit {
+            peak,
+            rms: (sum_sq / self.radii.len().max(1) as f64).sqrt(),
+        }
+    }
+}
+
+/// Samples each map's radius at evenly spaced times.
+struct Sampler<'a> {
     maps: &'a [[DofVec; 2]],
     dof: usize,
     /// Start of the revolution, its length and its number of samples.
@@ -38,31 +71,24 @@ struct OrbitSampler<'a> {
     /// The index (1..=samples) of the next sample.
     next: u32,
     q: Vec<f64>,
-    peak: Vec<f64>,
-    sum_sq: Vec<f64>,
-    count: usize,
+    radii: Vec<Vec<f64>>,
 }
 
-impl OrbitSampler<'_> {
+impl Sampler<'_> {
     fn take(&mut self, dense: &dyn DenseOutput, t: f64) {
         dense.eval(t, &mut self.q);
-        for (b, [gu, gv]) in self.maps.iter().enumerate() {
-            let dot = |g: &DofVec| {
-                g[..self.dof]
-                    .iter()
-                    .zip(&self.q)
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>()
-            };
-            let r2 = dot(gu).powi(2) + dot(gv).powi(2);
-            self.peak[b] = self.peak[b].max(r2.sqrt());
-            self.sum_sq[b] += r2;
-        }
-        self.count += 1;
+        let q = &self.q;
+        let dot = |g: &DofVec| g[..self.dof].iter().zip(q).map(|(a, b)| a * b).sum::<f64>();
+        self.radii.push(
+            self.maps
+                .iter()
+                .map(|[gu, gv]| dot(gu).hypot(dot(gv)))
+                .collect(),
+        );
     }
 }
 
-impl StepObserver for OrbitSampler<'_> {
+impl StepObserver for Sampler<'_> {
     fn step(&mut self, step: &Step<'_>) -> Flow {
         // Sample k at t0 + k/samples of a revolution, k = 1..=samples (the
         // last exactly at the end, which the final step reaches).
@@ -82,9 +108,50 @@ impl StepObserver for OrbitSampler<'_> {
     }
 }
 
-/// Each bearing's orbit over the revolution after `(t, y)`, integrating
-/// `ode` (whose state has the layout of `system`) with `method`; `None`
-/// when the rotor names no bearings or the revolution cannot be integrated.
+/// The revolution (2π/ω) after `(t, y)`, integrating `ode` (whose state has
+/// the layout of `system`) with `method`, sampled `samples_per_rev` times
+/// (at least 32) at the places `maps`; `None` when it cannot be integrated.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_revolution<S: OdeSystem + ?Sized>(
+    method: Method,
+    ode: &S,
+    system: &RotorSystem,
+    (t, y): (f64, &[f64]),
+    omega: f64,
+    samples_per_rev: u32,
+    options: &SolverOptions,
+    maps: &[[DofVec; 2]],
+) -> Option<Revolution> {
+    if !y.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let rev = 2.0 * PI / omega;
+    let samples = samples_per_rev.max(32);
+    let dof = system.rotor().dof();
+    let mut sampler = Sampler {
+        maps,
+        dof,
+        t0: t,
+        rev,
+        samples,
+        next: 1,
+        q: vec![0.0; dof],
+        radii: Vec::with_capacity(samples as usize),
+    };
+    let report = solve(method, ode, t, y, t + rev, options, &mut sampler);
+    if matches!(report.status, Status::Failed(_)) || sampler.radii.len() != samples as usize {
+        return None;
+    }
+    Some(Revolution {
+        radii: sampler.radii,
+        t: report.t,
+        y: report.y,
+    })
+}
+
+/// Each bearing's orbit over the revolution after `(t, y)` (see
+/// [`integrate_revolution`]); `None` when the rotor names no bearings or the
+/// revolution cannot be integrated.
 #[allow(clippy::too_many_arguments)]
 pub fn bearing_orbits<S: OdeSystem + ?Sized>(
     method: Method,
@@ -95,40 +162,20 @@ pub fn bearing_orbits<S: OdeSystem + ?Sized>(
     omega: f64,
     samples_per_rev: u32,
     options: &SolverOptions,
-) -> Option<Vec<BearingOrbit>> {
+) -> Option<Vec<Orbit>> {
     let maps = system.rotor().bearing_maps();
-    if maps.is_empty() || !y.iter().all(|v| v.is_finite()) {
+    if maps.is_empty() {
         return None;
     }
-    let rev = 2.0 * PI / omega;
-    let samples = samples_per_rev.max(32);
-    let dof = system.rotor().dof();
-    let mut sampler = OrbitSampler {
-        maps: &maps,
-        dof,
-        t0: t,
-        rev,
-        samples,
-        next: 1,
-        q: vec![0.0; dof],
-        peak: vec![0.0; maps.len()],
-        sum_sq: vec![0.0; maps.len()],
-        count: 0,
-    };
-    let report = solve(method, ode, t, y, t + rev, options, &mut sampler);
-    if matches!(report.status, Status::Failed(_)) || sampler.count == 0 {
-        return None;
-    }
-    let n = sampler.count as f64;
-    Some(
-        sampler
-            .peak
-            .iter()
-            .zip(&sampler.sum_sq)
-            .map(|(&peak, &s)| BearingOrbit {
-                peak,
-                rms: (s / n).sqrt(),
-            })
-            .collect(),
-    )
+    let revolution = integrate_revolution(
+        method,
+        ode,
+        system,
+        (t, y),
+        omega,
+        samples_per_rev,
+        options,
+        &maps,
+    )?;
+    Some((0..maps.len()).map(|m| revolution.orbit(m)).collect())
 }

@@ -7,6 +7,7 @@
 
 mod estimate;
 pub mod settings;
+pub mod stepped;
 
 pub use settings::{Fidelity, MethodChoice, SolverSettings, scaled_atol};
 
@@ -116,6 +117,34 @@ impl Simulation {
         Ok(RunResult { metrics, series })
     }
 
+    /// The solver options of this simulation's runs of `system` at speed ω
+    /// (absolute tolerances scaled by A_ref), for an explicit or implicit method.
+    fn solver_options(
+        &self,
+        system: &RotorSystem,
+        a_ref: f64,
+        omega: f64,
+        explicit: bool,
+    ) -> SolverOptions {
+        SolverOptions {
+            rtol: self.solver.rtol,
+            atol: scaled_atol(system, self.solver.atol(), a_ref, omega),
+            h0: None,
+            h_max: f64::INFINITY,
+            max_steps: self.solver.max_steps,
+            max_wall: Some(std::time::Duration::from_secs_f64(
+                self.solver.max_wall_seconds,
+            )),
+            reduce_second_order: !self.solver.full_newton,
+            structured_newton: !self.solver.dense_newton,
+            stiffness: if explicit && self.solver.implicit_fallback {
+                Stiffness::SwitchToImplicit
+            } else {
+                Stiffness::Ignore
+            },
+        }
+    }
+
     /// Integrate `ode` (whose state has the layout of `system`), switching to
     /// Radau5 when an explicit method stalls; `frame` is ω for the rotating frame.
     fn integrate<'a, S: OdeSystem>(
@@ -145,23 +174,7 @@ impl Simulation {
                 observer = observer.certify_with(ode, self.solver.rtol);
             }
         }
-        let options = SolverOptions {
-            rtol: self.solver.rtol,
-            atol: scaled_atol(system, self.solver.atol(), observer.a_ref(), omega),
-            h0: None,
-            h_max: f64::INFINITY,
-            max_steps: self.solver.max_steps,
-            max_wall: Some(std::time::Duration::from_secs_f64(
-                self.solver.max_wall_seconds,
-            )),
-            reduce_second_order: !self.solver.full_newton,
-            structured_newton: !self.solver.dense_newton,
-            stiffness: if explicit && self.solver.implicit_fallback {
-                Stiffness::SwitchToImplicit
-            } else {
-                Stiffness::Ignore
-            },
-        };
+        let options = self.solver_options(system, observer.a_ref(), omega, explicit);
         let report = solve(method, ode, 0.0, y0, t_end, &options, &mut observer);
         let (mut metrics, series) = observer.finish(&report);
         if metrics.outcome.has_residual() {

@@ -66,6 +66,21 @@ fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String
             facts.a_ref_median * 1e6
         );
     }
+    if let Some((floor, why)) = plan
+        .file
+        .scene
+        .effects
+        .whirl_floor()
+        .filter(|&(f, _)| f >= band)
+    {
+        return format!(
+            "{why} = {:.3} µm, as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): no balancer gets inside it; true the race, or judge against a band wider than the floor (metrics.delta above {:.3})",
+            floor * 1e6,
+            band * 1e6,
+            facts.a_ref_median * 1e6,
+            floor / facts.a_ref_median
+        );
+    }
     if facts.over_capacity_share >= 0.5 {
         return format!(
             "the capacity C = {:.4e} kg·m is below the unbalance drawn in {:.0} % of runs: use more or heavier weights, or a larger race",

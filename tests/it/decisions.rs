@@ -112,6 +112,34 @@ fn a_dead_band_wider_than_the_settling_band_crowns_no_design_and_is_named() {
     assert!(verdicts.contains(&"no_design_balances"), "{verdicts:?}");
 }
 
+/// An off-centre race leaves its plane whirling at e_r whatever the weights
+/// do: a floor above the settling band is named as the cause (before, the
+/// diagnosis said "none of the usual causes applies").
+#[test]
+fn a_race_eccentricity_above_the_settling_band_is_named_as_the_cause() {
+    let tmp = tempfile::tempdir().unwrap();
+    // e_r = 10 µm against δ·A_ref of about 2 µm (U = 0.2–0.4 of capacity).
+    let text = drum_like(
+        &tmp.path().join("results"),
+        "runout",
+        r#"{ distribution = "uniform", min = 0.2, max = 0.4, relative_to = "capacity" }"#,
+        "[scene.effects.race_eccentricity]\noffset = 1e-5\n",
+    );
+    let out = run(tmp.path(), &text, &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    assert!(
+        stdout.contains("verdict: no design balances this rotor"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("cause: the race eccentricity e_r (effects.race_eccentricity.offset)")
+            && stdout.contains("r = e_r = 10.000 µm"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("recommendation: design"), "{stdout}");
+}
+
 #[test]
 fn runs_out_of_budget_make_the_study_exit_1_naming_max_steps_after_writing_everything() {
     let tmp = tempfile::tempdir().unwrap();

@@ -46,6 +46,7 @@ mod rolling_resistance;
 mod sample_bounds;
 mod schema;
 mod sommerfeld;
+mod stepped_sweep;
 mod structured_newton;
 mod study_input;
 mod study_runner;

@@ -60,6 +60,16 @@ pub fn sweep_points(text: &str) -> Result<usize, String> {
     whole_in(text, "speeds of the sweep, ends included", 2, MAX_POINTS)
 }
 
+/// `stepped --dwell`: seconds at each speed, in (0, one day].
+pub fn dwell_seconds(text: &str) -> Result<f64, String> {
+    number_in(text, "seconds held at each speed; a day at most", 86_400.0)
+}
+
+/// `stepped --step-rpm`: rpm between steps, in (0, 10⁶].
+pub fn step_rpm(text: &str) -> Result<f64, String> {
+    number_in(text, "rpm between two steps", 1e6)
+}
+
 /// `--progress-every`: seconds in (0, [`MAX_PROGRESS_SECONDS`]].
 pub fn progress_seconds(text: &str) -> Result<f64, String> {
     number_in(

@@ -21,6 +21,7 @@ mod ranking;
 mod report_cmd;
 mod run_cmd;
 mod simulate_cmd;
+mod stepped_cmd;
 mod sweep_cmd;
 mod tradeoff_cmd;
 
@@ -88,6 +89,9 @@ enum Command {
     /// Simulate one scene over a grid of speeds next to the criterion and linear stability.
     #[command(after_help = sweep_cmd::EXAMPLES)]
     Sweep(sweep_cmd::SweepArgs),
+    /// Stepped speed sweep carrying the state, run-up then run-down, as rigs are measured.
+    #[command(after_help = stepped_cmd::EXAMPLES)]
+    Stepped(stepped_cmd::SteppedArgs),
     /// Stability map of the balanced state over speed and unbalance (Parquet and a character picture).
     #[command(after_help = map_cmd::EXAMPLES)]
     Map(map_cmd::MapArgs),
@@ -149,6 +153,7 @@ fn main() -> ExitCode {
         Command::Linear(args) => linear_cmd::run(&args),
         Command::Sweep(args) => sweep_cmd::run(&args),
         Command::Map(args) => map_cmd::run(&args),
+        Command::Stepped(args) => stepped_cmd::run(&args),
         Command::Run(args) => run_cmd::run(&args),
         Command::Merge(args) => run_cmd::merge_shards(&args),
         Command::Optimize(args) => optimize_cmd::run(&args),

@@ -138,6 +138,11 @@ pub trait EffectSpec {
     fn capacity_demand(&self, _planes: usize, _compliance: &dyn Fn(usize) -> Option<f64>) -> f64 {
         0.0
     }
+    /// The smallest whirl (m) any balancer leaves with this effect on, and
+    /// what sets it; `None` when the effect sets no such floor.
+    fn whirl_floor(&self) -> Option<(f64, &'static str)> {
+        None
+    }
     /// True when the effect makes the equations stiff by construction, so
     /// that the `auto` method starts implicit instead of waiting for a
     /// stiffness test to notice.
@@ -271,6 +276,14 @@ impl Effects {
         self.enabled()
             .map(|(_, spec)| spec.capacity_demand(planes, compliance))
             .sum()
+    }
+
+    /// The highest whirl floor among the enabled effects (see
+    /// [`EffectSpec::whirl_floor`]), with what sets it.
+    pub fn whirl_floor(&self) -> Option<(f64, &'static str)> {
+        self.enabled()
+            .filter_map(|(_, spec)| spec.whirl_floor())
+            .max_by(|a, b| a.0.total_cmp(&b.0))
     }
 
     /// Why an enabled effect rules out the rotating-frame formulation, if one does.

@@ -84,6 +84,15 @@ impl EffectSpec for RaceEccentricity {
             .fold(0.0, f64::max)
     }
 
+    /// The weights centre the race on the axis and leave its plane whirling
+    /// at exactly r = e_r (docs/model.md): no balancer does better.
+    fn whirl_floor(&self) -> Option<(f64, &'static str)> {
+        (self.offset > 0.0).then_some((
+            self.offset,
+            "the race eccentricity e_r (effects.race_eccentricity.offset): the weights centre the race on the axis and leave its plane whirling at r = e_r",
+        ))
+    }
+
     fn check_scene(&self, key: &str, facts: &SceneFacts) -> Result<(), SceneError> {
         if self.offset == 0.0 {
             return Ok(());

@@ -1,0 +1,183 @@
+//! `study stepped`: one scene stepped up (and back down) through a speed
+//! range with a dwell at each step, carrying the state, as rigs are measured.
+
+use crate::UserError;
+use autobal::output_file::{WhenExists, prepare};
+use autobal::scene_file::SceneFile;
+use autobal::simulation::stepped::{StepPoint, SteppedError, stepped_speeds, to_dataframe};
+use autobal::study::io::{Provenance, write_parquet};
+use clap::Args;
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+/// Examples shown under `study stepped --help`.
+pub const EXAMPLES: &str = "Examples:
+  study stepped scenes/bristol_rig.toml --rpm 1000..5000 --step-rpm 100 --dwell 0.25
+  study stepped scenes/two_support_long.toml --rpm 10..60 --step-rpm 2.5 --dwell 60 --up-only
+  study stepped scenes/bristol_rig.toml --rpm 1000..3000 --step-rpm 50 --dwell 0.5 --out steps.parquet";
+
+/// Arguments of `study stepped`.
+#[derive(Args)]
+pub struct SteppedArgs {
+    /// Scene file (TOML); its speed law is replaced by each step's constant
+    /// speed, and its start is where the run-up begins.
+    scene: PathBuf,
+    /// Speed range `lo..hi` (rpm): the run-up goes from lo to hi.
+    #[arg(long)]
+    rpm: String,
+    /// Speed step between dwells (rpm); the last step up ends at hi.
+    #[arg(long, value_parser = crate::limits::step_rpm)]
+    step_rpm: f64,
+    /// Time held at each speed (s), at least one revolution: the last
+    /// revolution of each dwell is the one measured.
+    #[arg(long, value_parser = crate::limits::dwell_seconds)]
+    dwell: f64,
+    /// Run up only (by default the run-down from hi back to lo follows).
+    #[arg(long)]
+    up_only: bool,
+    /// Write one row per step to this Parquet file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Replace the --out file if it exists.
+    #[arg(long, requires = "out")]
+    overwrite: bool,
+    /// Print the steps as JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Most steps one sweep may take (each a whole dwell's integration).
+const MAX_STEPS: f64 = 100_000.0;
+
+fn parse_rpm(text: &str) -> Result<(f64, f64), UserError> {
+    let bad = || {
+        UserError(
+            format!("--rpm {text}: expected lo..hi with 0 < lo < hi, e.g. 1000..5000"),
+            2,
+        )
+    };
+    let (a, b) = text.split_once("..").ok_or_else(bad)?;
+    let (lo, hi): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if lo > 0.0 && hi > lo && hi.is_finite() {
+        Ok((lo, hi))
+    } else {
+        Err(bad())
+    }
+}
+
+/// Run `study stepped`.
+pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
+    let (lo, hi) = parse_rpm(&args.rpm)?;
+    if (hi - lo) / args.step_rpm > MAX_STEPS {
+        return Err(UserError(
+            format!(
+                "--step-rpm {}: {:.0} steps from {lo} to {hi} rpm, more than {MAX_STEPS}; take larger steps",
+                args.step_rpm,
+                (hi - lo) / args.step_rpm
+            ),
+            2,
+        ));
+    }
+    if let Some(path) = &args.out {
+        prepare("--out", path, WhenExists::from_overwrite(args.overwrite))?;
+    }
+    let shown = args.scene.display().to_string();
+    let file = SceneFile::read(&args.scene)?;
+    let simulation = file.simulation(&shown)?;
+    let to_rad = PI / 30.0;
+    let speeds = stepped_speeds(
+        lo * to_rad,
+        hi * to_rad,
+        args.step_rpm * to_rad,
+        !args.up_only,
+    );
+    let (points, failure) = match simulation.stepped_sweep(&speeds, args.dwell) {
+        Ok(points) => (points, None),
+        Err(SteppedError::Scene(e)) if matches!(&e, autobal::model::scene::SceneError::Invalid { field, .. } if field == "dwell") =>
+        {
+            return Err(UserError(
+                format!("--dwell {}: {}", args.dwell, reason(&e)),
+                2,
+            ));
+        }
+        Err(SteppedError::Scene(e)) => return Err(e.into()),
+        Err(SteppedError::Failed { done, omega, why }) => (
+            done,
+            Some(format!(
+                "the solver stopped in the dwell at {:.1} rpm: {why}",
+                omega / to_rad
+            )),
+        ),
+    };
+    if let Some(path) = &args.out {
+        let text = autobal::input_file::read_text(&args.scene)?;
+        let provenance = Provenance::new(&text, 0, "stepped sweep");
+        let mut df = to_dataframe(&points).map_err(|e| UserError::internal(e.to_string()))?;
+        write_parquet(path, &mut df, &provenance)
+            .map_err(|e| UserError::internal(format!("--out {e}")))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&points)?);
+    } else {
+        print!("{}", describe(&points));
+    }
+    match failure {
+        // The steps before the failure are kept and shown; the run says why it stopped.
+        Some(why) => Err(UserError(why, 1)),
+        None => Ok(()),
+    }
+}
+
+/// The reason part of a scene error.
+fn reason(e: &autobal::model::scene::SceneError) -> String {
+    match e {
+        autobal::model::scene::SceneError::Invalid { reason, .. } => reason.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// The steps as a text table.
+fn describe(points: &[StepPoint]) -> String {
+    let bearings = points.iter().any(|p| p.bearing_peak.is_some());
+    let rows: Vec<Vec<String>> = points
+        .iter()
+        .map(|p| {
+            let mut row = vec![
+                p.direction.name().to_string(),
+                format!("{:.1}", p.omega * 30.0 / PI),
+                format!("{:.3}", p.omega),
+                format!("{:.3e}", p.whirl_peak),
+            ];
+            if bearings {
+                let peaks = p.bearing_peak.clone().unwrap_or_default();
+                let mean = peaks.iter().sum::<f64>() / peaks.len().max(1) as f64;
+                row.push(
+                    peaks
+                        .iter()
+                        .map(|x| format!("{x:.3e}"))
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                );
+                row.push(format!("{mean:.3e}"));
+                let without = p.bearing_peak_without.clone().unwrap_or_default();
+                let mean_without = without.iter().sum::<f64>() / without.len().max(1) as f64;
+                row.push(format!("{:.3}", mean / mean_without));
+            }
+            row.push(format!("{:.2e}", p.balancing_error));
+            row
+        })
+        .collect();
+    let mut header = vec!["run", "speed\nrpm", "ω\nrad/s", "whirl peak\nm"];
+    if bearings {
+        header.push("bearing peaks\nm");
+        header.push("mean of peaks\nm");
+        header.push("over\nwithout");
+    }
+    header.push("ε");
+    let mut s = crate::output::text_table(&header, &rows);
+    s += "\nEach row: the last revolution of the dwell at that speed, the state carried from the step before. Whirl: the largest balancer (or load) plane's radial displacement; bearing peaks: each support's; over without: the mean of the peaks over the same mean without the balancer's unbalance (the rotor's own unbalance, weights' mass carried); ε: the unbalance left over U.\n";
+    s
+}
