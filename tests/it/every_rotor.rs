@@ -398,3 +398,58 @@ fn the_bearing_orbits_after_a_run_are_the_forced_response_at_the_bearings() {
         }
     }
 }
+
+/// The flexible shaft (a disc on a cantilever) and a rigid rotor on two
+/// supports share the kinetic energy and the form of the potential
+/// ½k11(x² + y²) + ½k33(α² + β²) + k14(xβ − yα): supports at ±l with
+/// l² = k33/k11 and k2 − k1 = k14/l give the shaft's k11, k14, k33, and
+/// dampers b at both supports give c_t = 2b, c_r = 2b l². The two models,
+/// written apart, must then run the same under every effect. (The sign of
+/// k14 is a symmetry of both, (α, β) → −(α, β), so only its size shows;
+/// a 10 % error in l or a factor 2 in c_r fails at A_ref.)
+#[test]
+fn the_flexible_shaft_is_its_equivalent_two_support_rotor_under_every_effect() {
+    // EI = 1/12, L = 1: k11 = 12EI/L³ = 1, k14 = −6EI/L² = −0.5, k33 = 4EI/L = 1/3.
+    let (k11, k14, k33) = (1.0f64, -0.5f64, 1.0f64 / 3.0);
+    let l = (k33 / k11).sqrt();
+    let (k1, k2) = ((k11 - k14 / l) / 2.0, (k11 + k14 / l) / 2.0);
+    let c_t = 0.2;
+    let angle = "17.188733853924695";
+    let flexible = format!(
+        "[rotor]\nmodel = \"flexible\"\nmass = 1.0\ntransverse_inertia = 0.25\npolar_inertia = 0.5\nei = {}\nlength = 1.0\nc_t = {c_t}\nc_r = {}\neccentricity = 0.01\nunbalance_angle_deg = {angle}\n{}",
+        1.0 / 12.0,
+        c_t * l * l,
+        tail()
+    );
+    let two_support = format!(
+        "[rotor]\nmodel = \"two_support\"\nmass = 1.0\ntransverse_inertia = 0.25\npolar_inertia = 0.5\nl1 = {l}\nl2 = {l}\nk1 = {k1}\nk2 = {k2}\nb1 = {b}\nb2 = {b}\nplanes = [0.0]\nstatic_unbalance = 0.01\nstatic_angle_deg = {angle}\n{}",
+        tail(),
+        b = c_t / 2.0
+    );
+    for (name, effects) in EFFECTS {
+        let a = run(&format!("{flexible}{effects}"));
+        let b = run(&format!("{two_support}{effects}"));
+        assert_eq!(a.metrics.outcome, b.metrics.outcome, "{name}");
+        assert!(
+            (a.metrics.a_ref / b.metrics.a_ref - 1.0).abs() < 1e-9,
+            "{name}: A_ref {} vs {}",
+            a.metrics.a_ref,
+            b.metrics.a_ref
+        );
+        let (sa, sb) = (a.series.unwrap(), b.series.unwrap());
+        let n = sa.r.len().min(sb.r.len());
+        assert!(n > 1000, "{name}: {n} samples");
+        let worst = (0..n)
+            .map(|i| (sa.r[i] - sb.r[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 1e-5 * a.metrics.a_ref,
+            "{name}: r differs by {worst:e} (A_ref {:e})",
+            a.metrics.a_ref
+        );
+        for j in 0..3 {
+            let d = (sa.psi[j][n - 1] - sb.psi[j][n - 1]).abs();
+            assert!(d < 1e-5, "{name}: weight {j} differs by {d} rad");
+        }
+    }
+}
