@@ -242,8 +242,13 @@ pub struct BestVersusRest {
     pub others: Vec<(Comparison, f64, Verdict)>,
 }
 
-/// Design indices of `designs`, best first by `criterion` (ties: the lower
-/// restricted mean, then the lower residual p95, then the grid order).
+/// Design indices of `designs`, best first: the designs that balance
+/// ([`balances`]) before those that do not, each group by `criterion`
+/// (ties: the lower restricted mean, then the lower residual p95, then the
+/// grid order). A design that settles in under half its runs is no answer
+/// to "which one do I build", however fast its lucky runs are, so it never
+/// ranks above one that works (before 2026-11-27 it could, and then the
+/// study printed "no design balances" beside a design that did).
 pub fn ranking(designs: &[DesignRuns], criterion: Criterion, scale: &Scale) -> Vec<usize> {
     // Ties (every design at τ when none settles, for instance) go to the
     // lower restricted mean, then to the lower residual p95: of designs that
@@ -258,10 +263,12 @@ pub fn ranking(designs: &[DesignRuns], criterion: Criterion, scale: &Scale) -> V
             ]
         })
         .collect();
+    let fails: Vec<bool> = designs.iter().map(|d| !balances(d)).collect();
     let mut order: Vec<usize> = (0..designs.len()).collect();
     order.sort_by(|&x, &y| {
-        criterion
-            .order(keys[x][0], keys[y][0])
+        fails[x]
+            .cmp(&fails[y])
+            .then(criterion.order(keys[x][0], keys[y][0]))
             .then(Criterion::Mean.order(keys[x][1], keys[y][1]))
             .then(Criterion::ResidualP95.order(keys[x][2], keys[y][2]))
             .then(x.cmp(&y))
@@ -393,5 +400,49 @@ pub fn holm_across(families: &mut [BestVersusRest]) {
                 Verdict::NotDistinguishable
             };
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::survival::Observation;
+    use crate::study::criterion::Within;
+
+    /// Runs that settle at `settled` (revolutions) or are censored at 500.
+    fn design(id: u32, settled: &[Option<f64>]) -> DesignRuns {
+        DesignRuns {
+            design_id: id,
+            sample_ids: (0..settled.len() as u32).collect(),
+            settling: settled
+                .iter()
+                .map(|s| match s {
+                    Some(t) => Observation { time: *t, settled: true },
+                    None => Observation { time: 500.0, settled: false },
+                })
+                .collect(),
+            residual: settled.iter().map(|s| Some(if s.is_some() { 0.02 } else { 0.5 })).collect(),
+            residual_abs: vec![Some(1e-6); settled.len()],
+        }
+    }
+
+    #[test]
+    fn a_design_that_works_ranks_above_a_faster_one_that_mostly_fails() {
+        // A: 4 of 10 runs settle by 10 rev, the rest never (40 %: no
+        // balancer); B: every run settles at 40 rev. By "settled by 30 rev"
+        // A leads, 0.4 against 0; the crown goes to B, which works.
+        let mut a = vec![Some(10.0); 4];
+        a.extend([None; 6]);
+        let designs = [design(0, &a), design(1, &[Some(40.0); 10])];
+        let scale = Scale { tau: 490.0, rev_seconds: 0.01 };
+        let by = Criterion::SettledBy(Within::Revs(30.0));
+        assert_eq!(by.value(&designs[0], &scale), Some(0.4));
+        assert_eq!(ranking(&designs, by, &scale), vec![1, 0]);
+        let v = best_versus_rest(&designs, by, &scale, 0.05, true, 1).unwrap();
+        assert_eq!((v.best, v.works), (1, true));
+        // With neither working, the criterion alone orders them.
+        let designs = [design(0, &a), design(1, &a[1..].to_vec())];
+        let v = best_versus_rest(&designs, by, &scale, 0.05, true, 1).unwrap();
+        assert!(!v.works);
     }
 }
