@@ -157,7 +157,9 @@ fn disagreement(c: &Comparison, holm: &[f64], alpha: f64, a: &str, b: &str) -> S
         .skip(1)
         .filter(|(m, p)| {
             m.difference.is_some_and(|d| {
-                **p <= alpha && d.difference != 0.0 && m.criterion.a_better(d.difference) != a_ahead
+                **p <= alpha
+                    && crate::study::verdict::material(d.a, d.b, d.difference)
+                    && m.criterion.a_better(d.difference) != a_ahead
             })
         })
         .map(|(m, p)| format!("the {} (Holm-adjusted {})", m.criterion.label(), p_text(*p)))

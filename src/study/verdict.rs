@@ -46,17 +46,37 @@ pub struct MeasureComparison {
     pub p_holm: f64,
 }
 
+/// The smallest difference worth reporting, relative to the larger of the
+/// two values compared: 1 %. A difference below it is "not
+/// distinguishable" however small its p-value (a residual p95 of 0.3640
+/// against 0.3640, 3·10⁻⁶ apart, was once reported as a disagreement at
+/// Holm p 0.001).
+pub const MIN_RELATIVE_EFFECT: f64 = 0.01;
+
+/// Whether a difference between values `a` and `b` is large enough to report.
+pub fn material(a: f64, b: f64, difference: f64) -> bool {
+    difference.abs() >= MIN_RELATIVE_EFFECT * a.abs().max(b.abs())
+}
+
 impl MeasureComparison {
-    /// True when A is better than B on this measure at level `alpha`.
+    /// True when A is better than B on this measure at level `alpha`, by a
+    /// difference worth reporting ([`material`]).
     pub fn a_better_at(&self, alpha: f64) -> bool {
-        self.difference
-            .is_some_and(|d| self.p_holm <= alpha && self.criterion.a_better(d.difference))
+        self.difference.is_some_and(|d| {
+            self.p_holm <= alpha
+                && material(d.a, d.b, d.difference)
+                && self.criterion.a_better(d.difference)
+        })
     }
 
-    /// True when B is better than A on this measure at level `alpha`.
+    /// True when B is better than A on this measure at level `alpha`, by a
+    /// difference worth reporting.
     pub fn b_better_at(&self, alpha: f64) -> bool {
         self.difference.is_some_and(|d| {
-            self.p_holm <= alpha && d.difference != 0.0 && !self.criterion.a_better(d.difference)
+            self.p_holm <= alpha
+                && d.difference != 0.0
+                && material(d.a, d.b, d.difference)
+                && !self.criterion.a_better(d.difference)
         })
     }
 }
@@ -417,11 +437,20 @@ mod tests {
             settling: settled
                 .iter()
                 .map(|s| match s {
-                    Some(t) => Observation { time: *t, settled: true },
-                    None => Observation { time: 500.0, settled: false },
+                    Some(t) => Observation {
+                        time: *t,
+                        settled: true,
+                    },
+                    None => Observation {
+                        time: 500.0,
+                        settled: false,
+                    },
                 })
                 .collect(),
-            residual: settled.iter().map(|s| Some(if s.is_some() { 0.02 } else { 0.5 })).collect(),
+            residual: settled
+                .iter()
+                .map(|s| Some(if s.is_some() { 0.02 } else { 0.5 }))
+                .collect(),
             residual_abs: vec![Some(1e-6); settled.len()],
         }
     }
@@ -434,7 +463,10 @@ mod tests {
         let mut a = vec![Some(10.0); 4];
         a.extend([None; 6]);
         let designs = [design(0, &a), design(1, &[Some(40.0); 10])];
-        let scale = Scale { tau: 490.0, rev_seconds: 0.01 };
+        let scale = Scale {
+            tau: 490.0,
+            rev_seconds: 0.01,
+        };
         let by = Criterion::SettledBy(Within::Revs(30.0));
         assert_eq!(by.value(&designs[0], &scale), Some(0.4));
         assert_eq!(ranking(&designs, by, &scale), vec![1, 0]);
@@ -444,5 +476,34 @@ mod tests {
         let designs = [design(0, &a), design(1, &a[1..].to_vec())];
         let v = best_versus_rest(&designs, by, &scale, 0.05, true, 1).unwrap();
         assert!(!v.works);
+    }
+
+    #[test]
+    fn a_difference_below_one_percent_is_not_reported_however_significant() {
+        use crate::stats::paired_measures::Difference;
+        let tiny = MeasureComparison {
+            criterion: Criterion::ResidualP95,
+            difference: Some(Difference {
+                a: 0.364_003,
+                b: 0.364_000,
+                difference: 3e-6,
+                interval: (2e-6, 4e-6),
+                p_value: 1e-4,
+                test: "bootstrap_paired",
+            }),
+            p_holm: 1e-3,
+        };
+        assert!(!tiny.b_better_at(0.05) && !tiny.a_better_at(0.05));
+        let real = MeasureComparison {
+            difference: Some(Difference {
+                a: 0.40,
+                b: 0.36,
+                difference: 0.04,
+                ..tiny.difference.unwrap()
+            }),
+            ..tiny
+        };
+        assert!(real.b_better_at(0.05));
+        assert!(material(10.0, 9.9, 0.1) && !material(10.0, 9.95, 0.05));
     }
 }

@@ -626,7 +626,12 @@ fn disagreement_line(
             let hi = sum.f(&format!("vs_best_{name}_diff_hi"))?[i];
             let p = sum.f(&format!("vs_best_{name}_p_holm"))?[i];
             let values = sum.f(value_column(*m))?;
-            let significant = p.is_some_and(|p| p <= alpha);
+            // Significant and large enough to matter (verdict::material).
+            let significant = p.is_some_and(|p| p <= alpha)
+                && match (diff, values[i], values[best]) {
+                    (Some(d), Some(a), Some(b)) => autobal::study::verdict::material(a, b, d),
+                    _ => true,
+                };
             let this_better = diff.is_some_and(|d| {
                 if m.lower_is_better() {
                     d < 0.0
