@@ -473,7 +473,7 @@ mod tests {
         let v = best_versus_rest(&designs, by, &scale, 0.05, true, 1).unwrap();
         assert_eq!((v.best, v.works), (1, true));
         // With neither working, the criterion alone orders them.
-        let designs = [design(0, &a), design(1, &a[1..].to_vec())];
+        let designs = [design(0, &a), design(1, &a[1..])];
         let v = best_versus_rest(&designs, by, &scale, 0.05, true, 1).unwrap();
         assert!(!v.works);
     }
