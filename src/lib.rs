@@ -36,6 +36,7 @@ pub mod input_file;
 pub mod integrate;
 pub mod metrics;
 pub mod model;
+pub mod number_text;
 pub mod optimize;
 pub mod output_file;
 pub mod plot;

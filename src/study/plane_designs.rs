@@ -275,7 +275,7 @@ fn label(d: &Design, units: bool) -> String {
         joined(&|p| p.spec.kind.name().to_string()),
         joined(&|p| p.spec.n.to_string()),
         joined(&|p| format!("{:.3}", p.rho)),
-        joined(&|p| p.spec.drag.to_string()),
+        joined(&|p| crate::number_text::significant(p.spec.drag, 4)),
         unit(" N·s/m")
     )
 }

@@ -87,7 +87,7 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
                     Some(p) => format!("{:.3}/{:.3}", e.candidate.rho, p.rho),
                     None => format!("{:.3}", e.candidate.rho),
                 },
-                format!("{}", e.candidate.drag),
+                autobal::number_text::significant(e.candidate.drag, 4),
                 e.value.map_or("–".into(), |v| with_se(v, e.std_err)),
                 with_se(e.std_err, e.std_err),
                 e.capacity.map_or("–".into(), |c| format!("{c:.4e}")),

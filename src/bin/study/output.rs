@@ -29,15 +29,18 @@ pub fn terminal_columns() -> usize {
 }
 
 /// `text` with every line wrapped at words to `width` (continuation lines
-/// indented by two spaces); unchanged for `None`.
+/// indented by two spaces); lines kept whole for `None`. Every line ends in
+/// a newline either way.
 pub fn wrap(text: &str, width: Option<usize>) -> String {
-    let Some(width) = width else {
-        return text.to_string();
-    };
-    let options = textwrap::Options::new(width).subsequent_indent("  ");
+    // Every line ends in a newline at any width: at full width too, or a
+    // text without one runs into the next ("failures 0wrote results/…").
+    let options = width.map(|w| textwrap::Options::new(w).subsequent_indent("  "));
     let mut out = String::new();
     for line in text.lines() {
-        out.push_str(&textwrap::fill(line, &options));
+        match &options {
+            Some(options) => out.push_str(&textwrap::fill(line, options)),
+            None => out.push_str(line),
+        }
         out.push('\n');
     }
     out
@@ -192,5 +195,18 @@ pub fn p_value_text(p: f64) -> String {
         "< 0.0001".to_string()
     } else {
         format!("{p:.4}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap;
+
+    #[test]
+    fn every_line_ends_in_a_newline_at_any_width() {
+        let text = "finished: 8 runs, failures 0";
+        assert_eq!(wrap(text, None), format!("{text}\n"));
+        assert_eq!(wrap("a\n\nb\n", None), "a\n\nb\n");
+        assert_eq!(wrap("one two three", Some(40)), "one two three\n");
     }
 }

@@ -44,9 +44,12 @@ impl Summary<'_> {
     }
 }
 
-/// A value as the user wrote it (`10`, `0.5`), or "–".
+/// A parameter to four significant digits (`10`, `0.5`, not
+/// `0.05000000000000001`), or "–".
 fn plain(v: Option<f64>) -> String {
-    v.map_or("–".to_string(), |x| format!("{x}"))
+    v.map_or("–".to_string(), |x| {
+        autobal::number_text::significant(x, 4)
+    })
 }
 
 /// A number with `digits` decimals, or "–".
