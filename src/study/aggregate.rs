@@ -199,6 +199,10 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
         rows.res_median.push(res_q(0.5));
         rows.res_p95.push(res_q(0.95));
+        // Over every run: a failed run has no residual and is not counted worse.
+        let worse = residual.iter().flatten().filter(|&r| r > 1.0).count();
+        rows.worse_than_none
+            .push((runs_n > 0).then(|| worse as f64 / runs_n as f64));
         let abs_sorted = sorted_values(simulated.column("residual_abs")?.f64()?);
         rows.res_abs_p95
             .push(quantile_sorted(&abs_sorted, 0.95, Interpolation::Linear));
@@ -306,6 +310,7 @@ struct SummaryColumns {
     res_mean: Vec<Option<f64>>,
     res_median: Vec<Option<f64>>,
     res_p95: Vec<Option<f64>>,
+    worse_than_none: Vec<Option<f64>>,
     /// 95th percentile of the residual whirl in metres.
     res_abs_p95: Vec<Option<f64>>,
     /// Seconds per revolution of the operating speed (the unit of every `*_revs` column).
@@ -446,6 +451,7 @@ impl SummaryColumns {
             Column::new("residual_rel_mean".into(), self.res_mean),
             Column::new("residual_rel_median".into(), self.res_median),
             Column::new("residual_rel_p95".into(), self.res_p95),
+            Column::new("worse_than_none_fraction".into(), self.worse_than_none),
             Column::new("residual_abs_p95".into(), self.res_abs_p95),
             Column::new("seconds_per_rev".into(), self.seconds_per_rev),
             Column::new("censored".into(), self.censored),

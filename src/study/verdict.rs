@@ -239,6 +239,36 @@ impl Verdict {
 /// residual/A_ref (median) it may leave, to be called a working balancer.
 pub const MIN_SETTLED_SHARE: f64 = 0.5;
 
+/// The share of runs a design that works settles in: below it a crowned
+/// design is recommended with its shortfall stated.
+pub const WORKS_SETTLED_SHARE: f64 = 0.9;
+
+/// The most runs a design that works may leave vibrating more than with no
+/// balancer (residual/A_ref above 1).
+pub const WORKS_WORSE_SHARE: f64 = 0.05;
+
+/// Where a design falls short of one that works, with the share measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shortfall {
+    /// It settles in fewer than [`WORKS_SETTLED_SHARE`] of its runs.
+    SettlesTooRarely(f64),
+    /// More than [`WORKS_WORSE_SHARE`] of its runs end worse than no balancer.
+    OftenWorseThanNone(f64),
+}
+
+/// The ways a design with these shares falls short of one that works
+/// (empty when it works).
+pub fn shortfalls(settled_share: f64, worse_than_none_share: f64) -> Vec<Shortfall> {
+    let mut out = Vec::new();
+    if settled_share < WORKS_SETTLED_SHARE {
+        out.push(Shortfall::SettlesTooRarely(settled_share));
+    }
+    if worse_than_none_share > WORKS_WORSE_SHARE {
+        out.push(Shortfall::OftenWorseThanNone(worse_than_none_share));
+    }
+    out
+}
+
 /// The best design against every other one.
 #[derive(Debug, Clone)]
 pub struct BestVersusRest {
@@ -505,5 +535,22 @@ mod tests {
         };
         assert!(real.b_better_at(0.05));
         assert!(material(10.0, 9.9, 0.1) && !material(10.0, 9.95, 0.05));
+    }
+
+    #[test]
+    fn a_marginal_winner_has_its_shortfalls_named() {
+        // The audit's crowned design: 65 % settled, 18 % worse than none.
+        assert_eq!(
+            shortfalls(0.65, 0.18),
+            vec![
+                Shortfall::SettlesTooRarely(0.65),
+                Shortfall::OftenWorseThanNone(0.18)
+            ]
+        );
+        assert!(shortfalls(0.95, 0.01).is_empty());
+        assert_eq!(
+            shortfalls(0.95, 0.06),
+            vec![Shortfall::OftenWorseThanNone(0.06)]
+        );
     }
 }

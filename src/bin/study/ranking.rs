@@ -6,6 +6,7 @@
 use crate::UserError;
 use crate::output::{dropped_note, fitted_table, p_value_text, text_table, text_width, wrap};
 use autobal::study::criterion::Criterion;
+use autobal::study::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE, shortfalls};
 use polars::prelude::DataFrame;
 
 /// Typed access to the summary's columns.
@@ -711,6 +712,32 @@ fn recommendation_line(
         ids[best],
         criterion.label()
     );
+    // A crown that falls short of a design that works says so, with the rule.
+    // Absent from summaries written before the column existed.
+    let worse = sum
+        .f("worse_than_none_fraction")
+        .ok()
+        .and_then(|v| v[best])
+        .unwrap_or(0.0);
+    let settled = sum.f("settled_fraction")?[best].unwrap_or(0.0);
+    let short: Vec<String> = shortfalls(settled, worse)
+        .iter()
+        .map(|s| match s {
+            Shortfall::SettlesTooRarely(f) => format!(
+                "it settles in only {:.1} % of its runs (a design that works settles in at least {:.0} %)",
+                100.0 * f,
+                100.0 * WORKS_SETTLED_SHARE
+            ),
+            Shortfall::OftenWorseThanNone(f) => format!(
+                "{:.1} % of its runs end vibrating more than with no balancer (at most {:.0} % for a design that works)",
+                100.0 * f,
+                100.0 * WORKS_WORSE_SHARE
+            ),
+        })
+        .collect();
+    if !short.is_empty() {
+        line += &format!(", with a caution: {}", short.join("; "));
+    }
     if members.len() > 1 {
         line += &format!(
             "; {} designs are not dominated on the study's Pareto measures: {}: if your requirement names another measure, choose among them by it",
