@@ -318,18 +318,19 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         header.push("M_s\nN·m".into());
     }
     header.push("settled\n%".into());
+    // Settling times carry their unit in the header, not only in a footnote.
     header.push(if criterion == Criterion::Median {
-        "median\n[95% CI]".into()
+        "median rev\n[95% CI]".into()
     } else {
-        "median".into()
+        "median\nrev".into()
     });
     header.push(if criterion == Criterion::Mean {
-        "mean\n[95% CI]".into()
+        "mean rev\n[95% CI]".into()
     } else {
-        "mean".into()
+        "mean\nrev".into()
     });
     header.extend([
-        "p90".into(),
+        "p90\nrev".into(),
         "residual\np95 µm".into(),
         "residual\np95/A_ref".into(),
     ]);
@@ -338,7 +339,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     }
     header.push("failed".into());
     header.push("Holm p\nvs #1".into());
-    header.push("Δ vs #1\n[95% CI]".into());
+    header.push("Δ vs #1 (paired)\n[95% CI]".into());
     // A run-up ranks on the clock from the operating speed; the median
     // from t = 0 (motor and balancer together) stands beside it.
     let run_up = sum
@@ -493,7 +494,7 @@ fn column_priority(header: &str, criterion: Criterion, any_failed: bool) -> u8 {
         "failed" => 8,
         h if h.starts_with("Holm p") => 3,
         h if h.starts_with("residual") && h.ends_with("µm") => 4,
-        "p90" => 6,
+        "p90\nrev" => 6,
         h if h.starts_with('Δ') => 7,
         _ => 5,
     }
@@ -644,8 +645,15 @@ fn disagreement_line(
                 }
             });
             if significant && this_better {
+                // The median's Δ is the median of the paired differences,
+                // not the difference of the two medians: say so.
+                let delta = if *m == Criterion::Median {
+                    "median paired Δ"
+                } else {
+                    "Δ"
+                };
                 better.push(format!(
-                    "{} {} vs {} (Δ {} [{}, {}], Holm p {})",
+                    "{} {} vs {} ({delta} {} [{}, {}], Holm p {})",
                     short(*m),
                     measure_text(*m, values[i]),
                     measure_text(*m, values[best]),
