@@ -46,6 +46,79 @@ pub struct MeasureComparison {
     pub p_holm: f64,
 }
 
+/// A design axis of the grid, as the study file names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// `designs.n`.
+    Count,
+    /// `designs.rho`.
+    Rho,
+    /// `designs.drag`.
+    Drag,
+}
+
+impl Axis {
+    /// The key in the study file.
+    pub fn key(self) -> &'static str {
+        match self {
+            Axis::Count => "designs.n",
+            Axis::Rho => "designs.rho",
+            Axis::Drag => "designs.drag",
+        }
+    }
+}
+
+/// A winner at the end of a swept axis: the axis, and whether it sits at
+/// the largest value swept (else the smallest).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Edge {
+    /// Which axis.
+    pub axis: Axis,
+    /// At the largest value swept.
+    pub high: bool,
+    /// The winner's value there.
+    pub value: f64,
+}
+
+/// The swept axes (at least three values among the designs of the winner's
+/// kind) on whose end the winner sits: there the best may lie beyond what
+/// was swept. `designs` holds (kind, n, ρ, β) per design, `best` its index.
+pub fn edges(designs: &[(String, f64, f64, f64)], best: usize) -> Vec<Edge> {
+    let Some(winner) = designs.get(best) else {
+        return Vec::new();
+    };
+    let pick = [
+        (
+            Axis::Count,
+            (|d: &(String, f64, f64, f64)| d.1) as fn(&(String, f64, f64, f64)) -> f64,
+        ),
+        (Axis::Rho, |d| d.2),
+        (Axis::Drag, |d| d.3),
+    ];
+    pick.iter()
+        .filter_map(|&(axis, value)| {
+            let mut swept: Vec<f64> = designs
+                .iter()
+                .filter(|d| d.0 == winner.0)
+                .map(value)
+                .filter(|v| v.is_finite())
+                .collect();
+            swept.sort_by(f64::total_cmp);
+            swept.dedup();
+            let v = value(winner);
+            if swept.len() < 3 {
+                return None;
+            }
+            let high = v == *swept.last()?;
+            (high || v == swept[0]).then_some(Edge {
+                axis,
+                high,
+                value: v,
+            })
+        })
+        .collect()
+}
+
 /// The smallest difference worth reporting, relative to the larger of the
 /// two values compared: 1 %. A difference below it is "not
 /// distinguishable" however small its p-value (a residual p95 of 0.3640
@@ -552,5 +625,29 @@ mod tests {
             shortfalls(0.95, 0.06),
             vec![Shortfall::OftenWorseThanNone(0.06)]
         );
+    }
+
+    #[test]
+    fn a_winner_at_the_end_of_a_sweep_names_the_axis_to_extend() {
+        let grid = |drags: &[f64]| -> Vec<(String, f64, f64, f64)> {
+            drags
+                .iter()
+                .map(|&b| ("ball".to_string(), 3.0, 0.3, b))
+                .collect()
+        };
+        // The optical drive: the largest drag swept wins.
+        let e = edges(&grid(&[3e-5, 3e-4, 3e-3]), 2);
+        assert_eq!(
+            e,
+            vec![Edge {
+                axis: Axis::Drag,
+                high: true,
+                value: 3e-3
+            }]
+        );
+        assert!(!edges(&grid(&[3e-5, 3e-4, 3e-3]), 0)[0].high);
+        // Inside the sweep, or a two-value comparison: nothing to extend.
+        assert!(edges(&grid(&[3e-5, 3e-4, 3e-3]), 1).is_empty());
+        assert!(edges(&grid(&[3e-4, 3e-3]), 1).is_empty());
     }
 }

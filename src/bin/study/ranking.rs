@@ -6,7 +6,9 @@
 use crate::UserError;
 use crate::output::{dropped_note, fitted_table, p_value_text, text_table, text_width, wrap};
 use autobal::study::criterion::Criterion;
-use autobal::study::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE, shortfalls};
+use autobal::study::verdict::{
+    Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE, edges, shortfalls,
+};
 use polars::prelude::DataFrame;
 
 /// Typed access to the summary's columns.
@@ -745,6 +747,29 @@ fn recommendation_line(
         .collect();
     if !short.is_empty() {
         line += &format!(", with a caution: {}", short.join("; "));
+    }
+    // A winner at the end of a swept axis: the best may lie beyond it.
+    let n: Vec<Option<u32>> = sum.0.column("n")?.u32()?.iter().collect();
+    let (kind, rho, drag) = (sum.s("kind")?, sum.f("rho")?, sum.f("drag")?);
+    let grid: Vec<(String, f64, f64, f64)> = (0..ids.len())
+        .map(|i| {
+            (
+                kind[i].clone().unwrap_or_default(),
+                n[i].map_or(f64::NAN, f64::from),
+                rho[i].unwrap_or(f64::NAN),
+                drag[i].unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    for e in edges(&grid, best) {
+        line += &format!(
+            "; it sits at the {} {} swept ({}): the best may lie beyond, so extend {} {} it",
+            if e.high { "largest" } else { "smallest" },
+            e.axis.key(),
+            autobal::number_text::significant(e.value, 4),
+            e.axis.key(),
+            if e.high { "above" } else { "below" },
+        );
     }
     if members.len() > 1 {
         line += &format!(
