@@ -126,6 +126,8 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         });
         rows.drag.push(design.spec.drag);
         rows.capacity.push(design.capacity);
+        rows.race_radius.push(design.spec.race_radius);
+        rows.weight_mass.push(design.weight_mass);
         rows.runs.push(runs_n);
         rows.settled.push(settled_n);
         rows.settled_fraction.push(if runs_n == 0 {
@@ -283,6 +285,8 @@ struct SummaryColumns {
     rho_rule: Vec<Option<String>>,
     drag: Vec<f64>,
     capacity: Vec<f64>,
+    race_radius: Vec<f64>,
+    weight_mass: Vec<f64>,
     runs: Vec<u64>,
     settled: Vec<u64>,
     settled_fraction: Vec<f64>,
@@ -421,6 +425,8 @@ impl SummaryColumns {
             Column::new("rho_rule".into(), self.rho_rule),
             Column::new("drag".into(), self.drag),
             Column::new("capacity".into(), self.capacity),
+            Column::new("race_radius".into(), self.race_radius),
+            Column::new("weight_mass".into(), self.weight_mass),
             Column::new("runs".into(), self.runs),
             Column::new("settled".into(), self.settled),
             Column::new("settled_fraction".into(), self.settled_fraction),

@@ -112,3 +112,46 @@ impl<T: Clone> OneOrMany<T> {
 
 /// Most weights one balancer may have (docs/running-at-scale.md).
 pub const MAX_WEIGHTS: u32 = 256;
+
+/// The design as a part to build, in the units a drawing uses: "3 balls of
+/// 36.4 mm diameter, 197.3 g each, in a race of radius 50 mm, drag 10
+/// N·s/m per weight" (`kind` as in files; diameter 2ρR).
+pub fn part_text(
+    kind: &str,
+    n: u32,
+    rho: f64,
+    race_radius: f64,
+    weight_mass: f64,
+    drag: f64,
+) -> String {
+    let sig = |v: f64| crate::number_text::significant(v, 4);
+    let diameter = sig(2.0 * rho * race_radius * 1e3);
+    let weights = match kind {
+        "roller" => format!("{n} rollers of {diameter} mm diameter"),
+        "pendulum" => format!("{n} pendulums with bobs of {diameter} mm"),
+        _ => format!("{n} balls of {diameter} mm diameter"),
+    };
+    format!(
+        "{weights}, {} g each, in a race of radius {} mm, drag {} N·s/m per weight",
+        sig(weight_mass * 1e3),
+        sig(race_radius * 1e3),
+        sig(drag)
+    )
+}
+
+#[cfg(test)]
+mod part_tests {
+    use super::part_text;
+
+    #[test]
+    fn a_design_reads_as_a_part_with_its_dimensions() {
+        // Three steel balls, ρ = 0.3638 of a 50 mm race: 36.38 mm across.
+        assert_eq!(
+            part_text("ball", 3, 0.3638, 0.05, 0.1973, 10.0),
+            "3 balls of 36.38 mm diameter, 197.3 g each, in a race of radius 50 mm, drag 10 N·s/m per weight"
+        );
+        assert!(
+            part_text("roller", 4, 0.25, 0.1, 0.5, 2.0).starts_with("4 rollers of 50 mm diameter")
+        );
+    }
+}

@@ -722,6 +722,24 @@ fn recommendation_line(
         ids[best],
         criterion.label()
     );
+    // The part to build, where the summary carries its dimensions (plane
+    // 0's with a design per plane; summaries written before lack them).
+    let part = (|| {
+        let kind = sum.s("kind").ok()?[best].clone()?;
+        let n = sum.0.column("n").ok()?.u32().ok()?.get(best)?;
+        let f = |name: &str| sum.f(name).ok().and_then(|v| v[best]);
+        Some(autobal::study::design::part_text(
+            &kind,
+            n,
+            f("rho")?,
+            f("race_radius")?,
+            f("weight_mass")?,
+            f("drag")?,
+        ))
+    })();
+    if let Some(part) = part {
+        line += &format!(": {part}");
+    }
     // A crown that falls short of a design that works says so, with the rule.
     // Absent from summaries written before the column existed.
     let worse = sum
