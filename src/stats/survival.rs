@@ -97,6 +97,30 @@ impl RestrictedMean {
         let (lower, upper) = (self.estimate - half, self.estimate + half);
         Interval { lower, upper }
     }
+
+    /// The Wald interval on the logit of θ = estimate/τ, mapped back: the
+    /// restricted mean lies in [0, τ] as a proportion lies in [0, 1], and
+    /// this interval stays inside it, asymmetric near either end, where
+    /// the plain Wald interval runs past 0 or τ and must be clipped (a
+    /// small sample printed "97.7 [0.0, 243.1]"). Away from the ends it
+    /// agrees with [`RestrictedMean::interval`] to first order (delta
+    /// method). At θ = 0 or 1, or with no spread, it is the point itself.
+    pub fn bounded_interval(&self, level: f64) -> Interval {
+        let theta = self.estimate / self.tau;
+        if !(theta > 0.0 && theta < 1.0) || self.std_error <= 0.0 {
+            return Interval {
+                lower: self.estimate,
+                upper: self.estimate,
+            };
+        }
+        let logit = (theta / (1.0 - theta)).ln();
+        let half = z_value(level) * self.std_error / (self.tau * theta * (1.0 - theta));
+        let back = |g: f64| self.tau / (1.0 + (-g).exp());
+        Interval {
+            lower: back(logit - half),
+            upper: back(logit + half),
+        }
+    }
 }
 
 /// Two-sided standard-normal quantile for `level`; panics outside (0, 1).
@@ -710,5 +734,47 @@ rmean 10 0 40 0";
         )
         .unwrap();
         assert!(same.chi_squared.abs() < 1e-15 && (same.p_value - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_bounded_restricted_mean_interval_stays_inside_zero_and_tau() {
+        // The audit's small sample: 97.7 with a Wald half-width of 145.4
+        // printed [0.0, 243.1] after clipping; the logit interval is
+        // asymmetric and above 0.
+        let small = RestrictedMean {
+            tau: 1950.0,
+            estimate: 97.7,
+            std_error: 145.4 / 1.959_963_984_540_054,
+        };
+        let wald = small.interval(0.95);
+        assert!(wald.lower < 0.0);
+        let b = small.bounded_interval(0.95);
+        assert!(b.lower > 0.0 && b.upper < 1950.0, "{b:?}");
+        assert!(b.lower < 97.7 && b.upper > 97.7);
+        assert!(
+            97.7 - b.lower < b.upper - 97.7,
+            "asymmetric towards 0: {b:?}"
+        );
+        // Mid-range and precise: the same as Wald to a fraction of a percent.
+        let mid = RestrictedMean {
+            tau: 100.0,
+            estimate: 50.0,
+            std_error: 0.5,
+        };
+        let (w, m) = (mid.interval(0.95), mid.bounded_interval(0.95));
+        assert!((w.lower - m.lower).abs() < 1e-3 && (w.upper - m.upper).abs() < 1e-3);
+        // Every run at τ (nothing settled): the point itself.
+        let none = RestrictedMean {
+            tau: 100.0,
+            estimate: 100.0,
+            std_error: 0.0,
+        };
+        assert_eq!(
+            none.bounded_interval(0.95),
+            Interval {
+                lower: 100.0,
+                upper: 100.0
+            }
+        );
     }
 }

@@ -157,11 +157,10 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.ts_median_km_hi.push(median_hi);
         let rmst = km.as_ref().map(|k| k.restricted_mean(scale.tau));
         rows.ts_rmst.push(rmst.map(|r| r.estimate));
-        let rmst_interval = rmst.map(|r| r.interval(LEVEL));
-        rows.ts_rmst_lo
-            .push(rmst_interval.map(|i| i.lower.max(0.0)));
-        rows.ts_rmst_hi
-            .push(rmst_interval.map(|i| i.upper.min(scale.tau)));
+        // Inside [0, τ] by construction: no clipping.
+        let rmst_interval = rmst.map(|r| r.bounded_interval(LEVEL));
+        rows.ts_rmst_lo.push(rmst_interval.map(|i| i.lower));
+        rows.ts_rmst_hi.push(rmst_interval.map(|i| i.upper));
         rows.horizon.push(scale.tau);
         rows.rank_value
             .push(runs.and_then(|r| criterion.value(r, &scale)));

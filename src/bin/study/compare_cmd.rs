@@ -111,13 +111,9 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 None => "beyond the run".into(),
             },
             rmst.map_or("–".into(), |r| {
-                let i = r.interval(0.95);
-                format!(
-                    "{:.1} [{:.1}, {:.1}]",
-                    r.estimate,
-                    i.lower.max(0.0),
-                    i.upper
-                )
+                // The same bounded interval as summary.parquet's.
+                let i = r.bounded_interval(0.95);
+                format!("{:.1} [{:.1}, {:.1}]", r.estimate, i.lower, i.upper)
             }),
             p90.map_or("beyond the run".into(), |x| format!("{x:.1}")),
             f(residual, 4),
