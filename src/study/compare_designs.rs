@@ -61,8 +61,12 @@ pub struct Side {
     /// Each watched plane's statistics (rotors with several planes; empty
     /// otherwise).
     pub plane_stats: Vec<super::plane_summary::PlaneStats>,
-    /// Sampled unbalance (fraction of capacity) and direction of each run.
+    /// The sampled unbalance of each run as it was drawn (kg·m, or the
+    /// fraction of capacity) and its direction.
     draws: Vec<(Option<f64>, Option<f64>)>,
+    /// Whether the study drew unbalances in kg·m (else as fractions of
+    /// each design's capacity).
+    absolute: bool,
 }
 
 impl Side {
@@ -107,7 +111,16 @@ impl Side {
                 .collect(),
             None => Vec::new(),
         };
-        let fraction = mine.column("unbalance_fraction")?.f64()?;
+        // Runs pair when they shared the draw itself: the unbalance in kg·m
+        // for an absolute study (its fraction differs with the capacity),
+        // the fraction for a capacity-relative one.
+        let absolute = plan.file.sampling.unbalance.scale() == super::distribution::Scale::Absolute;
+        let drawn = if absolute {
+            "unbalance"
+        } else {
+            "unbalance_fraction"
+        };
+        let fraction = mine.column(drawn)?.f64()?;
         let direction = mine.column("direction_deg")?.f64()?;
         Ok(Side {
             dir: dir.to_path_buf(),
@@ -120,7 +133,17 @@ impl Side {
             clock,
             default_criterion: plan.file.summary.rank_by,
             draws: fraction.iter().zip(direction.iter()).collect(),
+            absolute,
         })
+    }
+
+    /// What two paired runs of this side's study shared.
+    pub fn shared(&self) -> &'static str {
+        if self.absolute {
+            "the same unbalance in kg·m"
+        } else {
+            "the same fraction of each design's capacity"
+        }
     }
 
     /// Kaplan–Meier estimate of the side's settling.
@@ -147,6 +170,16 @@ pub fn pairing_refusal(a: &Side, b: &Side) -> Option<String> {
             b.runs.sample_ids.len()
         ));
     }
+    if a.absolute != b.absolute {
+        return Some(
+            "one study drew unbalances in kg·m, the other as fractions of capacity".to_string(),
+        );
+    }
+    let what = if a.absolute {
+        "unbalance (kg·m"
+    } else {
+        "unbalance (fraction"
+    };
     let differ = a
         .draws
         .iter()
@@ -155,7 +188,7 @@ pub fn pairing_refusal(a: &Side, b: &Side) -> Option<String> {
         .find(|((x, y), _)| x != y);
     differ.map(|(((fa, da), (fb, db)), sample)| {
         format!(
-            "sample {sample} met a different unbalance (fraction {:.4} at {:.1}° against {:.4} at {:.1}°): the runs were drawn from different streams (another seed, or common_random_numbers = false)",
+            "sample {sample} met a different {what} {:.4e} at {:.1}° against {:.4e} at {:.1}°): the runs were drawn from different streams (another seed, or common_random_numbers = false)",
             fa.unwrap_or(f64::NAN),
             da.unwrap_or(f64::NAN),
             fb.unwrap_or(f64::NAN),

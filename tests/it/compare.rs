@@ -53,6 +53,8 @@ fn compare(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_study"))
         .arg("compare")
         .args(args)
+        // Whole sentences, not wrapped to 80 columns, for the assertions.
+        .arg("--wide")
         .output()
         .unwrap()
 }
@@ -130,4 +132,66 @@ fn designs_of_one_study_are_paired_and_foreign_samples_are_not() {
     let out = compare(&[a_s, "--designs", "0,1", "--alpha", "2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--alpha"));
+}
+
+/// An absolute-unbalance study draws one unbalance in kg·m per sample for
+/// every design, whatever its capacity: 3 and 4 balls met the same loads
+/// and pair, although their fractions of capacity differ (before, compare
+/// refused them on the fraction). The statement says what they shared.
+#[test]
+fn absolute_unbalances_pair_designs_of_different_capacity_and_say_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = format!(
+        r#"
+name = "absolute"
+seed = 11
+output = "{}"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+kind = "ball"
+n = [3, 4]
+rho = 0.25
+race_radius = 0.05
+drag = 10.0
+[sampling]
+samples = 8
+unbalance = {{ distribution = "uniform", min = 1e-3, max = 3e-3, relative_to = "absolute" }}
+[metrics]
+t_end_revs = 400
+"#,
+        tmp.path().join("out").display()
+    );
+    let plan = StudyFile::parse(&text, "absolute.toml")
+        .and_then(|f| f.plan(&text, "absolute.toml"))
+        .unwrap();
+    let dir = run_study(&plan, &RunOptions::default(), &NoProgress)
+        .unwrap()
+        .dir;
+    let out = compare(&[dir.to_str().unwrap(), "--designs", "0,1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("paired on 8 samples that met the same unbalance in kg·m"),
+        "{text}"
+    );
+    // The main job's form, relative to capacity, says so too.
+    let rel = run(&tmp.path().join("rel"), 7);
+    let out = compare(&[rel.to_str().unwrap(), "--designs", "0,1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("met the same fraction of each design's capacity"),
+        "{text}"
+    );
 }

@@ -169,8 +169,9 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
     match (&c.paired, &result.unpaired_because) {
         (Some(pair), _) => {
             say(&format!(
-                "paired on {} samples that met the same unbalances: A settles sooner in {:.0} % [{:.0}, {:.0}], B in {:.0} %, ties {:.0} %",
+                "paired on {} samples that met {}: A settles sooner in {:.0} % [{:.0}, {:.0}], B in {:.0} %, ties {:.0} %",
                 pair.n,
+                a.shared(),
                 100.0 * pair.a_sooner_share,
                 100.0 * pair.a_sooner_share_interval.0,
                 100.0 * pair.a_sooner_share_interval.1,
