@@ -84,6 +84,12 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         }
     };
     let criterion = plan.file.summary.rank_by;
+    // The analytic and linear rungs predict settling; they integrate nothing.
+    let estimated = matches!(
+        plan.file.solver.fidelity,
+        crate::simulation::settings::Fidelity::Analytic
+            | crate::simulation::settings::Fidelity::Linear
+    );
     let verdicts = best_versus_rest(
         &by_design,
         criterion,
@@ -195,18 +201,26 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         });
         rows.failed_counted.push(FAILED_RUNS_COUNTED.to_string());
         rows.vs_best_alpha.push(plan.file.statistics.alpha);
-        rows.res_mean.push(residual.mean());
+        // An estimate rung measures no residual: its zeros are not data, so
+        // no residual statistic is written (before 2026-11-27 the analytic
+        // rung printed "residual p95 0.00 µm" as if measured).
+        let measured = |v: Option<f64>| v.filter(|_| !estimated);
+        rows.res_mean.push(measured(residual.mean()));
         let res_sorted = sorted_values(&residual);
-        let res_q = |q| quantile_sorted(&res_sorted, q, Interpolation::Linear);
+        let res_q = |q| measured(quantile_sorted(&res_sorted, q, Interpolation::Linear));
         rows.res_median.push(res_q(0.5));
         rows.res_p95.push(res_q(0.95));
         // Over every run: a failed run has no residual and is not counted worse.
         let worse = residual.iter().flatten().filter(|&r| r > 1.0).count();
         rows.worse_than_none
-            .push((runs_n > 0).then(|| worse as f64 / runs_n as f64));
+            .push(measured((runs_n > 0).then(|| worse as f64 / runs_n as f64)));
         let abs_sorted = sorted_values(simulated.column("residual_abs")?.f64()?);
-        rows.res_abs_p95
-            .push(quantile_sorted(&abs_sorted, 0.95, Interpolation::Linear));
+        rows.res_abs_p95.push(measured(quantile_sorted(
+            &abs_sorted,
+            0.95,
+            Interpolation::Linear,
+        )));
+        rows.estimated.push(estimated);
         // The revolution every `*_revs` column counts in: one turn at the
         // operating speed, whatever the speed law.
         rows.seconds_per_rev.push(Some(
@@ -314,6 +328,7 @@ struct SummaryColumns {
     res_median: Vec<Option<f64>>,
     res_p95: Vec<Option<f64>>,
     worse_than_none: Vec<Option<f64>>,
+    estimated: Vec<bool>,
     /// 95th percentile of the residual whirl in metres.
     res_abs_p95: Vec<Option<f64>>,
     /// Seconds per revolution of the operating speed (the unit of every `*_revs` column).
@@ -457,6 +472,7 @@ impl SummaryColumns {
             Column::new("residual_rel_median".into(), self.res_median),
             Column::new("residual_rel_p95".into(), self.res_p95),
             Column::new("worse_than_none_fraction".into(), self.worse_than_none),
+            Column::new("estimated".into(), self.estimated),
             Column::new("residual_abs_p95".into(), self.res_abs_p95),
             Column::new("seconds_per_rev".into(), self.seconds_per_rev),
             Column::new("censored".into(), self.censored),

@@ -183,6 +183,34 @@ fn a_marginal_winner_is_recommended_with_its_shortfall_stated() {
     assert!(worse.iter().flatten().all(|w| (0.0..=1.0).contains(&w)));
 }
 
+/// An estimate rung measures no residual: the summary's residual columns
+/// are null and the ranking says its numbers are predictions (before, the
+/// analytic rung printed "residual p95 0.00 µm" as if measured).
+#[test]
+fn estimates_never_pass_for_measurements() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = drum_like(
+        &tmp.path().join("results"),
+        "estimate",
+        r#"{ distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }"#,
+        "[solver]\nfidelity = \"analytic\"\n",
+    );
+    let out = run(tmp.path(), &text, &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains("(estimates, not measurements:"), "{stdout}");
+    let summary = read_parquet(&tmp.path().join("results/estimate/summary.parquet")).unwrap();
+    for column in [
+        "residual_rel_p95",
+        "residual_abs_p95",
+        "residual_rel_median",
+    ] {
+        let c = summary.column(column).unwrap();
+        assert_eq!(c.null_count(), c.len(), "{column} should be null");
+    }
+    assert!(summary.column("estimated").unwrap().bool().unwrap().all());
+}
+
 #[test]
 fn runs_out_of_budget_make_the_study_exit_1_naming_max_steps_after_writing_everything() {
     let tmp = tempfile::tempdir().unwrap();

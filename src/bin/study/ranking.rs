@@ -474,7 +474,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         header,
         rows,
         priority,
-        legend: legend + &seconds_note + &rho_note + &plane_note,
+        legend: legend + &estimate_note(&sum)? + &seconds_note + &rho_note + &plane_note,
         findings,
         passage: passage_table(summary)?,
     })
@@ -683,6 +683,22 @@ fn disagreement_line(
             "other measures disagree: better than #1 are {}\n",
             claims.join("; ")
         )
+    })
+}
+
+/// Said first when the runs are estimates (the analytic or linear rung):
+/// their settling times are predicted, not simulated, and they measure no
+/// residual, so the ranking is a ranking of predictions.
+fn estimate_note(sum: &Summary) -> Result<String, UserError> {
+    // Absent from summaries written before the column existed.
+    let estimated = sum
+        .b("estimated")
+        .map(|v| v.iter().any(|&e| e))
+        .unwrap_or(false);
+    Ok(if estimated {
+        "(estimates, not measurements: every run is the fidelity rung's prediction (solver.fidelity = \"analytic\" or \"linear\"), so settling times are predicted, no residual is measured (shown –), and the ranking ranks predictions; `study tradeoff` measures how far they agree with simulation)\n".to_string()
+    } else {
+        String::new()
     })
 }
 
