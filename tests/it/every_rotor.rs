@@ -9,6 +9,7 @@
 //!   plane, two-support and flexible rotors alike (docs/model.md);
 //! - closed forms for the critical speeds and the anisotropic orbit.
 
+use crate::fixtures::assert_same_trajectory;
 use autobal::scene_file::SceneFile;
 use autobal::simulation::RunResult;
 
@@ -96,21 +97,7 @@ fn a_decoupled_two_support_rotor_is_the_plane_rotor_under_every_effect() {
                 a.metrics.a_ref,
                 b.metrics.a_ref
             );
-            let (sa, sb) = (a.series.unwrap(), b.series.unwrap());
-            let n = sa.r.len().min(sb.r.len());
-            assert!(n > 1000, "{what}: {n} samples");
-            let worst = (0..n)
-                .map(|i| (sa.r[i] - sb.r[i]).abs())
-                .fold(0.0, f64::max);
-            assert!(
-                worst < 1e-5 * a.metrics.a_ref,
-                "{what}: r differs by {worst:e} (A_ref {:e})",
-                a.metrics.a_ref
-            );
-            for j in 0..3 {
-                let d = (sa.psi[j][n - 1] - sb.psi[j][n - 1]).abs();
-                assert!(d < 1e-5, "{what}: weight {j} differs by {d} rad");
-            }
+            assert_same_trajectory(&a, &b, 1e-5, &what);
         }
     }
 }
@@ -436,20 +423,6 @@ fn the_flexible_shaft_is_its_equivalent_two_support_rotor_under_every_effect() {
             a.metrics.a_ref,
             b.metrics.a_ref
         );
-        let (sa, sb) = (a.series.unwrap(), b.series.unwrap());
-        let n = sa.r.len().min(sb.r.len());
-        assert!(n > 1000, "{name}: {n} samples");
-        let worst = (0..n)
-            .map(|i| (sa.r[i] - sb.r[i]).abs())
-            .fold(0.0, f64::max);
-        assert!(
-            worst < 1e-5 * a.metrics.a_ref,
-            "{name}: r differs by {worst:e} (A_ref {:e})",
-            a.metrics.a_ref
-        );
-        for j in 0..3 {
-            let d = (sa.psi[j][n - 1] - sb.psi[j][n - 1]).abs();
-            assert!(d < 1e-5, "{name}: weight {j} differs by {d} rad");
-        }
+        assert_same_trajectory(&a, &b, 1e-5, name);
     }
 }

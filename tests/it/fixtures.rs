@@ -141,3 +141,32 @@ pub fn long_rotor(planes: Vec<f64>) -> autobal::model::rotor::TwoSupportRotor {
         weights_tilt_inertia: false,
     }
 }
+
+/// Two recorded runs follow one trajectory: over more than 1 000 common
+/// samples the whirl r agrees within `tol`·A_ref (of `a`) and every
+/// weight's final angle within `tol` rad. `what` names the case in failures.
+pub fn assert_same_trajectory(
+    a: &autobal::simulation::RunResult,
+    b: &autobal::simulation::RunResult,
+    tol: f64,
+    what: &str,
+) {
+    let (sa, sb) = (
+        a.series.as_ref().expect("recorded"),
+        b.series.as_ref().expect("recorded"),
+    );
+    let n = sa.r.len().min(sb.r.len());
+    assert!(n > 1000, "{what}: {n} samples");
+    let worst = (0..n)
+        .map(|i| (sa.r[i] - sb.r[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < tol * a.metrics.a_ref,
+        "{what}: r differs by {worst:e} (A_ref {:e})",
+        a.metrics.a_ref
+    );
+    for j in 0..sa.psi.len() {
+        let d = (sa.psi[j][n - 1] - sb.psi[j][n - 1]).abs();
+        assert!(d < tol, "{what}: weight {j} differs by {d} rad");
+    }
+}

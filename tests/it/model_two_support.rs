@@ -97,21 +97,7 @@ fn tilt_locked_rotor_with_a_balancer_at_the_centre_of_mass_is_the_plane_rotor() 
         (ta - tb).abs() <= a.metrics.settling_time_err,
         "{ta} vs {tb}"
     );
-    let (sa, sb) = (a.series.unwrap(), b.series.unwrap());
-    let n = sa.r.len().min(sb.r.len());
-    assert!(n > 1000);
-    let worst = (0..n)
-        .map(|i| (sa.r[i] - sb.r[i]).abs())
-        .fold(0.0, f64::max);
-    assert!(
-        worst < 1e-4 * a.metrics.a_ref,
-        "trajectories differ by {worst:e} (A_ref {:e})",
-        a.metrics.a_ref
-    );
-    for j in 0..3 {
-        let d = (sa.psi[j][n - 1] - sb.psi[j][n - 1]).abs();
-        assert!(d < 1e-4, "cargo {j} differs by {d} rad");
-    }
+    crate::fixtures::assert_same_trajectory(&a, &b, 1e-4, "two-support against plane");
 }
 
 /// Records the largest relative drift of energy and angular momentum.

@@ -60,6 +60,34 @@ pub fn sweep_points(text: &str) -> Result<usize, String> {
     whole_in(text, "speeds of the sweep, ends included", 2, MAX_POINTS)
 }
 
+/// A range flag `lo..hi` (finite hi > lo; lo > 0, or lo ≥ 0 when
+/// `zero_allowed`), or the message naming `--flag`, with `example` if given.
+pub fn range(
+    flag: &str,
+    text: &str,
+    zero_allowed: bool,
+    example: Option<&str>,
+) -> Result<(f64, f64), String> {
+    let bad = || {
+        let bound = if zero_allowed {
+            "0 ≤ lo < hi"
+        } else {
+            "0 < lo < hi"
+        };
+        let example = example.map(|e| format!(", e.g. {e}")).unwrap_or_default();
+        format!("--{flag} {text}: expected lo..hi with {bound}{example}")
+    };
+    let (a, b) = text.split_once("..").ok_or_else(bad)?;
+    let lo: f64 = a.trim().parse().map_err(|_| bad())?;
+    let hi: f64 = b.trim().parse().map_err(|_| bad())?;
+    let lo_ok = if zero_allowed { lo >= 0.0 } else { lo > 0.0 };
+    if lo_ok && hi > lo && hi.is_finite() {
+        Ok((lo, hi))
+    } else {
+        Err(bad())
+    }
+}
+
 /// `stepped --dwell`: seconds at each speed, in (0, one day].
 pub fn dwell_seconds(text: &str) -> Result<f64, String> {
     number_in(text, "seconds held at each speed; a day at most", 86_400.0)

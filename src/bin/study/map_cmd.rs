@@ -38,20 +38,7 @@ pub struct MapArgs {
 }
 
 fn parse_range(name: &str, text: &str) -> Result<(f64, f64), UserError> {
-    let bad = || {
-        UserError(
-            format!("--{name} {text}: expected lo..hi with 0 ≤ lo < hi"),
-            2,
-        )
-    };
-    let (a, b) = text.split_once("..").ok_or_else(bad)?;
-    let lo: f64 = a.trim().parse().map_err(|_| bad())?;
-    let hi: f64 = b.trim().parse().map_err(|_| bad())?;
-    if lo >= 0.0 && hi > lo && hi.is_finite() {
-        Ok((lo, hi))
-    } else {
-        Err(bad())
-    }
+    crate::limits::range(name, text, true, None).map_err(|e| UserError(e, 2))
 }
 
 /// Run `study map`.

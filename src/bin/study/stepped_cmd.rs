@@ -50,22 +50,7 @@ pub struct SteppedArgs {
 const MAX_STEPS: f64 = 100_000.0;
 
 fn parse_rpm(text: &str) -> Result<(f64, f64), UserError> {
-    let bad = || {
-        UserError(
-            format!("--rpm {text}: expected lo..hi with 0 < lo < hi, e.g. 1000..5000"),
-            2,
-        )
-    };
-    let (a, b) = text.split_once("..").ok_or_else(bad)?;
-    let (lo, hi): (f64, f64) = (
-        a.trim().parse().map_err(|_| bad())?,
-        b.trim().parse().map_err(|_| bad())?,
-    );
-    if lo > 0.0 && hi > lo && hi.is_finite() {
-        Ok((lo, hi))
-    } else {
-        Err(bad())
-    }
+    crate::limits::range("rpm", text, false, Some("1000..5000")).map_err(|e| UserError(e, 2))
 }
 
 /// Run `study stepped`.

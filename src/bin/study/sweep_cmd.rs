@@ -37,22 +37,7 @@ pub struct SweepArgs {
 }
 
 fn parse_range(text: &str) -> Result<(f64, f64), UserError> {
-    let bad = || {
-        UserError(
-            format!("--omega {text}: expected lo..hi with 0 < lo < hi, e.g. 0.5..8"),
-            2,
-        )
-    };
-    let (a, b) = text.split_once("..").ok_or_else(bad)?;
-    let (lo, hi): (f64, f64) = (
-        a.trim().parse().map_err(|_| bad())?,
-        b.trim().parse().map_err(|_| bad())?,
-    );
-    if lo > 0.0 && hi > lo && hi.is_finite() {
-        Ok((lo, hi))
-    } else {
-        Err(bad())
-    }
+    crate::limits::range("omega", text, false, Some("0.5..8")).map_err(|e| UserError(e, 2))
 }
 
 /// Run `study sweep`.
