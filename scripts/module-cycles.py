@@ -31,7 +31,7 @@ CRATE_LAYERS = [
 MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",
      "tilt_inertia", "sommerfeld"},
-    {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "quasi_static", "start",
+    {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "balanced_family", "quasi_static", "start",
      "unbalance", "zero_approx", "critical_speeds"},
 ]
 STUDY_LAYERS = [

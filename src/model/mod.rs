@@ -10,11 +10,13 @@
 //! - [`critical_speeds`]: undamped natural frequencies and critical speeds.
 //! - [`start`]: initial states (locked steady state, rest, step, run-up).
 //! - [`invariants`]: energy and angular momentum, for validation.
+//! - [`balanced_family`]: linear stability over the family of balanced states.
 //! - [`linear`]: linear stability of the balanced state (rotating frame).
 //! - [`validate`]: why a scene is rejected (a leaf every layer may use).
 //! - [`sommerfeld`]: the whirl's load on a limited drive (passage through resonance).
 //! - [`zero_approx`]: seed 003's empirical criterion for any rotor model.
 
+pub mod balanced_family;
 pub mod balancer;
 pub mod cargo;
 pub mod coupling;

@@ -192,13 +192,16 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
             .push(median_of(&a_ref).map(|a| settling_band(plan, a)));
         rows.dead_band.push(dead_band(plan, design));
         rows.over_capacity.push(facts.over_capacity_share);
-        rows.diagnosis.push(match &verdicts {
+        let diagnosis = match &verdicts {
             Some(v) if v.best == design.id && !v.works => Some(diagnose(plan, design, &facts)),
             None if runs.is_some_and(|r| !super::verdict::balances(r)) => {
                 Some(diagnose(plan, design, &facts))
             }
             _ => None,
-        });
+        };
+        rows.diagnosis_cause
+            .push(diagnosis.as_ref().map(|d| d.cause.key().to_string()));
+        rows.diagnosis.push(diagnosis.map(|d| d.to_string()));
         rows.failed_counted.push(FAILED_RUNS_COUNTED.to_string());
         rows.vs_best_alpha.push(plan.file.statistics.alpha);
         // An estimate rung measures no residual: its zeros are not data, so
@@ -290,6 +293,7 @@ struct SummaryColumns {
     dead_band: Vec<Option<f64>>,
     over_capacity: Vec<f64>,
     diagnosis: Vec<Option<String>>,
+    diagnosis_cause: Vec<Option<String>>,
     failed_counted: Vec<String>,
     kind: Vec<String>,
     n: Vec<u32>,
@@ -493,6 +497,7 @@ impl SummaryColumns {
             Column::new("dead_band_m".into(), self.dead_band),
             Column::new("over_capacity_share".into(), self.over_capacity),
             Column::new("diagnosis".into(), self.diagnosis),
+            Column::new("diagnosis_cause".into(), self.diagnosis_cause),
             Column::new("failed_runs_counted".into(), self.failed_counted),
         ];
         columns.extend(measures);

@@ -8,13 +8,14 @@
 //! 2. a capacity below the unbalances drawn;
 //! 3. a speed at or below the rotor's critical speed;
 //! 4. gravity, g/(l ω²), against δ·U/C;
-//! 5. a horizon too short for the slowest mode, or an unstable balanced
-//!    state (the linear analysis of `study linear`).
+//! 5. a balanced state unstable at every point of its family tried, or a
+//!    horizon too short for the slowest mode where it is stable (the linear
+//!    analysis of `study linear`, repeated along the family).
 
 use super::config::StudyPlan;
 use super::design::Design;
+use crate::model::balanced_family::family_stability;
 use crate::model::critical_speeds::critical_speeds_in_range;
-use crate::model::linear::analyse;
 
 /// What the checks measured for one design (every length in m).
 #[derive(Debug, Clone, PartialEq)]
@@ -38,106 +39,349 @@ pub fn settling_band(plan: &StudyPlan, a_ref: f64) -> f64 {
     plan.file.metrics.delta * a_ref
 }
 
-/// The first cause among the checks that applies to `design`, in words with
-/// its numbers; a sentence saying none applied otherwise.
-pub fn diagnose(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String {
-    let cause = first_cause(plan, design, facts);
-    // Fractions of capacity this small are usually kg·m read as fractions.
-    if facts.unbalance_fraction_median < 0.01
-        && plan.file.sampling.unbalance.scale() == super::distribution::Scale::Capacity
-    {
-        return format!(
-            "{cause} (note: the median unbalance drawn is {:.1e} of the capacity; if the values were meant in kg·m, set relative_to = \"absolute\")",
-            facts.unbalance_fraction_median
-        );
+/// The diagnosis of a design that does not balance: its cause, and the
+/// median U/C when it is so small that kg·m were probably meant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnosis {
+    /// The first check that applies.
+    pub cause: Cause,
+    /// The median U/C, when under 1 % with `relative_to = "capacity"`.
+    pub tiny_fraction: Option<f64>,
+}
+
+impl std::fmt::Display for Diagnosis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.cause)?;
+        if let Some(fraction) = self.tiny_fraction {
+            write!(
+                f,
+                " (note: the median unbalance drawn is {fraction:.1e} of the capacity; if the values were meant in kg·m, set relative_to = \"absolute\")"
+            )?;
+        }
+        Ok(())
     }
-    cause
+}
+
+/// The first cause among the checks that applies to `design`, and the
+/// kg·m note where the fractions drawn look like kg·m.
+pub fn diagnose(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> Diagnosis {
+    // Fractions of capacity this small are usually kg·m read as fractions.
+    let tiny = facts.unbalance_fraction_median < 0.01
+        && plan.file.sampling.unbalance.scale() == super::distribution::Scale::Capacity;
+    Diagnosis {
+        cause: first_cause(plan, design, facts),
+        tiny_fraction: tiny.then_some(facts.unbalance_fraction_median),
+    }
+}
+
+/// Why a design does not balance: the first check that applies, with the
+/// numbers it measured (lengths in m, rates in 1/s, speeds in rad/s).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cause {
+    /// Rolling resistance stops the weights anywhere inside μ_s·l ≥ δ·A_ref.
+    DeadBand {
+        /// μ_s·l.
+        dead: f64,
+        /// The track radius l.
+        track_radius: f64,
+        /// δ·A_ref at the median A_ref.
+        band: f64,
+        /// Median A_ref.
+        a_ref: f64,
+    },
+    /// An effect leaves a whirl no balancer removes, at least the band.
+    WhirlFloor {
+        /// The floor's size.
+        floor: f64,
+        /// What makes it (the effect's own words).
+        what: &'static str,
+        /// δ·A_ref at the median A_ref.
+        band: f64,
+        /// Median A_ref.
+        a_ref: f64,
+    },
+    /// Half the runs or more drew an unbalance above the capacity.
+    OverCapacity {
+        /// The capacity C (kg·m).
+        capacity: f64,
+        /// Share of runs over it.
+        share: f64,
+    },
+    /// The speed is at or below the rotor's (lowest) critical speed.
+    BelowCritical {
+        /// ω.
+        omega: f64,
+        /// The critical speed.
+        critical: f64,
+        /// Whether the rotor has more than one.
+        several: bool,
+    },
+    /// Gravity swings the weights by more than the band allows.
+    Gravity {
+        /// g/(l ω²), each weight's swing (rad).
+        swing: f64,
+        /// The most whirl the swing leaves, relative to A_ref (`gravity_whirl`).
+        whirl_over_a_ref: f64,
+        /// δ, the band relative to A_ref.
+        delta: f64,
+    },
+    /// Unstable at every balanced position tried along the family.
+    Unstable {
+        /// ω.
+        omega: f64,
+        /// Balanced positions reached.
+        points: usize,
+        /// The slowest decay rate at the symmetric fan (negative: growing).
+        sigma_fan: f64,
+    },
+    /// Stable somewhere on the family, but too slow for the horizon.
+    HorizonTooShort {
+        /// Decay rate at the fastest stable position found.
+        sigma: f64,
+        /// Revolutions the linear estimate needs to reach the band.
+        needed_revs: f64,
+        /// t_end − hold, in revolutions.
+        horizon_revs: f64,
+        /// When the symmetric fan is unstable: stable positions of those reached.
+        fan_unstable: Option<(usize, usize)>,
+    },
+    /// None of the checks applies.
+    NoneFound,
+}
+
+impl Cause {
+    /// A stable key for the cause, written to `summary.parquet` (`diagnosis_cause`).
+    pub fn key(&self) -> &'static str {
+        match self {
+            Cause::DeadBand { .. } => "dead_band",
+            Cause::WhirlFloor { .. } => "whirl_floor",
+            Cause::OverCapacity { .. } => "over_capacity",
+            Cause::BelowCritical { .. } => "below_critical_speed",
+            Cause::Gravity { .. } => "gravity",
+            Cause::Unstable { .. } => "unstable",
+            Cause::HorizonTooShort { .. } => "horizon_too_short",
+            Cause::NoneFound => "none_found",
+        }
+    }
+}
+
+impl std::fmt::Display for Cause {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Cause::DeadBand {
+                dead,
+                track_radius,
+                band,
+                a_ref,
+            } => write!(
+                f,
+                "the dead band of rolling resistance μ_s·l = {:.3} µm (l = {:.2} mm the track radius) is as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): the weights stop anywhere inside it; lower μ_s, or judge against a band wider than the dead band",
+                dead * 1e6,
+                track_radius * 1e3,
+                band * 1e6,
+                a_ref * 1e6
+            ),
+            Cause::WhirlFloor {
+                floor,
+                what,
+                band,
+                a_ref,
+            } => write!(
+                f,
+                "{what} = {:.3} µm, as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): no balancer gets inside it; true the race, or judge against a band wider than the floor (metrics.delta above {:.3})",
+                floor * 1e6,
+                band * 1e6,
+                a_ref * 1e6,
+                floor / a_ref
+            ),
+            Cause::OverCapacity { capacity, share } => write!(
+                f,
+                "the capacity C = {capacity:.4e} kg·m is below the unbalance drawn in {:.0} % of runs: use more or heavier weights, or a larger race",
+                100.0 * share
+            ),
+            Cause::BelowCritical {
+                omega,
+                critical,
+                several,
+            } => write!(
+                f,
+                "the speed ω = {omega:.1} rad/s is at or below the rotor's {} {critical:.1} rad/s: a passive balancer only balances above it",
+                if several {
+                    "lowest critical speed"
+                } else {
+                    "critical speed"
+                }
+            ),
+            Cause::Gravity {
+                swing,
+                whirl_over_a_ref,
+                delta,
+            } => write!(
+                f,
+                "gravity swings the weights every revolution by g/(l ω²) = {swing:.3e} rad, which can leave a whirl at twice the speed of up to {whirl_over_a_ref:.3} A_ref, as large as the settling band δ = {delta}: run faster, or on a vertical axis"
+            ),
+            Cause::Unstable {
+                omega,
+                points,
+                sigma_fan,
+            } => write!(
+                f,
+                "the balanced state is linearly unstable at ω = {omega:.1} rad/s at each of the {points} balanced positions reached (slowest decay rate σ = {sigma_fan:.3e} 1/s at the symmetric fan, negative: growing; `study linear` on this design shows the growing mode)"
+            ),
+            Cause::HorizonTooShort {
+                sigma,
+                needed_revs,
+                horizon_revs,
+                fan_unstable,
+            } => {
+                write!(
+                    f,
+                    "the horizon is too short for the slowest mode: at the fastest stable balanced position found it decays at σ = {sigma:.3e} 1/s and needs about {needed_revs:.0} rev to reach the band, against t_end_revs − hold_revs = {horizon_revs:.0} rev"
+                )?;
+                if let Some((stable, reached)) = fan_unstable {
+                    write!(
+                        f,
+                        " (the symmetric fan is unstable, but {stable} of the {reached} balanced positions reached are stable, and the weights can settle there)"
+                    )?;
+                }
+                write!(f, "; raise metrics.t_end_revs")
+            }
+            Cause::NoneFound => write!(
+                f,
+                "none of the usual causes applies (dead band, capacity, critical speed, gravity, horizon): look at single runs with `study simulate` or `study plot run`"
+            ),
+        }
+    }
+}
+
+/// The whirl, relative to A_ref, that gravity leaves through the weights'
+/// swing, at U/C = `fraction`: an upper bound.
+///
+/// In the rotating frame gravity pushes weight j along the race with
+/// m g sin(ωt + ψ_j); the weight answers by inertia, δψ_j = (g/(l ω²))
+/// sin(ωt + ψ_j). The unbalance this moves, Σ m l i δψ_j e^{iψ_j}, has a
+/// part that turns at −ω in the rotating frame (fixed in the ground frame:
+/// it throws nothing) and one of size (m g/(2ω²))|Σ e^{2iψ_j}|, at most
+/// (C/2)·g/(l ω²), that turns at 2ω in the ground frame, where the rotor
+/// answers with |H(2ω)| instead of |H(ω)|. The bound takes every weight's
+/// swing in phase, because gravity moves the weights off the fan that
+/// would spread them. (Before 2026-11-27 the test compared g/(l ω²) with
+/// δ·U/C directly, twice this bound.)
+pub fn gravity_whirl(swing: f64, fraction: f64, response_ratio: f64) -> f64 {
+    0.5 * swing * response_ratio / fraction
+}
+
+/// |H(2ω)|/|H(ω)| of a mass on isotropic supports, H(Ω) = Ω²/(k − MΩ² + ibΩ)
+/// the whirl per unit unbalance turning at Ω.
+fn response_ratio(mass: f64, stiffness: f64, damping: f64, omega: f64) -> f64 {
+    let h = |w: f64| w * w / (stiffness - mass * w * w).hypot(damping * w);
+    h(2.0 * omega) / h(omega)
 }
 
 /// The first of the checks that applies.
-fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> String {
+pub fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> Cause {
     let band = settling_band(plan, facts.a_ref_median);
     if let Some(dead) = dead_band(plan, design).filter(|&d| d >= band) {
-        return format!(
-            "the dead band of rolling resistance μ_s·l = {:.3} µm (l = {:.2} mm the track radius) is as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): the weights stop anywhere inside it; lower μ_s, or judge against a band wider than the dead band",
-            dead * 1e6,
-            design.track_radius * 1e3,
-            band * 1e6,
-            facts.a_ref_median * 1e6
-        );
+        return Cause::DeadBand {
+            dead,
+            track_radius: design.track_radius,
+            band,
+            a_ref: facts.a_ref_median,
+        };
     }
-    if let Some((floor, why)) = plan
+    if let Some((floor, what)) = plan
         .file
         .scene
         .effects
         .whirl_floor()
         .filter(|&(f, _)| f >= band)
     {
-        return format!(
-            "{why} = {:.3} µm, as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): no balancer gets inside it; true the race, or judge against a band wider than the floor (metrics.delta above {:.3})",
-            floor * 1e6,
-            band * 1e6,
-            facts.a_ref_median * 1e6,
-            floor / facts.a_ref_median
-        );
+        return Cause::WhirlFloor {
+            floor,
+            what,
+            band,
+            a_ref: facts.a_ref_median,
+        };
     }
     if facts.over_capacity_share >= 0.5 {
-        return format!(
-            "the capacity C = {:.4e} kg·m is below the unbalance drawn in {:.0} % of runs: use more or heavier weights, or a larger race",
-            design.capacity,
-            100.0 * facts.over_capacity_share
-        );
+        return Cause::OverCapacity {
+            capacity: design.capacity,
+            share: facts.over_capacity_share,
+        };
     }
     let omega = plan.file.scene.speed.nominal_speed();
     if let Some((critical, several)) = critical_speed(plan, design).filter(|&(w, _)| omega <= w) {
-        let which = if several {
-            "lowest critical speed"
-        } else {
-            "critical speed"
+        return Cause::BelowCritical {
+            omega,
+            critical,
+            several,
         };
-        return format!(
-            "the speed ω = {omega:.1} rad/s is at or below the rotor's {which} {critical:.1} rad/s: a passive balancer only balances above it"
-        );
-    }
-    if let Some(g) = plan.file.scene.effects.gravity.as_ref() {
-        let ratio = g.in_plane() / (design.track_radius * omega * omega);
-        let limit = plan.file.metrics.delta * facts.unbalance_fraction_median;
-        if ratio >= limit {
-            return format!(
-                "gravity pulls the weights round every revolution: g/(l ω²) = {ratio:.3e} is above δ·U/C = {limit:.3e}, so the weights swing by more than the band allows"
-            );
-        }
     }
     let scene = plan.scene(
         design,
         facts.unbalance_fraction_median * design.capacity,
         0.0,
     );
-    if plan.file.scene.speed.is_prescribed()
-        && let Ok(report) = scene
-            .build()
-            .map_err(|_| ())
-            .and_then(|s| analyse(&s, None).map_err(|_| ()))
-    {
-        if !report.stable {
-            return format!(
-                "the balanced state is linearly unstable at ω = {omega:.1} rad/s (slowest decay rate σ = {:.3e} 1/s; `study linear` on this design shows the growing mode)",
-                report.slowest_decay
-            );
-        }
-        // From the locked start the whirl is up to (U + C)/U times A_ref.
-        let from = 1.0 + 1.0 / facts.unbalance_fraction_median.max(f64::MIN_POSITIVE);
-        let needed = report.settling_time(from, plan.file.metrics.delta) * omega
-            / (2.0 * std::f64::consts::PI);
-        let horizon = plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs;
-        if needed >= horizon {
-            return format!(
-                "the horizon is too short for the slowest mode: it decays at σ = {:.3e} 1/s and needs about {needed:.0} rev to reach the band, against t_end_revs − hold_revs = {horizon:.0} rev; raise metrics.t_end_revs",
-                report.slowest_decay
-            );
+    if let Some(g) = plan.file.scene.effects.gravity.as_ref() {
+        let swing = g.in_plane() / (design.track_radius * omega * omega);
+        // Off the plane rotor the response ratio is taken as 1 (well above
+        // resonance both are about 1/M).
+        let ratio = scene.rotor.as_rotor().isotropic_plane().map_or(1.0, |r| {
+            let weights = design.weight_mass * f64::from(design.spec.n);
+            response_ratio(r.mass + weights, r.stiffness, r.damping, omega)
+        });
+        let delta = plan.file.metrics.delta;
+        let whirl = gravity_whirl(swing, facts.unbalance_fraction_median, ratio);
+        if whirl >= delta {
+            return Cause::Gravity {
+                swing,
+                whirl_over_a_ref: whirl,
+                delta,
+            };
         }
     }
-    "none of the usual causes applies (dead band, capacity, critical speed, gravity, horizon): look at single runs with `study simulate` or `study plot run`".to_string()
+    // Gravity below the band and friction (whose regularised sign no
+    // finite-difference Jacobian resolves) are left out of the linear
+    // analysis: the equations would not be autonomous in the rotating frame.
+    let mut scene = scene;
+    scene.effects.gravity = None;
+    scene.effects.rolling_resistance = None;
+    if plan.file.scene.speed.is_prescribed()
+        && let Ok(family) = scene
+            .build()
+            .map_err(|_| ())
+            .and_then(|s| family_stability(&s).map_err(|_| ()))
+    {
+        // Unstable only where every point of the balanced family tried is:
+        // a run may settle anywhere on it, not only at the symmetric fan.
+        let Some(stable) = family.fastest_stable() else {
+            return Cause::Unstable {
+                omega,
+                points: family.points.len(),
+                sigma_fan: family
+                    .at_fan()
+                    .or(family.points.first())
+                    .map_or(f64::NAN, |r| r.slowest_decay),
+            };
+        };
+        // From the locked start the whirl is up to (U + C)/U times A_ref.
+        let from = 1.0 + 1.0 / facts.unbalance_fraction_median.max(f64::MIN_POSITIVE);
+        let needed_revs = stable.settling_time(from, plan.file.metrics.delta) * omega
+            / (2.0 * std::f64::consts::PI);
+        let horizon_revs = plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs;
+        if needed_revs >= horizon_revs {
+            return Cause::HorizonTooShort {
+                sigma: stable.slowest_decay,
+                needed_revs,
+                horizon_revs,
+                fan_unstable: family
+                    .at_fan()
+                    .filter(|r| !r.stable)
+                    .map(|_| (family.stable_count(), family.points.len())),
+            };
+        }
+    }
+    Cause::NoneFound
 }
 
 /// The rotor's lowest critical speed with the weights' mass carried (any

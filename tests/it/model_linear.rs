@@ -366,3 +366,29 @@ t_end_revs = 3000
         );
     }
 }
+
+/// On an optical-drive rotor with four light balls and little drag, the
+/// symmetric fan of the balanced family is unstable while other members
+/// are stable (the runs of `decisions.rs` settle there): the family's
+/// analysis finds both, and every point it reports balances the rotor.
+#[test]
+fn the_balanced_family_is_stable_away_from_an_unstable_fan() {
+    use autobal::model::balanced_family::family_stability;
+    // Steel balls of 1 mm radius in a 15 mm race; U = C/2.
+    let mass = 7850.0 * 4.0 / 3.0 * std::f64::consts::PI * 1e-9;
+    let capacity = 4.0 * mass * 0.014;
+    let rotor: RotorModel = PlaneRotor::isotropic(0.01, 0.5 * capacity / 0.01, 1800.0, 0.3).into();
+    let cargo: Vec<Cargo> = (0..4)
+        .map(|_| Cargo::point(mass, 0.014, 3e-5, 1.4))
+        .collect();
+    let system = scene(rotor, cargo, 754.0).build().unwrap();
+    let family = family_stability(&system).unwrap();
+    let fan = family.at_fan().expect("the fan is a balanced state");
+    assert!(!fan.stable, "{fan:?}");
+    let stable = family.fastest_stable().expect("a stable member");
+    assert!(stable.slowest_decay > 0.0);
+    assert!(family.points.len() > 4, "{}", family.points.len());
+    for point in &family.points {
+        assert!(point.balancing_error < 1e-3, "{}", point.balancing_error);
+    }
+}
