@@ -179,81 +179,100 @@ impl Evaluator<'_> {
         }
     }
 
-    /// Monte Carlo estimate and standard error of a simulated objective.
-    ///
-    /// Samples k = 0..N draw from the same streams for every candidate (common
-    /// random numbers), and are reduced in index order, so the estimate does
-    /// not depend on the thread count.
-    fn simulate(&self, design: &Design, objective: Objective) -> (f64, f64) {
-        let metrics: Vec<_> = (0..self.samples)
+    /// The candidate as a design, or the constraint it breaks.
+    pub fn build(&self, c: &Candidate) -> Result<Design, String> {
+        self.design(c)
+    }
+
+    /// Each run's contribution to a simulated objective, for samples
+    /// `samples` (common random numbers: sample k draws the same for every
+    /// design), in index order whatever the thread count.
+    pub fn run_values(
+        &self,
+        design: &Design,
+        samples: std::ops::Range<u64>,
+        objective: Objective,
+    ) -> Vec<f64> {
+        let ids: Vec<u64> = samples.collect();
+        let metrics: Vec<_> = ids
             .into_par_iter()
             .with_max_len(1) // one simulation per job, as runs (study::run)
-            .map(|k| run_design_sample(self.plan, design, k.into(), k.into()).metrics)
+            .map(|k| run_design_sample(self.plan, design, k, k).metrics)
             .collect();
-        let n = metrics.len() as f64;
-        let mean_se = |v: &[f64]| {
-            let mean = v.iter().sum::<f64>() / n;
-            let var = if v.len() > 1 {
-                v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)
-            } else {
-                0.0
-            };
-            (mean, (var / n).sqrt())
-        };
         // A run that never settles counts as the horizon, the latest settling
         // time a run can show: right-censored there, so the mean is the
         // restricted mean and the quantiles are the Kaplan–Meier ones.
         let horizon = settling_horizon(self.plan);
-        let censored: Vec<f64> = metrics
+        let yes = |b: bool| if b { 1.0 } else { 0.0 };
+        metrics
             .iter()
-            .map(|m| m.settling_revs.unwrap_or(horizon).min(horizon))
-            .collect();
-        let quantile_se = |q: f64| {
-            let at = move |v: &[f64]| {
-                quantile(v, q, Interpolation::Linear).expect("at least one sample")
+            .map(|m| match objective {
+                Objective::SettlingMean | Objective::SettlingMedian | Objective::SettlingP90 => {
+                    m.settling_revs.unwrap_or(horizon).min(horizon)
+                }
+                Objective::SettledFraction => yes(m.settled),
+                Objective::Residual => m.residual_rel,
+                Objective::ResidualP95 => measured_residual(m),
+                Objective::PResidualBelow => {
+                    yes(measured_residual(m) < self.spec.residual_spec.expect("validated"))
+                }
+                Objective::Capacity | Objective::ATilde => {
+                    unreachable!("analytic objectives are not simulated")
+                }
+            })
+            .collect()
+    }
+
+    /// Monte Carlo estimate and standard error of a simulated objective on
+    /// the search's samples 0..N.
+    fn simulate(&self, design: &Design, objective: Objective) -> (f64, f64) {
+        let values = self.run_values(design, 0..u64::from(self.samples), objective);
+        estimate(self.plan, objective, &values)
+    }
+}
+
+/// The objective's statistic of per-run values: the mean, or a quantile
+/// (settling median and p90, residual p95).
+pub fn statistic(objective: Objective, values: &mut [f64]) -> f64 {
+    match objective {
+        Objective::SettlingMedian => quantile(values, 0.5, Interpolation::Linear),
+        Objective::SettlingP90 => quantile(values, 0.9, Interpolation::Linear),
+        Objective::ResidualP95 => quantile(values, 0.95, Interpolation::Linear),
+        _ => Some(values.iter().sum::<f64>() / values.len() as f64),
+    }
+    .unwrap_or(f64::NAN)
+}
+
+/// The objective's value on per-run values and its standard error: the
+/// sample's for a mean, the binomial one for a share, a bootstrap one for a
+/// quantile.
+pub fn estimate(plan: &StudyPlan, objective: Objective, values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let value = statistic(objective, &mut values.to_vec());
+    let bootstrap_se = || {
+        bootstrap::std_error(
+            values,
+            |v| statistic(objective, &mut v.to_vec()),
+            &mut stream(plan.file.seed, None, 0, Purpose::Bootstrap),
+        )
+    };
+    match objective {
+        Objective::SettlingMedian | Objective::SettlingP90 => (value, bootstrap_se()),
+        // Resamples that reach a +∞ run make the spread +∞ or NaN.
+        Objective::ResidualP95 => {
+            let se = bootstrap_se();
+            (value, if se.is_finite() { se } else { 0.0 })
+        }
+        Objective::SettledFraction | Objective::PResidualBelow => {
+            (value, (value * (1.0 - value) / n).sqrt())
+        }
+        _ => {
+            let var = if values.len() > 1 {
+                values.iter().map(|x| (x - value).powi(2)).sum::<f64>() / (n - 1.0)
+            } else {
+                0.0
             };
-            (
-                at(&censored),
-                bootstrap::std_error(
-                    &censored,
-                    at,
-                    &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
-                ),
-            )
-        };
-        match objective {
-            Objective::SettlingMean => mean_se(&censored),
-            Objective::SettlingMedian => quantile_se(0.5),
-            Objective::SettlingP90 => quantile_se(0.9),
-            Objective::SettledFraction => {
-                let p = metrics.iter().filter(|m| m.settled).count() as f64 / n;
-                (p, (p * (1.0 - p) / n).sqrt())
-            }
-            Objective::Residual => {
-                mean_se(&metrics.iter().map(|m| m.residual_rel).collect::<Vec<_>>())
-            }
-            Objective::ResidualP95 => {
-                let residuals: Vec<f64> = metrics.iter().map(measured_residual).collect();
-                let at = |v: &[f64]| {
-                    quantile(v, 0.95, Interpolation::Linear).expect("at least one sample")
-                };
-                let value = at(&residuals);
-                let se = bootstrap::std_error(
-                    &residuals,
-                    at,
-                    &mut stream(self.plan.file.seed, None, 0, Purpose::Bootstrap),
-                );
-                // Resamples that reach a +∞ run make the spread +∞ or NaN.
-                (value, if se.is_finite() { se } else { 0.0 })
-            }
-            Objective::PResidualBelow => {
-                let spec = self.spec.residual_spec.expect("validated");
-                let p = share_below(&metrics, spec);
-                (p, (p * (1.0 - p) / n).sqrt())
-            }
-            Objective::Capacity | Objective::ATilde => {
-                unreachable!("analytic objectives are not simulated")
-            }
+            (value, (var / n).sqrt())
         }
     }
 }

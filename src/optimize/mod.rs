@@ -7,6 +7,7 @@
 //! variables, and [`optimize`] enumerates the integer n and kinds and writes
 //! the results.
 
+pub mod confirm;
 pub mod evaluate;
 pub mod noisy_simplex;
 pub mod search;
@@ -44,6 +45,8 @@ pub struct OptimizeOutput {
     pub best: Vec<Best>,
     /// Folder of the files.
     pub dir: PathBuf,
+    /// The optima confirmed on fresh samples (simulated objectives).
+    pub confirmation: Option<confirm::Confirmation>,
 }
 
 /// Why an optimisation cannot run.
@@ -173,6 +176,15 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             &format!("samples per candidate: 1 to {MAX_SAMPLES}"),
         ));
     }
+    if let Some(n) = spec.confirm_samples
+        && n > MAX_SAMPLES
+    {
+        return Err(bad(
+            "confirm_samples",
+            n.to_string(),
+            &format!("fresh samples per (kind, n) optimum: 0 to {MAX_SAMPLES}"),
+        ));
+    }
     if !(4..=MAX_EVALUATIONS).contains(&spec.max_evaluations) {
         return Err(bad(
             "max_evaluations",
@@ -285,13 +297,29 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
         terminations.push((label, scope, r.termination.clone()));
         evaluations.extend(r.evaluations.iter().cloned());
     }
-    if let Some(b) = best_of(
-        &best
+    let per_scope: Vec<Evaluation> = best.iter().map(|b| b.evaluation.clone()).collect();
+    let search_pick = best_of(&per_scope, spec.objective);
+    // A simulated pick is the best on fresh samples, not on the search's own.
+    let confirmation = search_pick.as_ref().and_then(|pick| {
+        let optima: Vec<(String, evaluate::Candidate)> = best
             .iter()
-            .map(|b| b.evaluation.clone())
-            .collect::<Vec<_>>(),
-        spec.objective,
-    ) {
+            .map(|b| (b.scope.clone(), b.evaluation.candidate))
+            .collect();
+        let at = per_scope.iter().position(|e| e == pick)?;
+        confirm::confirm(
+            &evaluator,
+            &optima,
+            at,
+            spec.confirm_samples
+                .unwrap_or_else(|| confirm::default_samples(evaluator.samples)),
+            1.0 - plan.file.statistics.alpha,
+        )
+    });
+    let overall = match &confirmation {
+        Some(c) => Some(per_scope[c.overall].clone()),
+        None => search_pick,
+    };
+    if let Some(b) = overall {
         best.push(Best {
             scope: "overall".into(),
             evaluation: b,
@@ -302,13 +330,21 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
         best.extend(complete_rows(&evaluator, &spec));
     }
     let dir = crate::study::run::output_dir(&plan, None);
-    write_outputs(&plan, &dir, &evaluations, &best, &terminations)
-        .map_err(|e| OptimizeError::Output(e.to_string()))?;
+    write_outputs(
+        &plan,
+        &dir,
+        &evaluations,
+        &best,
+        &terminations,
+        confirmation.as_ref(),
+    )
+    .map_err(|e| OptimizeError::Output(e.to_string()))?;
     Ok(OptimizeOutput {
         evaluations,
         terminations,
         best,
         dir,
+        confirmation,
     })
 }
 
@@ -462,6 +498,7 @@ fn write_outputs(
     evals: &[Evaluation],
     best: &[Best],
     terminations: &[(String, String, String)],
+    confirmation: Option<&confirm::Confirmation>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(dir)?;
     let provenance = Provenance::new(&plan.text, plan.file.seed, "all");
@@ -482,6 +519,49 @@ fn write_outputs(
         })
         .collect();
     optimum.with_column(Column::new("stop".into(), stops))?;
+    // Each scope's optimum on the fresh samples, and against the pick.
+    let confirmed: Vec<Option<&confirm::Confirmed>> = scopes
+        .iter()
+        .map(|scope| confirmation?.row(scope))
+        .collect();
+    let column = |name: &str, f: &dyn Fn(&confirm::Confirmed) -> Option<f64>| {
+        Column::new(
+            name.into(),
+            confirmed
+                .iter()
+                .map(|r| r.and_then(f))
+                .collect::<Vec<Option<f64>>>(),
+        )
+    };
+    let samples = confirmation.map(|c| c.samples);
+    for c in [
+        column("confirmed_objective", &|r| Some(r.value)),
+        column("confirmed_std_err", &|r| Some(r.std_err)),
+        column("vs_overall_diff", &|r| r.vs_overall.map(|d| d.difference)),
+        column("vs_overall_diff_lo", &|r| {
+            r.vs_overall.map(|d| d.interval.0)
+        }),
+        column("vs_overall_diff_hi", &|r| {
+            r.vs_overall.map(|d| d.interval.1)
+        }),
+        Column::new(
+            "confirmed_samples".into(),
+            confirmed
+                .iter()
+                .map(|r| r.and(samples))
+                .collect::<Vec<Option<u32>>>(),
+        ),
+        Column::new(
+            "tie_with_overall".into(),
+            confirmed
+                .iter()
+                .zip(&scopes)
+                .map(|(r, scope)| r.filter(|_| scope != "overall").map(|r| r.ties()))
+                .collect::<Vec<Option<bool>>>(),
+        ),
+    ] {
+        optimum.with_column(c)?;
+    }
     write_parquet(&dir.join("optimum.parquet"), &mut optimum, &provenance)?;
     Ok(())
 }

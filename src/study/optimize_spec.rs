@@ -107,6 +107,11 @@ pub struct OptimizeSpec {
     /// Monte Carlo samples per candidate (default: `sampling.samples`).
     #[serde(default)]
     pub samples: Option<u32>,
+    /// Fresh samples on which every (kind, n) optimum of a simulated
+    /// objective is evaluated again before the overall pick is made
+    /// (default: four times the search's samples; 0 skips the confirmation).
+    #[serde(default)]
+    pub confirm_samples: Option<u32>,
     /// Objective evaluations per (kind, n) at most.
     #[serde(default = "default_evaluations")]
     pub max_evaluations: u64,

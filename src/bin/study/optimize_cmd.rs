@@ -66,6 +66,20 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
             format!("{v:.decimals$}")
         }
     };
+    let confirmation = out.confirmation.as_ref();
+    // Each scope's optimum on the fresh samples (the overall row: the pick's).
+    let confirmed_text = |scope: &str| -> String {
+        let Some(c) = confirmation else {
+            return "–".into();
+        };
+        c.row(scope).map_or("–".into(), |r| {
+            format!(
+                "{} ± {}",
+                with_se(r.value, r.std_err),
+                with_se(r.std_err, r.std_err)
+            )
+        })
+    };
     let rows: Vec<Vec<String>> = out
         .best
         .iter()
@@ -90,6 +104,7 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
                 autobal::number_text::significant(e.candidate.drag, 4),
                 e.value.map_or("–".into(), |v| with_se(v, e.std_err)),
                 with_se(e.std_err, e.std_err),
+                confirmed_text(&b.scope),
                 e.capacity.map_or("–".into(), |c| format!("{c:.4e}")),
                 if e.feasible {
                     "ok".into()
@@ -109,12 +124,21 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         "β\nN·s/m",
         objective,
         "± SE",
+        "on fresh\nsamples ± SE",
         "capacity\nkg·m",
         "constraints",
     ];
-    let (table, dropped) = fitted_table(&header, &rows, &[0, 1, 1, 1, 3, 0, 2, 4, 2], text_width());
+    let (table, dropped) = fitted_table(
+        &header,
+        &rows,
+        &[0, 1, 1, 1, 3, 0, 2, 1, 4, 2],
+        text_width(),
+    );
     print!("{table}");
     print!("{}", wrap(&dropped_note(&dropped), text_width()));
+    if let Some(c) = confirmation {
+        print!("{}", wrap(&confirmation_lines(c, &with_se), text_width()));
+    }
     for (label, _, why) in &out.terminations {
         say_err(&format!("{label}: {why}"));
     }
@@ -124,4 +148,60 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         out.dir.display()
     ));
     Ok(())
+}
+
+/// What the confirmation on fresh samples found: the overall pick and why,
+/// and the scopes tied with it.
+fn confirmation_lines(
+    c: &autobal::optimize::confirm::Confirmation,
+    shown: &dyn Fn(f64, f64) -> String,
+) -> String {
+    let pick = &c.rows[c.overall];
+    let mut text = format!(
+        "overall: {} is the best of the (kind, n) optima on {} fresh samples (samples {}–{}, which the search never used): {} ± {}",
+        pick.scope,
+        c.samples,
+        c.first_sample,
+        c.first_sample + u64::from(c.samples) - 1,
+        shown(pick.value, pick.std_err),
+        shown(pick.std_err, pick.std_err),
+    );
+    if c.search_pick != c.overall {
+        let own = &c.rows[c.search_pick];
+        text += &format!(
+            "; the search's own values picked {}, which gives {} ± {} on them",
+            own.scope,
+            shown(own.value, own.std_err),
+            shown(own.std_err, own.std_err),
+        );
+    }
+    text += "\n";
+    let ties: Vec<String> = c
+        .ties()
+        .map(|r| {
+            let d = r.vs_overall.expect("a tie has a difference");
+            format!(
+                "{} (Δ {} [{}, {}])",
+                r.scope,
+                shown(d.difference, pick.std_err),
+                shown(d.interval.0, pick.std_err),
+                shown(d.interval.1, pick.std_err),
+            )
+        })
+        .collect();
+    if ties.is_empty() {
+        text += &format!(
+            "every other (kind, n) optimum differs from {} on the fresh samples (its {:.0} % paired bootstrap interval of the difference excludes 0, and the difference is at least 1 %)\n",
+            pick.scope,
+            100.0 * c.level
+        );
+    } else {
+        text += &format!(
+            "tied with {} on the fresh samples (the {:.0} % paired bootstrap interval of the difference covers 0, or the difference is under 1 %), so choose among them by cost or another measure: {}\n",
+            pick.scope,
+            100.0 * c.level,
+            ties.join(", ")
+        );
+    }
+    text
 }
