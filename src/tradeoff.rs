@@ -45,15 +45,38 @@ impl Setting {
     }
 }
 
+impl Setting {
+    /// The study-file keys that select this setting, as a user writes them.
+    pub fn keys(&self) -> String {
+        let fidelity = format!("[solver] fidelity = \"{}\"", self.fidelity.name());
+        if matches!(self.fidelity, Fidelity::Analytic | Fidelity::Linear) {
+            fidelity
+        } else {
+            format!(
+                "{fidelity}, method = \"{}\", rtol = {:.0e}",
+                self.method.name(),
+                self.rtol
+            )
+        }
+    }
+}
+
 /// One run measured at one setting, against the reference.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TradeoffRow {
     /// Run index in the study.
     pub run_id: u64,
+    /// The run's design.
+    pub design_id: u32,
     /// The setting.
     pub setting: Setting,
     /// Settling time (revolutions), if settled.
     pub settling_revs: Option<f64>,
+    /// The reference's settling time (revolutions), if it settled.
+    pub reference_settling_revs: Option<f64>,
+    /// The settling horizon t_end − hold (revolutions): where a run that
+    /// does not settle is censored.
+    pub horizon_revs: f64,
     /// |t_s − t_s,ref| in revolutions (0 when neither settles; None when only one does).
     pub settling_error_revs: Option<f64>,
     /// |residual − residual_ref| in units of A_ref.
@@ -87,6 +110,12 @@ pub struct SettingSummary {
     pub mean_rhs_calls: f64,
     /// Mean wall time per run (s).
     pub mean_wall_time_s: f64,
+    /// Designs with measured runs, ranked by this setting and the reference.
+    pub designs_ranked: usize,
+    /// Whether this setting's #1 design is the reference's (None: fewer than two designs).
+    pub same_best: Option<bool>,
+    /// Kendall's τ-b between this setting's ranking of the designs and the reference's.
+    pub kendall_tau: Option<f64>,
 }
 
 /// The settings swept: analytic; linear; each applicable frame with its default
@@ -157,7 +186,10 @@ pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
         rtol: 1e-11,
     };
     let mut rows = Vec::new();
+    let samples = u64::from(plan.file.sampling.samples);
+    let horizon_revs = crate::study::verdict::settling_horizon(plan);
     for &run_id in runs {
+        let design_id = plan.designs[(run_id / samples) as usize].id;
         let (reference, _) = simulate(plan, run_id, reference);
         let ref_angles = sorted_angles(&reference);
         for setting in settings(plan) {
@@ -182,8 +214,11 @@ pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
                 });
             rows.push(TradeoffRow {
                 run_id,
+                design_id,
                 setting,
                 settling_revs: m.settling_revs,
+                reference_settling_revs: reference.settling_revs,
+                horizon_revs,
                 settling_error_revs,
                 residual_error: (m.residual_rel - reference.residual_rel).abs(),
                 angle_error_deg,
@@ -223,15 +258,63 @@ pub fn summarize(rows: &[TradeoffRow]) -> Vec<SettingSummary> {
             outcome_agreement: mine.iter().filter(|r| r.outcome_agrees).count() as f64 / n,
             mean_rhs_calls: mine.iter().map(|r| r.rhs_calls as f64).sum::<f64>() / n,
             mean_wall_time_s: mine.iter().map(|r| r.wall_time_s).sum::<f64>() / n,
+            designs_ranked: 0,
+            same_best: None,
+            kendall_tau: None,
         });
+        let decision = decision_agreement(&mine);
+        let last = out.last_mut().expect("just pushed");
+        (last.designs_ranked, last.same_best, last.kendall_tau) = decision;
     }
     out
+}
+
+/// How far a setting's ranking of the designs agrees with the reference's
+/// on the same runs: each design ranked by its restricted mean settling time
+/// (a run that does not settle counts as the horizon), then whether the two
+/// #1 are the same design (ties: the first design) and Kendall's τ-b of the
+/// two rankings. The decision a study takes, not a run's error, is what a
+/// cheap rung must keep.
+fn decision_agreement(rows: &[&TradeoffRow]) -> (usize, Option<bool>, Option<f64>) {
+    let mut designs: Vec<u32> = rows.iter().map(|r| r.design_id).collect();
+    designs.sort_unstable();
+    designs.dedup();
+    let censored = |t: Option<f64>, horizon: f64| t.map_or(horizon, |t| t.min(horizon));
+    let means = |pick: &dyn Fn(&TradeoffRow) -> f64| -> Vec<f64> {
+        designs
+            .iter()
+            .map(|&d| {
+                let v: Vec<f64> = rows
+                    .iter()
+                    .filter(|r| r.design_id == d)
+                    .map(|r| pick(r))
+                    .collect();
+                v.iter().sum::<f64>() / v.len() as f64
+            })
+            .collect()
+    };
+    let mine = means(&|r| censored(r.settling_revs, r.horizon_revs));
+    let reference = means(&|r| censored(r.reference_settling_revs, r.horizon_revs));
+    if designs.len() < 2 {
+        return (designs.len(), None, None);
+    }
+    let best = |v: &[f64]| {
+        (0..v.len())
+            .min_by(|&a, &b| v[a].total_cmp(&v[b]))
+            .expect("two designs")
+    };
+    (
+        designs.len(),
+        Some(best(&mine) == best(&reference)),
+        crate::stats::kendall::kendall_tau_b(&mine, &reference),
+    )
 }
 
 /// The cheapest setting (by mean wall time) whose largest settling error is
 /// within `budget_revs`, whose residual error is within `budget_residual`
 /// (units of A_ref; estimates, which give no residual, are judged on settling
-/// only) and whose outcomes all agree with the reference.
+/// only), whose outcomes all agree with the reference, and which ranks the
+/// same design first (where two or more designs were measured).
 pub fn recommend(
     summary: &[SettingSummary],
     budget_revs: f64,
@@ -243,6 +326,7 @@ pub fn recommend(
             s.outcome_agreement == 1.0 && s.max_error_revs.is_some_and(|e| e <= budget_revs)
         })
         .filter(|s| s.setting.rtol == 0.0 || s.max_residual_error <= budget_residual)
+        .filter(|s| s.same_best != Some(false))
         .min_by(|a, b| a.mean_wall_time_s.total_cmp(&b.mean_wall_time_s))
 }
 
@@ -254,6 +338,10 @@ pub fn rows_frame(rows: &[TradeoffRow]) -> PolarsResult<DataFrame> {
             Column::new(
                 "run_id".into(),
                 rows.iter().map(|r| r.run_id).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "design_id".into(),
+                rows.iter().map(|r| r.design_id).collect::<Vec<_>>(),
             ),
             Column::new(
                 "fidelity".into(),
@@ -280,6 +368,12 @@ pub fn rows_frame(rows: &[TradeoffRow]) -> PolarsResult<DataFrame> {
             Column::new(
                 "settling_revs".into(),
                 rows.iter().map(|r| r.settling_revs).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "reference_settling_revs".into(),
+                rows.iter()
+                    .map(|r| r.reference_settling_revs)
+                    .collect::<Vec<_>>(),
             ),
             Column::new(
                 "settling_error_revs".into(),

@@ -4,7 +4,8 @@
 //! that regression checks are built from ([`ks`], [`proportion`], [`mood`],
 //! [`holm`]), censoring-aware settling statistics ([`survival`]: Kaplan–Meier,
 //! its median and restricted mean) and paired comparisons of designs that
-//! share their samples ([`paired`]: win shares, sign and signed-rank tests).
+//! share their samples ([`paired`]: win shares, sign and signed-rank tests),
+//! and the rank correlation of two rankings ([`kendall`]).
 //!
 //! Nothing here knows about rotors or studies; the analyses (`study`,
 //! `check`, `optimize`, `plot`, `tradeoff`) bring the data.
@@ -12,6 +13,7 @@
 pub mod bootstrap;
 pub mod holm;
 pub mod interval;
+pub mod kendall;
 pub mod ks;
 pub mod mood;
 pub mod paired;

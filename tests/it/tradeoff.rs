@@ -15,9 +15,9 @@ kind = "ball"
 n = 3
 rho = "optimal"
 race_radius = 0.05
-drag = 10.0
+drag = [2.0, 10.0]
 [sampling]
-samples = 4
+samples = 2
 unbalance = { distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }
 [metrics]
 t_end_revs = 300
@@ -32,7 +32,7 @@ t_end_revs = 300
     // Isotropic and constant speed: both frames are swept, plus the two estimates.
     assert!(all.iter().any(|s| s.fidelity == Fidelity::Rotating));
     assert!(all.iter().any(|s| s.fidelity == Fidelity::Linear));
-    let runs = spread_runs(&plan, 2);
+    let runs = spread_runs(&plan, 4);
     let rows = measure(&plan, &runs);
     assert_eq!(rows.len(), runs.len() * all.len());
     let summary = summarize(&rows);
@@ -46,7 +46,42 @@ t_end_revs = 300
         );
         assert_eq!(s.outcome_agreement, 1.0);
     }
+    // The decision: each setting ranks the two designs by their runs, and
+    // the tightest integrations rank them as the reference does.
+    for s in &summary {
+        assert_eq!(s.designs_ranked, 2, "{}", s.setting.label());
+    }
+    for s in summary.iter().filter(|s| s.setting.rtol == 1e-10) {
+        assert_eq!(s.same_best, Some(true), "{}", s.setting.label());
+        assert_eq!(s.kendall_tau, Some(1.0), "{}", s.setting.label());
+    }
+    // Recomputed from the rows: the reference's #1 is the design with the
+    // smaller mean settling time, censored at the horizon.
+    let mean_of = |design: u32, reference: bool| {
+        let v: Vec<f64> = rows
+            .iter()
+            .filter(|r| r.design_id == design && r.setting == summary[0].setting)
+            .map(|r| {
+                let t = if reference {
+                    r.reference_settling_revs
+                } else {
+                    r.settling_revs
+                };
+                t.map_or(r.horizon_revs, |t| t.min(r.horizon_revs))
+            })
+            .collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let analytic_same =
+        (mean_of(0, false) < mean_of(1, false)) == (mean_of(0, true) < mean_of(1, true));
+    assert_eq!(
+        summary[0].same_best,
+        Some(analytic_same),
+        "{}",
+        summary[0].setting.label()
+    );
     let best = recommend(&summary, 1.0, 0.01).expect("some setting meets 1 rev");
+    assert_ne!(best.same_best, Some(false));
     assert!(best.max_error_revs.unwrap() <= 1.0 && best.outcome_agreement == 1.0);
     let df = rows_frame(&rows).unwrap();
     for c in [

@@ -57,6 +57,9 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
                 format!("{:.0} %", 100.0 * s.outcome_agreement),
                 format!("{:.0}", s.mean_rhs_calls),
                 format!("{:.3}", 1e3 * s.mean_wall_time_s),
+                s.same_best
+                    .map_or("–".into(), |b| if b { "yes" } else { "NO" }.into()),
+                s.kendall_tau.map_or("–".into(), |t| format!("{t:.2}")),
             ]
         })
         .collect();
@@ -70,19 +73,33 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
                 "max |Δresidual|\n/A_ref",
                 "outcome\nagrees",
                 "RHS\ncalls",
-                "ms/run"
+                "ms/run",
+                "same #1\ndesign",
+                "rank corr.\n(Kendall)"
             ],
             &table
         )
     );
+    let ranked = summary.first().map_or(0, |s| s.designs_ranked);
+    if ranked >= 2 {
+        crate::output::say(&format!(
+            "(same #1 design, rank corr.: each setting's ranking of the {ranked} designs measured, by the restricted mean settling time of their measured runs, against the reference's on the same runs; Kendall's τ-b, 1 = the same order)"
+        ));
+    }
     match recommend(&summary, args.budget_revs, args.budget_residual) {
         Some(best) => crate::output::say(&format!(
-            "recommended within {} rev and {} A_ref: {} ({:.3} ms/run, {:.0} RHS calls)",
+            "recommended within {} rev and {} A_ref{}: {} ({:.3} ms/run, {:.0} RHS calls); set {}",
             args.budget_revs,
             args.budget_residual,
+            if ranked >= 2 {
+                ", ranking the same design first"
+            } else {
+                ""
+            },
             best.setting.label(),
             1e3 * best.mean_wall_time_s,
-            best.mean_rhs_calls
+            best.mean_rhs_calls,
+            best.setting.keys()
         )),
         None => crate::output::say(&format!(
             "no setting stays within {} rev on every measured run",
