@@ -10,7 +10,8 @@ use crate::stats::holm::holm_adjust;
 use crate::study::config::StudyPlan;
 use crate::study::criterion::Criterion;
 use crate::study::verdict::{
-    Comparison, DesignRuns, Verdict, best_versus_rest, compare, holm_across, measure_scale,
+    Comparison, DesignRuns, Favours, Verdict, best_versus_rest, compare, favoured, holm_across,
+    measure_scale,
 };
 use std::fmt::Write;
 
@@ -156,11 +157,9 @@ fn disagreement(c: &Comparison, holm: &[f64], alpha: f64, a: &str, b: &str) -> S
         .zip(holm)
         .skip(1)
         .filter(|(m, p)| {
-            m.difference.is_some_and(|d| {
-                **p <= alpha
-                    && crate::study::verdict::material(d.a, d.b, d.difference)
-                    && m.criterion.a_better(d.difference) != a_ahead
-            })
+            let behind = if a_ahead { Favours::B } else { Favours::A };
+            m.difference
+                .is_some_and(|d| favoured(m.criterion, &d, **p, alpha) == Some(behind))
         })
         .map(|(m, p)| format!("the {} (Holm-adjusted {})", m.criterion.label(), p_text(*p)))
         .collect();

@@ -6,7 +6,10 @@ use super::config::{StudyFile, StudyPlan};
 use super::criterion::Criterion;
 use super::io::read_parquet;
 use super::measured_runs::{DesignRuns, Scale};
-use super::verdict::{Comparison, SettlingClock, compare, design_runs, measure_scale};
+use super::verdict::{
+    Comparison, Favours, SettlingClock, compare, design_runs, favoured, measure_scale,
+};
+use crate::stats::holm::holm_adjust;
 use crate::stats::interval::wilson_interval;
 use crate::stats::survival::{KaplanMeier, Transform};
 use polars::prelude::*;
@@ -202,8 +205,62 @@ pub fn pairing_refusal(a: &Side, b: &Side) -> Option<String> {
 pub struct DesignComparison {
     /// A against B.
     pub comparison: Comparison,
-    /// Why the runs were not paired (`None`: paired).
-    pub unpaired_because: Option<String>,
+    /// Whether the runs were paired, or why not.
+    pub pairing: Pairing,
+}
+
+/// Whether two sides' runs pair: the same draws (seed, sample ids, common
+/// random numbers), or why not.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pairing {
+    /// Run k of A and run k of B met the same draws.
+    Paired,
+    /// Why they cannot be paired.
+    Refused(String),
+}
+
+/// The verdict of A against B on the criterion, and the other measures that
+/// disagree with it, each measure's p-value Holm-adjusted over the measures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairVerdict {
+    /// Which side the criterion favours (`None`: not distinguishable).
+    pub criterion_favours: Option<Favours>,
+    /// Holm-adjusted p-value of each measure, in the comparison's order.
+    pub p_holm: Vec<f64>,
+    /// Measures other than the criterion on which B is better although A is
+    /// the criterion's choice.
+    pub disagreeing: Vec<Criterion>,
+}
+
+impl DesignComparison {
+    /// The verdict at level `alpha`, by the rule of every verdict ([`favoured`]).
+    pub fn verdict(&self, alpha: f64) -> PairVerdict {
+        let measures = &self.comparison.measures;
+        let raw: Vec<f64> = measures
+            .iter()
+            .map(|m| m.difference.map_or(1.0, |d| d.p_value))
+            .collect();
+        let p_holm = holm_adjust(&raw);
+        let favours = |k: usize| {
+            measures[k]
+                .difference
+                .and_then(|d| favoured(measures[k].criterion, &d, p_holm[k], alpha))
+        };
+        let criterion_favours = if measures.is_empty() {
+            None
+        } else {
+            favours(0)
+        };
+        let disagreeing = (1..measures.len())
+            .filter(|&k| criterion_favours == Some(Favours::A) && favours(k) == Some(Favours::B))
+            .map(|k| measures[k].criterion)
+            .collect();
+        PairVerdict {
+            criterion_favours,
+            p_holm,
+            disagreeing,
+        }
+    }
 }
 
 /// Compare side A with side B (paired when [`pairing_refusal`] allows) on
@@ -222,7 +279,7 @@ pub fn compare_sides(a: &Side, b: &Side, seed: u64, criterion: Criterion) -> Des
             &common_scale(a, b),
             seed,
         ),
-        unpaired_because: refusal,
+        pairing: refusal.map_or(Pairing::Paired, Pairing::Refused),
     }
 }
 

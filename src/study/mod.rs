@@ -19,6 +19,7 @@
 //! - [`failures`]: runs that did not finish, and the setting to change.
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
 //! - [`compare_designs`]: two designs of one or two results folders (`study compare`).
+//! - [`decision`]: which design to build, or why none, typed, as `summary.parquet` records it.
 //! - [`merge`]: combining shard outputs.
 //! - [`study_folder`]: the study's folder as another verb's destination (tradeoff, optimize).
 //! - [`io`]: Parquet with provenance, atomic writes.
@@ -31,6 +32,7 @@ pub mod compare_designs;
 pub mod config;
 pub mod couple;
 pub mod criterion;
+pub mod decision;
 pub mod design;
 pub mod design_runs;
 pub mod diagnosis;

@@ -131,26 +131,48 @@ pub fn material(a: f64, b: f64, difference: f64) -> bool {
     difference.abs() >= MIN_RELATIVE_EFFECT * a.abs().max(b.abs())
 }
 
+/// Which design of a comparison of A against B a measure favours.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Favours {
+    /// Design A.
+    A,
+    /// Design B.
+    B,
+}
+
+/// The one rule by which a measure favours a design, used by every verdict,
+/// every "the measures disagree" sentence (`study run`, `study compare`,
+/// `study claims`) and the decision: significant at `alpha` on its
+/// Holm-adjusted p-value, non-zero, and large enough to matter
+/// ([`material`]). `None` when it favours neither.
+pub fn favoured(criterion: Criterion, d: &Difference, p_holm: f64, alpha: f64) -> Option<Favours> {
+    let significant = p_holm <= alpha && d.difference != 0.0 && material(d.a, d.b, d.difference);
+    significant.then(|| {
+        if criterion.a_better(d.difference) {
+            Favours::A
+        } else {
+            Favours::B
+        }
+    })
+}
+
 impl MeasureComparison {
     /// True when A is better than B on this measure at level `alpha`, by a
-    /// difference worth reporting ([`material`]).
+    /// difference worth reporting ([`favoured`]).
     pub fn a_better_at(&self, alpha: f64) -> bool {
-        self.difference.is_some_and(|d| {
-            self.p_holm <= alpha
-                && material(d.a, d.b, d.difference)
-                && self.criterion.a_better(d.difference)
-        })
+        self.favours(alpha) == Some(Favours::A)
     }
 
     /// True when B is better than A on this measure at level `alpha`, by a
     /// difference worth reporting.
     pub fn b_better_at(&self, alpha: f64) -> bool {
-        self.difference.is_some_and(|d| {
-            self.p_holm <= alpha
-                && d.difference != 0.0
-                && material(d.a, d.b, d.difference)
-                && !self.criterion.a_better(d.difference)
-        })
+        self.favours(alpha) == Some(Favours::B)
+    }
+
+    /// The side this measure favours at `alpha` on its own Holm p-value.
+    pub fn favours(&self, alpha: f64) -> Option<Favours> {
+        self.difference
+            .and_then(|d| favoured(self.criterion, &d, self.p_holm, alpha))
     }
 }
 

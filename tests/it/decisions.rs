@@ -2,7 +2,9 @@
 //! does not work (and why), failed runs never absorbed, divergence judged
 //! on a scale that covers the start, run-ups timed from the operating speed.
 
+use autobal::study::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
 use autobal::study::io::read_parquet;
+use autobal::study::verdict::{Favours, Shortfall, favoured};
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -100,6 +102,15 @@ fn a_dead_band_wider_than_the_settling_band_crowns_no_design_and_is_named() {
     assert!(!stdout.contains("recommendation: design"), "{stdout}");
     assert!(!stdout.contains("is better than"), "{stdout}");
     let summary = read_parquet(&tmp.path().join("results/deadband/summary.parquet")).unwrap();
+    // The same decision, typed.
+    let decision = StudyDecision::from_summary(&summary).unwrap();
+    assert_eq!(decision.recommendation, Recommendation::NoneBalances);
+    match &decision.crown {
+        Crown::NoneBalances { cause_key, .. } => {
+            assert_eq!(cause_key.as_deref(), Some("dead_band"));
+        }
+        other => panic!("{other:?}"),
+    }
     let verdicts: Vec<&str> = summary
         .column("vs_best_verdict")
         .unwrap()
@@ -167,6 +178,15 @@ fn a_marginal_winner_is_recommended_with_its_shortfall_stated() {
         .collect();
     let best = settled.iter().copied().fold(0.0, f64::max);
     assert!((0.5..0.9).contains(&best), "{settled:?}\n{stdout}");
+    match StudyDecision::from_summary(&summary)
+        .unwrap()
+        .recommendation
+    {
+        Recommendation::Build { shortfalls, .. } => {
+            assert_eq!(shortfalls, vec![Shortfall::SettlesTooRarely(best)]);
+        }
+        other => panic!("{other:?}"),
+    }
     assert!(
         stdout.contains(&format!(
             "with a caution: it settles in only {:.1} % of its runs (a design that works settles in at least 90 %)",
@@ -460,4 +480,78 @@ t_end_revs = {t_end}
         vec![1.0],
         "{stdout}"
     );
+}
+
+/// The typed decision agrees with the summary it was read from, on the
+/// rules of docs/statistics.md: designs that balance rank first, #1 is
+/// recommended with the Pareto set that contains it, and every design named
+/// better than #1 on another measure is so by the one rule ([`favoured`]).
+#[test]
+fn the_decision_is_typed_and_follows_the_rules_on_a_many_design_study() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let text = drum_like(
+        &results,
+        "grid",
+        r#"{ distribution = "uniform", min = 0.2, max = 0.9, relative_to = "capacity" }"#,
+        "",
+    )
+    .replace("drag = [0.5, 2.0]", "drag = [0.5, 1.0, 2.0, 4.0]")
+    .replace("samples = 4", "samples = 10");
+    let out = run(tmp.path(), &text, &[]);
+    assert_eq!(out.status.code(), Some(0));
+    let summary = read_parquet(&results.join("grid/summary.parquet")).unwrap();
+    let decision = StudyDecision::from_summary(&summary).unwrap();
+    assert_eq!(decision.ranked.len(), 4);
+    // Designs that balance come first.
+    if let Some(k) = decision.ranked.iter().position(|d| !d.balances) {
+        assert!(decision.ranked[k..].iter().all(|d| !d.balances));
+    }
+    let best = &decision.ranked[0];
+    assert!(best.balances, "{decision:?}");
+    assert_eq!(best.verdict, Some(StoredVerdict::Best));
+    match &decision.recommendation {
+        Recommendation::Build {
+            design,
+            pareto,
+            part,
+            ..
+        } => {
+            assert_eq!(*design, best.id);
+            assert!(pareto.contains(design));
+            assert!(
+                part.as_deref().is_some_and(|p| p.contains("3 balls")),
+                "{part:?}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    match &decision.crown {
+        Crown::Best {
+            better_than,
+            not_distinguishable,
+            other_better,
+            ..
+        } => assert_eq!(
+            better_than.len() + not_distinguishable.len() + other_better.len(),
+            3
+        ),
+        other => panic!("{other:?}"),
+    }
+    for d in &decision.disagreements {
+        assert_ne!(d.measure, decision.criterion);
+        let difference = autobal::stats::paired_measures::Difference {
+            a: d.values.0.unwrap_or(0.0),
+            b: d.values.1.unwrap_or(0.0),
+            difference: d.difference,
+            interval: (f64::NEG_INFINITY, f64::INFINITY),
+            p_value: d.p_holm,
+            test: "",
+        };
+        assert_eq!(
+            favoured(d.measure, &difference, d.p_holm, decision.alpha),
+            Some(Favours::A)
+        );
+    }
+    assert_eq!(decision.leading(2)[0], best.id);
 }

@@ -5,10 +5,12 @@ use crate::UserError;
 use crate::output::{p_value_text, say, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
 use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
-use autobal::stats::holm::holm_adjust;
-use autobal::study::compare_designs::{Side, common_scale, compare_sides, median_with_interval};
+use autobal::study::compare_designs::{
+    Pairing, Side, common_scale, compare_sides, median_with_interval,
+};
 use autobal::study::criterion::Criterion;
 use autobal::study::plane_summary::PlaneStats;
+use autobal::study::verdict::Favours;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -166,7 +168,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             "∞".into()
         }
     };
-    match (&c.paired, &result.unpaired_because) {
+    match (&c.paired, &result.pairing) {
         (Some(pair), _) => {
             say(&format!(
                 "paired on {} samples that met {}: A settles sooner in {:.0} % [{:.0}, {:.0}], B in {:.0} %, ties {:.0} %",
@@ -193,7 +195,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 ));
             }
         }
-        (None, Some(why)) => {
+        (None, Pairing::Refused(why)) => {
             say(&format!("not paired: {why}"));
             match &c.unpaired {
                 Some(lr) => say(&format!(
@@ -206,17 +208,12 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 None => say("log-rank test: no run settled in either design"),
             }
         }
-        (None, None) => say("nothing to compare: no runs"),
+        (None, Pairing::Paired) => say("nothing to compare: no runs"),
     }
-    // Every measure of this one pair, Holm-adjusted over the measures.
-    let raw: Vec<f64> = c
-        .measures
-        .iter()
-        .map(|m| m.difference.map_or(1.0, |d| d.p_value))
-        .collect();
-    let adjusted = holm_adjust(&raw);
-    let mut favours_b = Vec::new();
-    for (m, p_holm) in c.measures.iter().zip(&adjusted) {
+    // Every measure of this one pair, Holm-adjusted over the measures; the
+    // verdict is the library's (DesignComparison::verdict).
+    let verdict = result.verdict(args.alpha);
+    for (m, p_holm) in c.measures.iter().zip(&verdict.p_holm) {
         let Some(d) = m.difference else {
             say(&format!("{}: nothing to compare", m.criterion.label()));
             continue;
@@ -252,42 +249,34 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             c.measures.len(),
             p_value_text(*p_holm)
         ));
-        if m.criterion != criterion
-            && *p_holm <= args.alpha
-            && d.difference != 0.0
-            && !m.criterion.a_better(d.difference)
-        {
-            favours_b.push(m.criterion.label());
-        }
     }
-    let on = c.measures.first().and_then(|m| m.difference);
-    let p_on = adjusted.first().copied().unwrap_or(1.0);
-    let verdict = match on {
-        Some(d) if p_on <= args.alpha && criterion.a_better(d.difference) => {
-            format!(
-                "A is better than B on the {} (α = {})",
-                criterion.label(),
-                args.alpha
-            )
-        }
-        Some(d) if p_on <= args.alpha && d.difference != 0.0 => {
-            format!(
-                "B is better than A on the {} (α = {})",
-                criterion.label(),
-                args.alpha
-            )
-        }
-        _ => format!(
+    let verdict_text = match verdict.criterion_favours {
+        Some(Favours::A) => format!(
+            "A is better than B on the {} (α = {})",
+            criterion.label(),
+            args.alpha
+        ),
+        Some(Favours::B) => format!(
+            "B is better than A on the {} (α = {})",
+            criterion.label(),
+            args.alpha
+        ),
+        None => format!(
             "not distinguishable on the {} at α = {}",
             criterion.label(),
             args.alpha
         ),
     };
-    say(&format!("verdict: {verdict}"));
-    if !favours_b.is_empty() && verdict.starts_with("A is better") {
+    say(&format!("verdict: {verdict_text}"));
+    if !verdict.disagreeing.is_empty() {
         say(&format!(
             "but B is significantly better on the {}: the measures disagree",
-            favours_b.join(" and the ")
+            verdict
+                .disagreeing
+                .iter()
+                .map(|m| m.label())
+                .collect::<Vec<_>>()
+                .join(" and the ")
         ));
     }
     if let Some(path) = &args.plot {

@@ -6,9 +6,8 @@
 use crate::UserError;
 use crate::output::{dropped_note, fitted_table, p_value_text, text_table, text_width, wrap};
 use autobal::study::criterion::Criterion;
-use autobal::study::verdict::{
-    Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE, edges, shortfalls,
-};
+use autobal::study::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
+use autobal::study::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE};
 use polars::prelude::DataFrame;
 
 /// Typed access to the summary's columns.
@@ -78,22 +77,6 @@ fn diff_text(criterion: Criterion, v: Option<f64>) -> String {
         ("rev", Some(x)) => format!("{x:+.1}"),
         (_, Some(x)) => format!("{x:+.4}"),
     }
-}
-
-/// The criterion the summary was ranked by.
-fn rank_criterion(sum: &Summary) -> Result<Criterion, UserError> {
-    let text = sum.s("rank_by")?.into_iter().flatten().next();
-    Ok(text
-        .and_then(|t| Criterion::parse(&t).ok())
-        .unwrap_or_default())
-}
-
-/// Designs in the order of the summary's `rank` column (ties: grid order).
-fn order_by_rank(summary: &DataFrame) -> Result<Vec<usize>, UserError> {
-    let rank: Vec<Option<u32>> = summary.column("rank")?.u32()?.iter().collect();
-    let mut order: Vec<usize> = (0..summary.height()).collect();
-    order.sort_by_key(|&i| (rank[i].unwrap_or(u32::MAX), i));
-    Ok(order)
 }
 
 /// The kind, n, ρ and β cells of a study whose planes have designs of their
@@ -179,8 +162,9 @@ pub struct Ranking {
 /// The ranking of a summary, in pieces.
 pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     let sum = Summary(summary);
-    let criterion = rank_criterion(&sum)?;
-    let order = order_by_rank(summary)?;
+    let decision = StudyDecision::from_summary(summary)?;
+    let criterion = decision.criterion;
+    let order: Vec<usize> = decision.ranked.iter().map(|d| d.row).collect();
     let ids: Vec<u32> = summary
         .column("design_id")?
         .u32()?
@@ -221,7 +205,6 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .zip(sum.u("budget_exceeded")?)
         .map(|(a, b)| a + b)
         .collect();
-    let verdict = sum.s("vs_best_verdict")?;
     let p_holm = sum.f("vs_best_p_holm")?;
     let crit_name = criterion.to_string();
     let (crit_diff, crit_lo, crit_hi) = if Criterion::REPORTED.contains(&criterion) {
@@ -239,10 +222,12 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .iter()
         .enumerate()
         .map(|(r, &i)| {
-            let (versus, p_versus) = match verdict[i].as_deref() {
-                Some("best") => ("#1".to_string(), "–".to_string()),
-                Some("no_design_balances") => ("#1 (does not balance)".into(), "–".into()),
-                Some("only_design") | None => ("–".into(), "–".into()),
+            let (versus, p_versus) = match decision.ranked[r].verdict {
+                Some(StoredVerdict::Best) => ("#1".to_string(), "–".to_string()),
+                Some(StoredVerdict::NoDesignBalances) => {
+                    ("#1 (does not balance)".into(), "–".into())
+                }
+                Some(StoredVerdict::OnlyDesign) | None => ("–".into(), "–".into()),
                 Some(_) if crit_diff[i].is_some() => (
                     format!(
                         "{} [{}, {}]",
@@ -464,9 +449,9 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .iter()
         .map(|h| column_priority(h, criterion, any_failed))
         .collect();
-    let findings = verdict_line(&sum, &order, criterion)?
-        + &disagreement_line(&sum, &order, criterion)?
-        + &recommendation_line(&sum, &order, criterion)?
+    let findings = verdict_line(&decision)
+        + &disagreement_line(&decision)
+        + &recommendation_line(&decision)
         + &merged_line(&sum, &order)?
         + &dead_band_line(&sum, &order)?
         + &contact_line(summary)?;
@@ -507,12 +492,7 @@ fn p_text(p: Option<f64>) -> String {
     p.map_or("–".to_string(), p_value_text)
 }
 
-/// "#r (design id)" of a summary row.
-fn who(order: &[usize], ids: &[u32], i: usize) -> String {
-    let rank = order.iter().position(|&j| j == i).unwrap_or(0) + 1;
-    format!("#{rank} (design {})", ids[i])
-}
-
+/// Each summary row's design id.
 fn design_ids(sum: &Summary) -> Result<Vec<u32>, UserError> {
     Ok(sum
         .0
@@ -523,167 +503,122 @@ fn design_ids(sum: &Summary) -> Result<Vec<u32>, UserError> {
         .collect())
 }
 
+/// "#r (design id)".
+fn who_id(decision: &StudyDecision, id: u32) -> String {
+    format!("#{} (design {id})", decision.rank_of(id).unwrap_or(0))
+}
+
 /// The sentence under the ranking: whether #1 balances at all, and against
 /// how many designs it is better on the criterion at α.
-fn verdict_line(sum: &Summary, order: &[usize], criterion: Criterion) -> Result<String, UserError> {
-    let verdict = sum.s("vs_best_verdict")?;
-    let Some(&best) = order.first() else {
-        return Ok(String::new());
-    };
-    let ids = design_ids(sum)?;
-    let runs = sum.u("runs")?;
-    let per_design = runs.iter().max().copied().unwrap_or(0);
-    if verdict[best].as_deref() == Some("no_design_balances")
-        || (verdict[best].as_deref() == Some("only_design") && !sum.b("balances")?[best])
-    {
-        let frac = sum.f("settled_fraction")?[best].unwrap_or(0.0);
-        let residual = sum.f("residual_rel_median")?[best];
-        let why = sum.s("diagnosis")?[best]
-            .clone()
-            .unwrap_or_else(|| "no cause found".into());
-        return Ok(format!(
-            "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {why}\n",
-            who(order, &ids, best),
-            100.0 * frac,
-            residual.map_or("– (no run was simulated to its end)".into(), |r| format!(
+fn verdict_line(decision: &StudyDecision) -> String {
+    let criterion = decision.criterion;
+    match &decision.crown {
+        Crown::NoneBalances {
+            best,
+            settled_fraction,
+            residual_median,
+            cause,
+            ..
+        } => format!(
+            "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {}\n",
+            who_id(decision, *best),
+            100.0 * settled_fraction,
+            residual_median.map_or("– (no run was simulated to its end)".into(), |r| format!(
                 "{r:.2}"
-            ))
-        ));
+            )),
+            cause.as_deref().unwrap_or("no cause found")
+        ),
+        Crown::Alone => String::new(),
+        Crown::Best {
+            best,
+            better_than,
+            not_distinguishable,
+            other_better,
+        } => {
+            let names = |ids: &[u32]| -> Vec<String> {
+                ids.iter().map(|&id| who_id(decision, id)).collect()
+            };
+            let mut line = format!(
+                "verdict on the {}: {} is better than {} of the other {} designs ({}{}, Holm-adjusted at α = {}, {} runs per design)",
+                criterion.label(),
+                who_id(decision, *best),
+                better_than.len(),
+                decision.ranked.len() - 1,
+                criterion.test_name(decision.paired),
+                if decision.paired {
+                    " on runs paired by their shared samples"
+                } else {
+                    ": the designs did not share samples"
+                },
+                decision.alpha,
+                decision.runs_per_design,
+            );
+            if !not_distinguishable.is_empty() {
+                line += &format!(
+                    "; not distinguishable from {}",
+                    names(not_distinguishable).join(", ")
+                );
+            }
+            if !other_better.is_empty() {
+                line += &format!(
+                    "; {} significantly better on its test although #1 has the better point estimate",
+                    names(other_better).join(", ")
+                );
+            }
+            line + "\n"
+        }
     }
-    if verdict[best].as_deref() != Some("best") {
-        return Ok(String::new());
-    }
-    let alpha = sum
-        .f("vs_best_alpha")?
-        .first()
-        .copied()
-        .flatten()
-        .unwrap_or(f64::NAN);
-    let test = sum
-        .s("vs_best_test")?
-        .into_iter()
-        .flatten()
-        .next()
-        .unwrap_or_default();
-    let paired = test != "log_rank" && test != "bootstrap" && test != "two_proportion";
-    let of = |name: &str| -> Vec<String> {
-        order
-            .iter()
-            .filter(|&&i| verdict[i].as_deref() == Some(name))
-            .map(|&i| who(order, &ids, i))
-            .collect()
-    };
-    let mut line = format!(
-        "verdict on the {}: {} is better than {} of the other {} designs ({}{}, Holm-adjusted at α = {alpha}, {per_design} runs per design)",
-        criterion.label(),
-        who(order, &ids, best),
-        of("best_better").len(),
-        order.len() - 1,
-        criterion.test_name(paired),
-        if paired {
-            " on runs paired by their shared samples"
-        } else {
-            ": the designs did not share samples"
-        },
-    );
-    let unclear = of("not_distinguishable");
-    if !unclear.is_empty() {
-        line += &format!("; not distinguishable from {}", unclear.join(", "));
-    }
-    let reversed = of("other_better");
-    if !reversed.is_empty() {
-        line += &format!(
-            "; {} significantly better on its test although #1 has the better point estimate",
-            reversed.join(", ")
-        );
-    }
-    Ok(line + "\n")
 }
 
 /// One sentence naming every design significantly better than #1 on a
 /// reported measure other than the ranking criterion, with the numbers.
-fn disagreement_line(
-    sum: &Summary,
-    order: &[usize],
-    criterion: Criterion,
-) -> Result<String, UserError> {
-    let Some(&best) = order.first().filter(|_| order.len() > 1) else {
-        return Ok(String::new());
-    };
-    let ids = design_ids(sum)?;
-    let alpha = sum
-        .f("vs_best_alpha")?
-        .first()
-        .copied()
-        .flatten()
-        .unwrap_or(0.05);
-    let value_column = |m: Criterion| match m {
-        Criterion::Median => "settling_revs_median_km",
-        Criterion::Mean => "settling_revs_rmst",
-        Criterion::P90 => "settling_revs_p90_all_runs",
-        _ => "residual_rel_p95",
-    };
-    let mut claims = Vec::new();
-    for &i in order.iter().skip(1) {
-        let mut better = Vec::new();
-        for m in Criterion::REPORTED.iter().filter(|&&m| m != criterion) {
-            let name = m.to_string();
-            let diff = sum.f(&format!("vs_best_{name}_diff"))?[i];
-            let lo = sum.f(&format!("vs_best_{name}_diff_lo"))?[i];
-            let hi = sum.f(&format!("vs_best_{name}_diff_hi"))?[i];
-            let p = sum.f(&format!("vs_best_{name}_p_holm"))?[i];
-            let values = sum.f(value_column(*m))?;
-            // Significant and large enough to matter (verdict::material).
-            let significant = p.is_some_and(|p| p <= alpha)
-                && match (diff, values[i], values[best]) {
-                    (Some(d), Some(a), Some(b)) => autobal::study::verdict::material(a, b, d),
-                    _ => true,
-                };
-            let this_better = diff.is_some_and(|d| {
-                if m.lower_is_better() {
-                    d < 0.0
-                } else {
-                    d > 0.0
-                }
-            });
-            if significant && this_better {
-                // The median's Δ is the median of the paired differences,
-                // not the difference of the two medians: say so.
-                let delta = if *m == Criterion::Median {
-                    "median paired Δ"
-                } else {
-                    "Δ"
-                };
-                better.push(format!(
-                    "{} {} vs {} ({delta} {} [{}, {}], Holm p {})",
-                    short(*m),
-                    measure_text(*m, values[i]),
-                    measure_text(*m, values[best]),
-                    diff_text(*m, diff),
-                    diff_text(*m, lo),
-                    diff_text(*m, hi),
-                    p_text(p)
-                ));
-            }
-        }
-        if !better.is_empty() {
-            claims.push(format!(
-                "{} on the {}",
-                who(order, &ids, i),
-                better.join(" and the ")
-            ));
+fn disagreement_line(decision: &StudyDecision) -> String {
+    if decision.ranked.len() < 2 {
+        return String::new();
+    }
+    let mut claims: Vec<(u32, Vec<String>)> = Vec::new();
+    for d in &decision.disagreements {
+        // The median's Δ is the median of the paired differences, not the
+        // difference of the two medians: say so.
+        let delta = if d.measure == Criterion::Median {
+            "median paired Δ"
+        } else {
+            "Δ"
+        };
+        let text = format!(
+            "{} {} vs {} ({delta} {} [{}, {}], Holm p {})",
+            short(d.measure),
+            measure_text(d.measure, d.values.0),
+            measure_text(d.measure, d.values.1),
+            diff_text(d.measure, Some(d.difference)),
+            diff_text(d.measure, d.interval.0),
+            diff_text(d.measure, d.interval.1),
+            p_text(Some(d.p_holm))
+        );
+        match claims.last_mut() {
+            Some((id, texts)) if *id == d.design => texts.push(text),
+            _ => claims.push((d.design, vec![text])),
         }
     }
-    Ok(if claims.is_empty() {
+    if claims.is_empty() {
         format!(
-            "other measures: no design is significantly better than #1 on any of median, restricted mean, p90 and residual p95 (α = {alpha})\n"
+            "other measures: no design is significantly better than #1 on any of median, restricted mean, p90 and residual p95 (α = {})\n",
+            decision.alpha
         )
     } else {
         format!(
             "other measures disagree: better than #1 are {}\n",
-            claims.join("; ")
+            claims
+                .iter()
+                .map(|(id, texts)| format!(
+                    "{} on the {}",
+                    who_id(decision, *id),
+                    texts.join(" and the ")
+                ))
+                .collect::<Vec<_>>()
+                .join("; ")
         )
-    })
+    }
 }
 
 /// Said first when the runs are estimates (the analytic or linear rung):
@@ -712,59 +647,34 @@ fn short(m: Criterion) -> &'static str {
     }
 }
 
-/// The one-line recommendation: #1, and the Pareto set when it has more
-/// than one member; none when #1 does not balance.
-fn recommendation_line(
-    sum: &Summary,
-    order: &[usize],
-    criterion: Criterion,
-) -> Result<String, UserError> {
-    let Some(&best) = order.first() else {
-        return Ok(String::new());
+/// The one-line recommendation: #1 as a part to build, its cautions and
+/// edges, and the Pareto set when it has more than one member; none when
+/// no design balances.
+fn recommendation_line(decision: &StudyDecision) -> String {
+    let Recommendation::Build {
+        design,
+        part,
+        shortfalls,
+        edges,
+        pareto,
+    } = &decision.recommendation
+    else {
+        return match decision.recommendation {
+            Recommendation::NoneBalances => {
+                "recommendation: none of these designs; remove the cause above first\n".into()
+            }
+            _ => String::new(),
+        };
     };
-    let verdict = sum.s("vs_best_verdict")?;
-    let ids = design_ids(sum)?;
-    if verdict[best].as_deref() == Some("no_design_balances") || !sum.b("balances")?[best] {
-        return Ok("recommendation: none of these designs; remove the cause above first\n".into());
-    }
-    let pareto = sum.b("pareto")?;
-    let members: Vec<String> = order
-        .iter()
-        .filter(|&&i| pareto[i])
-        .map(|&i| who(order, &ids, i))
-        .collect();
     let mut line = format!(
-        "recommendation: design {} (#1 by the {})",
-        ids[best],
-        criterion.label()
+        "recommendation: design {design} (#1 by the {})",
+        decision.criterion.label()
     );
-    // The part to build, where the summary carries its dimensions (plane
-    // 0's with a design per plane; summaries written before lack them).
-    let part = (|| {
-        let kind = sum.s("kind").ok()?[best].clone()?;
-        let n = sum.0.column("n").ok()?.u32().ok()?.get(best)?;
-        let f = |name: &str| sum.f(name).ok().and_then(|v| v[best]);
-        Some(autobal::study::design::part_text(
-            &kind,
-            n,
-            f("rho")?,
-            f("race_radius")?,
-            f("weight_mass")?,
-            f("drag")?,
-        ))
-    })();
     if let Some(part) = part {
         line += &format!(": {part}");
     }
     // A crown that falls short of a design that works says so, with the rule.
-    // Absent from summaries written before the column existed.
-    let worse = sum
-        .f("worse_than_none_fraction")
-        .ok()
-        .and_then(|v| v[best])
-        .unwrap_or(0.0);
-    let settled = sum.f("settled_fraction")?[best].unwrap_or(0.0);
-    let short: Vec<String> = shortfalls(settled, worse)
+    let short: Vec<String> = shortfalls
         .iter()
         .map(|s| match s {
             Shortfall::SettlesTooRarely(f) => format!(
@@ -783,19 +693,7 @@ fn recommendation_line(
         line += &format!(", with a caution: {}", short.join("; "));
     }
     // A winner at the end of a swept axis: the best may lie beyond it.
-    let n: Vec<Option<u32>> = sum.0.column("n")?.u32()?.iter().collect();
-    let (kind, rho, drag) = (sum.s("kind")?, sum.f("rho")?, sum.f("drag")?);
-    let grid: Vec<(String, f64, f64, f64)> = (0..ids.len())
-        .map(|i| {
-            (
-                kind[i].clone().unwrap_or_default(),
-                n[i].map_or(f64::NAN, f64::from),
-                rho[i].unwrap_or(f64::NAN),
-                drag[i].unwrap_or(f64::NAN),
-            )
-        })
-        .collect();
-    for e in edges(&grid, best) {
+    for e in edges {
         line += &format!(
             "; it sits at the {} {} swept ({}): the best may lie beyond, so extend {} {} it",
             if e.high { "largest" } else { "smallest" },
@@ -805,14 +703,18 @@ fn recommendation_line(
             if e.high { "above" } else { "below" },
         );
     }
-    if members.len() > 1 {
+    if pareto.len() > 1 {
         line += &format!(
             "; {} designs are not dominated on the study's Pareto measures: {}: if your requirement names another measure, choose among them by it",
-            members.len(),
-            members.join(", ")
+            pareto.len(),
+            pareto
+                .iter()
+                .map(|&id| who_id(decision, id))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
-    Ok(line + "\n")
+    line + "\n"
 }
 
 /// Runs that ended `merged`: how many, of which designs, and the way out.

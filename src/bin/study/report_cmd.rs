@@ -7,6 +7,7 @@ use crate::plot_cmd::plot_error;
 use crate::ranking::ranking;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::report::{Report, question, study_figures};
+use autobal::study::decision::StudyDecision;
 use autobal::study::io::{read_metadata, read_parquet, write_text};
 use clap::Args;
 use std::path::PathBuf;
@@ -53,14 +54,8 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
     let parts = ranking(&summary)?;
     let study_text = autobal::input_file::read_text(&args.dir.join("study.toml"))
         .map_err(|e| UserError(format!("{}/study.toml: {e}", args.dir.display()), 2))?;
-    // The leading designs' ids, in rank order (the table's "id" column).
-    let id_column = parts.header.iter().position(|h| h == "id").unwrap_or(1);
-    let leading: Vec<u32> = parts
-        .rows
-        .iter()
-        .take(args.leading as usize)
-        .filter_map(|row| row.get(id_column)?.parse().ok())
-        .collect();
+    // The leading designs' ids, in rank order, from the typed decision.
+    let leading = StudyDecision::from_summary(&summary)?.leading(args.leading as usize);
     let figures = study_figures(&args.dir, &leading).map_err(plot_error)?;
     let meta = read_metadata(&args.dir.join("runs.parquet")).unwrap_or_default();
     let value = |key: &str| {

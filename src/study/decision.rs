@@ -1,0 +1,414 @@
+//! The study's decision, typed: which design to build, or why none; the
+//! verdict of #1 against the others; where the other measures disagree; and
+//! the recommendation with its cautions.
+//!
+//! `summary.parquet` is its serialised form: [`StudyDecision::from_summary`]
+//! reads it back, and `study run`, `merge`, `report` and `compare` render it
+//! (src/bin/study); nothing there decides. The rules are those of
+//! [`super::verdict`] (docs/statistics.md): designs that balance rank first,
+//! a measure favours a design by [`favoured`], a crown that falls short of a
+//! design that works carries its [`Shortfall`]s, a winner at the end of a
+//! swept axis its [`Edge`]s.
+
+use super::criterion::Criterion;
+use super::verdict::{Edge, Favours, Shortfall, edges, favoured, shortfalls};
+use crate::stats::paired_measures::Difference;
+use polars::prelude::{DataFrame, PolarsResult};
+
+/// The verdict stored for a design in `summary.parquet` (`vs_best_verdict`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StoredVerdict {
+    /// The first-ranked design, which balances.
+    Best,
+    /// #1 is better than this design at α.
+    BestBetter,
+    /// The data cannot tell this design from #1.
+    NotDistinguishable,
+    /// This design is significantly better than #1 on the criterion's test.
+    OtherBetter,
+    /// #1 does not balance, and so no design does.
+    NoDesignBalances,
+    /// The study has one design.
+    OnlyDesign,
+}
+
+impl StoredVerdict {
+    /// The verdict of a stored name; `None` for a name this build does not know.
+    pub fn parse(name: &str) -> Option<Self> {
+        Some(match name {
+            "best" => Self::Best,
+            "best_better" => Self::BestBetter,
+            "not_distinguishable" => Self::NotDistinguishable,
+            "other_better" => Self::OtherBetter,
+            "no_design_balances" => Self::NoDesignBalances,
+            "only_design" => Self::OnlyDesign,
+            _ => return None,
+        })
+    }
+}
+
+/// One design in rank order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RankedDesign {
+    /// Design id.
+    pub id: u32,
+    /// Its row in `summary.parquet`.
+    pub row: usize,
+    /// Its verdict against #1.
+    pub verdict: Option<StoredVerdict>,
+    /// Whether it balances (settles in at least half its runs, median residual ≤ A_ref).
+    pub balances: bool,
+    /// Not dominated on the study's Pareto measures.
+    pub pareto: bool,
+}
+
+/// What the verdict line says of #1.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Crown {
+    /// #1 balances and was compared with the others on the criterion.
+    Best {
+        /// #1's id.
+        best: u32,
+        /// Designs #1 is better than.
+        better_than: Vec<u32>,
+        /// Designs the data cannot tell from #1.
+        not_distinguishable: Vec<u32>,
+        /// Designs better than #1 on the criterion's test, behind it on the point estimate.
+        other_better: Vec<u32>,
+    },
+    /// No design balances: #1 is named, with why.
+    NoneBalances {
+        /// #1's id.
+        best: u32,
+        /// #1's settled share.
+        settled_fraction: f64,
+        /// #1's median residual/A_ref (`None`: no run was simulated to its end).
+        residual_median: Option<f64>,
+        /// The diagnosis, in words.
+        cause: Option<String>,
+        /// The diagnosis' key (`diagnosis_cause`).
+        cause_key: Option<String>,
+    },
+    /// One design that balances, or none at all: nothing to crown against.
+    Alone,
+}
+
+/// A design significantly and materially better than #1 on a reported
+/// measure other than the ranking criterion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disagreement {
+    /// The design.
+    pub design: u32,
+    /// The measure.
+    pub measure: Criterion,
+    /// The design's value and #1's (`None`: beyond the run, or not measured).
+    pub values: (Option<f64>, Option<f64>),
+    /// This design minus #1, with its interval and Holm-adjusted p-value.
+    pub difference: f64,
+    /// Interval of the difference.
+    pub interval: (Option<f64>, Option<f64>),
+    /// Holm-adjusted p-value.
+    pub p_holm: f64,
+}
+
+/// The recommendation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Recommendation {
+    /// Build this design.
+    Build {
+        /// Its id.
+        design: u32,
+        /// The part in an engineer's terms (count, diameter, mass, race, drag),
+        /// where the summary carries the dimensions.
+        part: Option<String>,
+        /// How it falls short of a design that works (empty: it works).
+        shortfalls: Vec<Shortfall>,
+        /// The swept axes on whose end it sits.
+        edges: Vec<Edge>,
+        /// The Pareto set, #1 included, in rank order.
+        pareto: Vec<u32>,
+    },
+    /// No design balances: none is recommended.
+    NoneBalances,
+    /// The summary has no design.
+    NoDesigns,
+}
+
+/// Which design to build, or why none, as `summary.parquet` records it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyDecision {
+    /// The ranking criterion.
+    pub criterion: Criterion,
+    /// α of the verdicts.
+    pub alpha: f64,
+    /// The test of the verdicts (`vs_best_test`).
+    pub test: String,
+    /// Whether the verdicts paired runs on their shared samples.
+    pub paired: bool,
+    /// Most runs of a design.
+    pub runs_per_design: u64,
+    /// The designs in rank order.
+    pub ranked: Vec<RankedDesign>,
+    /// The verdict on #1.
+    pub crown: Crown,
+    /// Designs better than #1 on another measure.
+    pub disagreements: Vec<Disagreement>,
+    /// The recommendation.
+    pub recommendation: Recommendation,
+}
+
+/// Typed access to a summary's columns (absent optional columns: `None`s).
+struct Columns<'a>(&'a DataFrame);
+
+impl Columns<'_> {
+    fn f(&self, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+        Ok(self.0.column(name)?.f64()?.iter().collect())
+    }
+    fn f_or_none(&self, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+        match self.0.column(name) {
+            Ok(_) => self.f(name),
+            Err(_) => Ok(vec![None; self.0.height()]),
+        }
+    }
+    fn s(&self, name: &str) -> PolarsResult<Vec<Option<String>>> {
+        Ok(self
+            .0
+            .column(name)?
+            .str()?
+            .iter()
+            .map(|s| s.map(str::to_string))
+            .collect())
+    }
+    fn s_or_none(&self, name: &str) -> PolarsResult<Vec<Option<String>>> {
+        match self.0.column(name) {
+            Ok(_) => self.s(name),
+            Err(_) => Ok(vec![None; self.0.height()]),
+        }
+    }
+    fn b(&self, name: &str) -> PolarsResult<Vec<bool>> {
+        Ok(self
+            .0
+            .column(name)?
+            .bool()?
+            .iter()
+            .map(Option::unwrap_or_default)
+            .collect())
+    }
+    fn u32s(&self, name: &str) -> PolarsResult<Vec<Option<u32>>> {
+        Ok(self.0.column(name)?.u32()?.iter().collect())
+    }
+}
+
+/// The summary column holding each reported measure's value.
+fn value_column(m: Criterion) -> &'static str {
+    match m {
+        Criterion::Median => "settling_revs_median_km",
+        Criterion::Mean => "settling_revs_rmst",
+        Criterion::P90 => "settling_revs_p90_all_runs",
+        _ => "residual_rel_p95",
+    }
+}
+
+impl StudyDecision {
+    /// The decision a summary records.
+    pub fn from_summary(summary: &DataFrame) -> PolarsResult<Self> {
+        let c = Columns(summary);
+        let criterion = c
+            .s("rank_by")?
+            .into_iter()
+            .flatten()
+            .next()
+            .and_then(|t| Criterion::parse(&t).ok())
+            .unwrap_or_default();
+        let ids: Vec<u32> = c
+            .u32s("design_id")?
+            .into_iter()
+            .map(Option::unwrap_or_default)
+            .collect();
+        let rank = c.u32s("rank")?;
+        let mut order: Vec<usize> = (0..summary.height()).collect();
+        order.sort_by_key(|&i| (rank[i].unwrap_or(u32::MAX), i));
+        let verdicts = c.s("vs_best_verdict")?;
+        let balances = c.b("balances")?;
+        let pareto = c.b("pareto")?;
+        let ranked: Vec<RankedDesign> = order
+            .iter()
+            .map(|&i| RankedDesign {
+                id: ids[i],
+                row: i,
+                verdict: verdicts[i].as_deref().and_then(StoredVerdict::parse),
+                balances: balances[i],
+                pareto: pareto[i],
+            })
+            .collect();
+        let alpha = c
+            .f("vs_best_alpha")?
+            .into_iter()
+            .flatten()
+            .next()
+            .unwrap_or(0.05);
+        let test = c
+            .s("vs_best_test")?
+            .into_iter()
+            .flatten()
+            .next()
+            .unwrap_or_default();
+        let paired = test != "log_rank" && test != "bootstrap" && test != "two_proportion";
+        let runs_per_design = summary
+            .column("runs")?
+            .u64()?
+            .iter()
+            .flatten()
+            .max()
+            .unwrap_or(0);
+        let crown = crown(&c, &ranked)?;
+        let disagreements = disagreements(&c, &ranked, criterion, alpha)?;
+        let recommendation = recommendation(&c, &ranked)?;
+        Ok(StudyDecision {
+            criterion,
+            alpha,
+            test,
+            paired,
+            runs_per_design,
+            ranked,
+            crown,
+            disagreements,
+            recommendation,
+        })
+    }
+
+    /// The rank (1-based) of design `id`.
+    pub fn rank_of(&self, id: u32) -> Option<usize> {
+        self.ranked.iter().position(|d| d.id == id).map(|r| r + 1)
+    }
+
+    /// The leading `count` designs' ids, in rank order.
+    pub fn leading(&self, count: usize) -> Vec<u32> {
+        self.ranked.iter().take(count).map(|d| d.id).collect()
+    }
+}
+
+/// The verdict on #1.
+fn crown(c: &Columns, ranked: &[RankedDesign]) -> PolarsResult<Crown> {
+    let Some(best) = ranked.first() else {
+        return Ok(Crown::Alone);
+    };
+    let none_balances = best.verdict == Some(StoredVerdict::NoDesignBalances)
+        || (best.verdict == Some(StoredVerdict::OnlyDesign) && !best.balances);
+    if none_balances {
+        return Ok(Crown::NoneBalances {
+            best: best.id,
+            settled_fraction: c.f("settled_fraction")?[best.row].unwrap_or(0.0),
+            residual_median: c.f("residual_rel_median")?[best.row],
+            cause: c.s("diagnosis")?[best.row].clone(),
+            cause_key: c.s_or_none("diagnosis_cause")?[best.row].clone(),
+        });
+    }
+    if best.verdict != Some(StoredVerdict::Best) {
+        return Ok(Crown::Alone);
+    }
+    let of = |v: StoredVerdict| -> Vec<u32> {
+        ranked
+            .iter()
+            .filter(|d| d.verdict == Some(v))
+            .map(|d| d.id)
+            .collect()
+    };
+    Ok(Crown::Best {
+        best: best.id,
+        better_than: of(StoredVerdict::BestBetter),
+        not_distinguishable: of(StoredVerdict::NotDistinguishable),
+        other_better: of(StoredVerdict::OtherBetter),
+    })
+}
+
+/// Every design better than #1 on a reported measure other than the criterion.
+fn disagreements(
+    c: &Columns,
+    ranked: &[RankedDesign],
+    criterion: Criterion,
+    alpha: f64,
+) -> PolarsResult<Vec<Disagreement>> {
+    let Some(best) = ranked.first().filter(|_| ranked.len() > 1) else {
+        return Ok(Vec::new());
+    };
+    let mut out = Vec::new();
+    for design in ranked.iter().skip(1) {
+        for &m in Criterion::REPORTED.iter().filter(|&&m| m != criterion) {
+            let name = m.to_string();
+            let column = |suffix: &str| -> PolarsResult<Option<f64>> {
+                Ok(c.f_or_none(&format!("vs_best_{name}_{suffix}"))?[design.row])
+            };
+            let (Some(diff), Some(p)) = (column("diff")?, column("p_holm")?) else {
+                continue;
+            };
+            let interval = (column("diff_lo")?, column("diff_hi")?);
+            let values = c.f(value_column(m))?;
+            let (a, b) = (values[design.row], values[best.row]);
+            // A value beyond the run has no size: only the sign and p count.
+            let d = Difference {
+                a: a.unwrap_or(0.0),
+                b: b.unwrap_or(0.0),
+                difference: diff,
+                interval: (
+                    interval.0.unwrap_or(f64::NEG_INFINITY),
+                    interval.1.unwrap_or(f64::INFINITY),
+                ),
+                p_value: p,
+                test: "",
+            };
+            if favoured(m, &d, p, alpha) == Some(Favours::A) {
+                out.push(Disagreement {
+                    design: design.id,
+                    measure: m,
+                    values: (a, b),
+                    difference: diff,
+                    interval,
+                    p_holm: p,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The recommendation: #1 with its part, cautions and edges, or none.
+fn recommendation(c: &Columns, ranked: &[RankedDesign]) -> PolarsResult<Recommendation> {
+    let Some(best) = ranked.first() else {
+        return Ok(Recommendation::NoDesigns);
+    };
+    if best.verdict == Some(StoredVerdict::NoDesignBalances) || !best.balances {
+        return Ok(Recommendation::NoneBalances);
+    }
+    let i = best.row;
+    let kind = c.s("kind")?;
+    let n = c.u32s("n")?;
+    let (rho, drag) = (c.f("rho")?, c.f("drag")?);
+    // Summaries written before these columns lack the part's dimensions.
+    let (race, mass) = (c.f_or_none("race_radius")?, c.f_or_none("weight_mass")?);
+    let part = match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
+        (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
+            Some(super::design::part_text(k, n, r, race, m, b))
+        }
+        _ => None,
+    };
+    let worse = c.f_or_none("worse_than_none_fraction")?[i].unwrap_or(0.0);
+    let settled = c.f("settled_fraction")?[i].unwrap_or(0.0);
+    let grid: Vec<(String, f64, f64, f64)> = (0..kind.len())
+        .map(|j| {
+            (
+                kind[j].clone().unwrap_or_default(),
+                n[j].map_or(f64::NAN, f64::from),
+                rho[j].unwrap_or(f64::NAN),
+                drag[j].unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    Ok(Recommendation::Build {
+        design: best.id,
+        part,
+        shortfalls: shortfalls(settled, worse),
+        edges: edges(&grid, i),
+        pareto: ranked.iter().filter(|d| d.pareto).map(|d| d.id).collect(),
+    })
+}
