@@ -555,3 +555,45 @@ fn the_decision_is_typed_and_follows_the_rules_on_a_many_design_study() {
     }
     assert_eq!(decision.leading(2)[0], best.id);
 }
+
+/// The default output in an engineer's terms: units in the settling
+/// headers, ρ explained, the part to build in mm and g, the paired Δ named
+/// as such, no "certified hold" or "touching angle" jargon, and stderr's
+/// lines kept apart (before: "failures 0wrote results/…").
+#[test]
+fn the_ranking_speaks_in_an_engineers_terms() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = drum_like(
+        &tmp.path().join("results"),
+        "terms",
+        r#"{ distribution = "uniform", min = 0.2, max = 0.9, relative_to = "capacity" }"#,
+        "",
+    );
+    let path = tmp.path().join("study.toml");
+    std::fs::write(&path, text).unwrap();
+    // Not --quiet: the closing progress line is on stderr.
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", path.to_str().unwrap(), "--wide"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let header: String = stdout.lines().take(2).collect::<Vec<_>>().join("\n");
+    for unit in ["rev", "N·s/m", "µm", "%"] {
+        assert!(header.contains(unit), "{unit}: {header}");
+    }
+    assert!(stdout.contains("ρ = r/R"), "{stdout}");
+    assert!(
+        stdout.contains("mm diameter,") && stdout.contains(" g each, in a race of radius 25 mm"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("angle at which two weights touch"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("touching angle"), "{stdout}");
+    assert!(!stderr.contains("certified hold"), "{stderr}");
+    assert!(!stderr.contains("failures 0wrote"), "{stderr}");
+    assert!(stderr.lines().any(|l| l.starts_with("wrote ")), "{stderr}");
+}

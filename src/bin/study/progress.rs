@@ -177,7 +177,7 @@ impl Progress for RunProgress {
         let certified = self.certified.load(Ordering::Relaxed);
         let early = if certified > 0 {
             format!(
-                " ({:.1} % by a certified hold)",
+                " ({:.1} % ended early: their hold window proved settled before it ran out, docs/metrics.md)",
                 100.0 * certified as f64 / done.max(1) as f64
             )
         } else {

@@ -365,7 +365,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .next()
         .unwrap_or_else(|| "from t = 0".into());
     let legend = format!(
-        "(ranked by the {}, designs that balance first; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: restricted to τ = {} rev; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window, in µm and relative to A_ref (the whirl the same unbalance causes without a balancer); failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
+        "(ranked by the {}, designs that balance first; ρ = r/R, the weight's radius over the race's; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: the restricted mean, each run counted up to the horizon τ = {} rev, t_end − hold; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window, in µm and relative to A_ref (the whirl the same unbalance causes without a balancer); failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
         criterion.label(),
         if run_up {
             " (but the column “median from t = 0”)"
@@ -780,7 +780,7 @@ fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
         .reduce(f64::max);
     let closest = deepest.map_or(String::new(), |f| {
         format!(
-            "; deepest overlap {:.2} % of the touching angle 2α",
+            "; deepest overlap {:.2} % of the angle at which two weights touch (2α)",
             100.0 * f
         )
     });
