@@ -245,9 +245,33 @@ fn runs_out_of_budget_make_the_study_exit_1_naming_max_steps_after_writing_every
     );
     let dir = tmp.path().join("results/corpus");
     assert!(dir.join("runs.parquet").exists() && dir.join("summary.parquet").exists());
-    // The ranking shows the failures per design.
+    // The ranking's "failed" column shows each design's failed runs: the
+    // sum of its cells is the count of failed runs in runs.parquet.
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("failed"), "{stdout}");
+    let failed_runs = outcomes(&dir.join("runs.parquet"))
+        .iter()
+        .filter(|o| *o == "budget_exceeded" || *o == "solver_failed")
+        .count();
+    assert!(failed_runs > 0);
+    let lines: Vec<Vec<char>> = stdout.lines().map(|l| l.chars().collect()).collect();
+    let header = &lines[1];
+    let end = (0..header.len())
+        .find(|&i| header[i..].starts_with(&['f', 'a', 'i', 'l', 'e', 'd']))
+        .expect("a failed column")
+        + 6;
+    let shown: usize = lines[3..]
+        .iter()
+        .take_while(|l| l.first().is_some_and(|c| c.is_ascii_digit()))
+        .map(|l| {
+            let cell: String = l[..end].iter().collect();
+            cell.split_whitespace()
+                .last()
+                .unwrap()
+                .parse::<usize>()
+                .unwrap()
+        })
+        .sum();
+    assert_eq!(shown, failed_runs, "{stdout}");
     assert!(
         outcomes(&dir.join("runs.parquet"))
             .iter()

@@ -334,10 +334,21 @@ t_end_revs = 3000
                 let system = sim.scene.build().expect("builds");
                 let outcome = match analyse(&system, None) {
                     Ok(report) => {
-                        eprintln!(
-                            "PROBE n={n} w={omega} slowest {:?} decay {}",
-                            report.slowest, report.slowest_decay
+                        // A verdict must be the report's own: stable exactly
+                        // when the slowest non-neutral root decays, every
+                        // root of the 2(4 + n)-dimensional state present,
+                        // and no more neutral roots set aside than n − 2.
+                        assert_eq!(
+                            report.stable,
+                            report.slowest_decay > 0.0,
+                            "n = {n}, ω = {omega}"
                         );
+                        assert_eq!(
+                            report.eigenvalues.len(),
+                            2 * (4 + n),
+                            "n = {n}, ω = {omega}"
+                        );
+                        assert!(report.neutral <= n - 2, "n = {n}, ω = {omega}");
                         format!("{}", report.stable)
                     }
                     Err(e @ LinearError::EigenvaluesDidNotConverge { .. }) => e.to_string(),

@@ -243,12 +243,23 @@ fn constant_speed_runs_are_identical_for_balls_rollers_and_pendulums_of_equal_ka
     );
 }
 
+/// A motor whose torque falls off steeply from its synchronous speed holds
+/// the speed the way a constant-speed law does: the whirl r(t) under a
+/// stiffer motor (stall torque 500) is closer to the constant-speed whirl
+/// than under a softer one (50), and both settle as the constant speed does.
+/// (Before 2026-11-27 the test compared settling times, equal to the sample
+/// for both, and accepted any pair below 0.5 s.)
 #[test]
 fn stiff_speed_controller_tends_to_constant_speed() {
     let start = [30.0, 150.0, 200.0];
-    let constant = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start)
-        .run(false)
-        .unwrap();
+    let whirl = |sim: Simulation| {
+        let mut sim = sim;
+        sim.metrics.t_end_revs = 20.0;
+        sim.metrics.stop_when_settled = false;
+        sim.run(true).unwrap().series.unwrap()
+    };
+    let constant = whirl(simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start));
+    let scale = constant.r.iter().copied().fold(0.0, f64::max);
     let mut errors = Vec::new();
     for stall in [50.0, 500.0] {
         let mut sim = simulation(rotor(), balls(3, 0.01, 0.01), 4.0, &start);
@@ -258,16 +269,27 @@ fn stiff_speed_controller_tends_to_constant_speed() {
             omega_sync: 4.0,
             omega_start: 4.0,
         };
-        let run = sim.run(false).unwrap();
-        assert_eq!(run.metrics.outcome, Outcome::Settled);
-        let d =
-            (run.metrics.settling_time.unwrap() - constant.metrics.settling_time.unwrap()).abs();
-        errors.push(d);
+        assert_eq!(
+            sim.clone().run(false).unwrap().metrics.outcome,
+            Outcome::Settled
+        );
+        let series = whirl(sim);
+        assert_eq!(series.t, constant.t, "the same output grid");
+        let d = series
+            .r
+            .iter()
+            .zip(&constant.r)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        errors.push(d / scale);
     }
-    assert!(errors[1] < errors[0] || errors[1] < 0.5, "{errors:?}");
+    // The speed's droop, and with it the whirl's departure, goes as 1/stall
+    // torque: ten times the torque, about a tenth of the departure.
+    let ratio = errors[0] / errors[1];
+    assert!((5.0..20.0).contains(&ratio), "{errors:?}");
     assert!(
-        errors[1] < 2.0,
-        "stiff motor settles within 2 s of constant speed: {errors:?}"
+        errors[1] < 0.05,
+        "within 5 % of the largest whirl: {errors:?}"
     );
 }
 
