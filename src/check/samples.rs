@@ -5,6 +5,7 @@
 //! times are those of settled runs, residual vibration that of every run
 //! simulated to the end (settled or not), as in `summary.parquet`.
 
+use crate::metrics::Outcome;
 use polars::prelude::*;
 
 /// Columns a check needs from a runs table.
@@ -114,7 +115,10 @@ pub fn design_samples(df: &DataFrame) -> PolarsResult<Vec<DesignSample>> {
                 s.settling_revs.push(t);
             }
         }
-        if matches!(outcome.get(i), Some("settled" | "censored" | "not_settled"))
+        if outcome
+            .get(i)
+            .and_then(Outcome::parse)
+            .is_some_and(Outcome::has_residual)
             && let Some(r) = residual.get(i)
         {
             s.residual_rel.push(r);

@@ -111,9 +111,34 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// Every outcome, in the order of the summary's count columns.
+    pub const ALL: [Outcome; 7] = [
+        Outcome::Settled,
+        Outcome::Censored,
+        Outcome::NotSettled,
+        Outcome::Diverged,
+        Outcome::BudgetExceeded,
+        Outcome::SolverFailed,
+        Outcome::Merged,
+    ];
+
+    /// The outcome of a name written by [`Outcome::name`]; `None` for
+    /// another text. The one place, with `name`, where outcomes are strings.
+    pub fn parse(name: &str) -> Option<Outcome> {
+        Outcome::ALL.into_iter().find(|o| o.name() == name)
+    }
+
+    /// A run the solver could not finish (out of budget, or failed): counted
+    /// as not settled in every settling statistic and named in the
+    /// failure advice. Divergence and merging are physics, not failures.
+    pub fn is_failure(self) -> bool {
+        matches!(self, Outcome::SolverFailed | Outcome::BudgetExceeded)
+    }
+
     /// True for the outcomes whose run reached a residual the metrics
     /// describe (settled, censored, not settled), false for a run that
-    /// failed, diverged or merged.
+    /// failed, diverged or merged. An estimate's `not_settled` measured
+    /// nothing: [`RunMetrics::has_measured_residual`] tells them apart.
     pub fn has_residual(self) -> bool {
         matches!(
             self,
@@ -131,6 +156,26 @@ impl Outcome {
             Outcome::BudgetExceeded => "budget_exceeded",
             Outcome::SolverFailed => "solver_failed",
             Outcome::Merged => "merged",
+        }
+    }
+}
+
+/// Which budget a run exceeded, from the reason it records.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Budget {
+    /// `[solver] max_steps`.
+    Steps,
+    /// `[solver] max_wall_seconds`.
+    WallTime,
+}
+
+impl Budget {
+    /// The budget named by a `budget_exceeded` run's reason.
+    pub fn of_reason(reason: &str) -> Budget {
+        if reason.contains("wall-time") {
+            Budget::WallTime
+        } else {
+            Budget::Steps
         }
     }
 }
@@ -288,6 +333,19 @@ impl std::fmt::Debug for RunMetrics {
 }
 
 impl RunMetrics {
+    /// Whether the run measured its residual, the RMS of r over its last
+    /// hold window: a settled or censored run, or one integrated and
+    /// certified not to settle (an estimate's `not_settled` took no step
+    /// and measured nothing), with a finite value.
+    pub fn has_measured_residual(&self) -> bool {
+        let measured = match self.outcome {
+            Outcome::Settled | Outcome::Censored => true,
+            Outcome::NotSettled => self.steps > 0,
+            _ => false,
+        };
+        measured && self.residual_abs.is_finite()
+    }
+
     /// Metrics of a run that was not integrated (a closed-form estimate, or
     /// a run that could not be simulated at all): nothing settled, no
     /// residual, no work; estimates fill in what they know.
@@ -419,5 +477,42 @@ impl MetricOptions {
             });
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Budget, Outcome};
+
+    /// Every name reads back as its outcome, and nothing else reads as one.
+    #[test]
+    fn outcome_names_round_trip() {
+        for o in Outcome::ALL {
+            assert_eq!(Outcome::parse(o.name()), Some(o));
+        }
+        assert_eq!(Outcome::parse("failed"), None);
+        assert_eq!(Outcome::parse("Settled"), None);
+    }
+
+    /// Failures are the solver's: divergence and merging are physics, and
+    /// they are the outcomes without a residual that are not failures.
+    #[test]
+    fn failures_are_the_solvers_alone() {
+        let failures: Vec<Outcome> = Outcome::ALL
+            .into_iter()
+            .filter(|o| o.is_failure())
+            .collect();
+        assert_eq!(
+            failures,
+            vec![Outcome::BudgetExceeded, Outcome::SolverFailed]
+        );
+        for o in Outcome::ALL {
+            assert!(!(o.is_failure() && o.has_residual()), "{o:?}");
+        }
+        assert_eq!(
+            Budget::of_reason("wall-time budget of 5 s exhausted at t = 1.2"),
+            Budget::WallTime
+        );
+        assert_eq!(Budget::of_reason("max_steps = 150 reached"), Budget::Steps);
     }
 }

@@ -21,12 +21,10 @@ use rayon::prelude::*;
 /// window), +∞ for a run that has none (diverged, failed, out of budget, or
 /// only estimated), so that it never meets a spec.
 pub fn measured_residual(m: &crate::metrics::RunMetrics) -> f64 {
-    use crate::metrics::Outcome;
-    match m.outcome {
-        Outcome::Settled | Outcome::Censored if m.residual_abs.is_finite() => m.residual_abs,
-        // An estimate's `not_settled` took no step and measured nothing.
-        Outcome::NotSettled if m.steps > 0 && m.residual_abs.is_finite() => m.residual_abs,
-        _ => f64::INFINITY,
+    if m.has_measured_residual() {
+        m.residual_abs
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -15,6 +15,7 @@ use super::record::{RunRecord, to_dataframe};
 use super::verdict::{
     BestVersusRest, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
 };
+use crate::metrics::Outcome;
 use crate::model::gap::GapGauge;
 use crate::stats::interval::wilson_interval;
 use crate::stats::quantile::{Interpolation, quantile_sorted};
@@ -108,12 +109,17 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
     for design in &plan.designs {
         let mine = df.filter(&design_col.equal(design.id))?;
         let outcome = mine.column("outcome")?.str()?.clone();
-        let count = |name: &str| outcome.equal(name).sum().unwrap_or(0) as u64;
+        let outcomes: Vec<Option<Outcome>> =
+            outcome.iter().map(|o| o.and_then(Outcome::parse)).collect();
+        let count = |which: Outcome| outcomes.iter().filter(|&&o| o == Some(which)).count() as u64;
         let settled_mask = mine.column("settled")?.bool()?.clone();
         let settled = mine.filter(&settled_mask)?;
-        let simulated = mine.filter(
-            &(outcome.equal("settled") | outcome.equal("censored") | outcome.equal("not_settled")),
-        )?;
+        let simulated = mine.filter(&BooleanChunked::from_iter_values(
+            "simulated".into(),
+            outcomes
+                .iter()
+                .map(|o| o.is_some_and(Outcome::has_residual)),
+        ))?;
         let residual = simulated.column("residual_rel")?.f64()?.clone();
         let runs_n = mine.height() as u64;
         let settled_n = settled.height() as u64;
@@ -229,12 +235,12 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.seconds_per_rev.push(Some(
             std::f64::consts::TAU / plan.file.scene.speed.nominal_speed(),
         ));
-        rows.censored.push(count("censored"));
-        rows.not_settled.push(count("not_settled"));
-        rows.diverged.push(count("diverged"));
-        rows.solver_failed.push(count("solver_failed"));
-        rows.budget_exceeded.push(count("budget_exceeded"));
-        rows.merged.push(count("merged"));
+        rows.censored.push(count(Outcome::Censored));
+        rows.not_settled.push(count(Outcome::NotSettled));
+        rows.diverged.push(count(Outcome::Diverged));
+        rows.solver_failed.push(count(Outcome::SolverFailed));
+        rows.budget_exceeded.push(count(Outcome::BudgetExceeded));
+        rows.merged.push(count(Outcome::Merged));
         // Whether the weights were solid, and how close they came in the
         // worst run (negative: they overlapped).
         let contact = mine.column("contact")?.bool()?.clone();

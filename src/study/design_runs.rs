@@ -5,6 +5,7 @@
 use super::config::StudyPlan;
 pub use super::measured_runs::DesignRuns;
 use super::measured_runs::Scale;
+use crate::metrics::Outcome;
 use crate::stats::survival::Observation;
 use polars::prelude::*;
 
@@ -109,7 +110,10 @@ pub fn design_runs(
                 settled: false,
             },
         };
-        let simulated = matches!(outcome.get(i), Some("settled" | "censored" | "not_settled"));
+        let simulated = outcome
+            .get(i)
+            .and_then(Outcome::parse)
+            .is_some_and(Outcome::has_residual);
         d.sample_ids.push(sample.get(i).unwrap_or_default());
         d.settling.push(observation);
         d.residual

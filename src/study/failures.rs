@@ -4,6 +4,7 @@
 //! exits 1).
 
 use super::config::StudyPlan;
+use crate::metrics::{Budget, Outcome};
 use polars::prelude::*;
 use std::path::Path;
 
@@ -19,10 +20,12 @@ pub fn failure_advice(plan: &StudyPlan, runs_path: &Path) -> PolarsResult<Option
     let reason = df.column("reason")?.str()?;
     let (mut steps, mut wall, mut failed) = (0u64, 0u64, 0u64);
     for (o, r) in outcome.iter().zip(reason.iter()) {
-        match o {
-            Some("budget_exceeded") if r.is_some_and(|r| r.contains("wall-time")) => wall += 1,
-            Some("budget_exceeded") => steps += 1,
-            Some("solver_failed") => failed += 1,
+        match o.and_then(Outcome::parse) {
+            Some(Outcome::BudgetExceeded) => match Budget::of_reason(r.unwrap_or_default()) {
+                Budget::WallTime => wall += 1,
+                Budget::Steps => steps += 1,
+            },
+            Some(Outcome::SolverFailed) => failed += 1,
             _ => {}
         }
     }

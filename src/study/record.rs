@@ -321,16 +321,10 @@ pub fn deterministic_columns(df: &DataFrame) -> Vec<String> {
 }
 
 fn outcome_from(name: &str) -> PolarsResult<Outcome> {
-    Ok(match name {
-        "settled" => Outcome::Settled,
-        "not_settled" => Outcome::NotSettled,
-        "censored" => Outcome::Censored,
-        "budget_exceeded" => Outcome::BudgetExceeded,
-        "diverged" => Outcome::Diverged,
-        "merged" => Outcome::Merged,
-        "solver_failed" => Outcome::SolverFailed,
-        other => polars_bail!(ComputeError: "unknown outcome '{other}' in runs file"),
-    })
+    match Outcome::parse(name) {
+        Some(o) => Ok(o),
+        None => polars_bail!(ComputeError: "unknown outcome '{name}' in runs file"),
+    }
 }
 
 /// Read records back from a DataFrame written by [`to_dataframe`].

@@ -3,7 +3,6 @@
 //! Kubernetes log would otherwise show nothing until the end), nothing with
 //! `--quiet`.
 
-use autobal::metrics::Outcome;
 use autobal::study::record::RunRecord;
 use autobal::study::run::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -132,10 +131,8 @@ impl Progress for RunProgress {
         if record.metrics.hold_certified {
             self.certified.fetch_add(1, Ordering::Relaxed);
         }
-        let failed = matches!(
-            record.metrics.outcome,
-            Outcome::Diverged | Outcome::SolverFailed | Outcome::BudgetExceeded | Outcome::Merged
-        );
+        // The same failures as the ranking's "failed" column and the advice.
+        let failed = record.metrics.outcome.is_failure();
         if failed {
             self.failures.fetch_add(1, Ordering::Relaxed);
         }
