@@ -27,9 +27,9 @@
 //! of the pairs and the percentiles by nearest rank, as [`super::bootstrap`].
 
 use super::bootstrap::CI_RESAMPLES;
+use super::interval::wilson_interval_at;
 use super::quantile::{Interpolation, quantile_sorted};
 use rand::{Rng, RngExt};
-use statrs::distribution::{ContinuousCDF, Normal};
 use statrs::function::factorial::ln_binomial;
 use statrs::function::gamma::gamma_ur;
 use std::f64::consts::LN_2;
@@ -126,7 +126,7 @@ pub fn compare_settling(
         b_sooner,
         ties: n - a_sooner - b_sooner,
         a_sooner_share: a_sooner as f64 / n as f64,
-        a_sooner_share_interval: wilson(a_sooner, n, level),
+        a_sooner_share_interval: wilson_interval_at(a_sooner, n, level),
         sign_test_p: sign_test_p_value(a_sooner, a_sooner + b_sooner),
         median_difference: median_in_place(&mut differences.clone()),
         median_difference_interval,
@@ -291,18 +291,6 @@ pub fn median_ratio(
 
 fn check_level(level: f64) {
     assert!(0.0 < level && level < 1.0, "level {level} outside (0, 1)");
-}
-
-/// Wilson score interval of `successes / trials` at `level`; the same formula
-/// as [`super::interval::wilson_interval`], which is fixed at 95 %.
-fn wilson(successes: u64, trials: u64, level: f64) -> (f64, f64) {
-    let z = Normal::standard().inverse_cdf(0.5 + level / 2.0);
-    let n = trials as f64;
-    let p = successes as f64 / n;
-    let z2 = z * z;
-    let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
-    let half = z * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / (1.0 + z2 / n);
-    ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
 /// The median exactly as [`super::quantile::median`] computes it (the mean of
@@ -504,7 +492,7 @@ mod tests {
     #[test]
     fn helpers_agree_with_the_house_functions() {
         for (k, n) in [(0, 20), (7, 20), (20, 20), (480, 1000)] {
-            let ((lo, hi), (lo95, hi95)) = (wilson(k, n, 0.95), wilson_interval(k, n));
+            let ((lo, hi), (lo95, hi95)) = (wilson_interval_at(k, n, 0.95), wilson_interval(k, n));
             let close = |x: f64, y: f64| (x - y).abs() < 1e-12;
             assert!(close(lo, lo95) && close(hi, hi95), "{k}/{n}");
         }

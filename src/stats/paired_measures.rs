@@ -118,7 +118,7 @@ fn quantile_in_place(values: &mut [f64], q: f64) -> f64 {
         return x_lo;
     }
     let x_hi = rest.iter().copied().fold(f64::INFINITY, f64::min);
-    x_lo + (h - lo as f64) * (x_hi - x_lo)
+    super::quantile::linear_between(x_lo, x_hi, h - lo as f64)
 }
 
 /// The q-quantile of a and of b and a percentile bootstrap of their

@@ -45,12 +45,23 @@ pub fn quantile_sorted(sorted: &[f64], q: f64, method: Interpolation) -> Option<
     }
     let upper = sorted[i + 1];
     Some(match method {
-        Interpolation::Linear if lower == upper => lower,
-        Interpolation::Linear => frac * (upper - lower) + lower,
+        Interpolation::Linear => linear_between(lower, upper, frac),
         Interpolation::Midpoint => 0.5 * (lower + upper),
         Interpolation::Higher => upper,
         Interpolation::Nearest => sorted[h.round() as usize],
     })
+}
+
+/// The linear interpolation between two neighbouring order statistics,
+/// frac of the way from `lower` to `upper`; `lower` itself when they are
+/// equal (so that two +∞ give +∞, not NaN). Every linear quantile here is
+/// this one formula.
+pub fn linear_between(lower: f64, upper: f64, frac: f64) -> f64 {
+    if lower == upper {
+        lower
+    } else {
+        frac * (upper - lower) + lower
+    }
 }
 
 /// Quantile `q` of unsorted values (a sorted copy, NaNs ordered by `f64::total_cmp`).
@@ -68,6 +79,17 @@ pub fn median(values: &[f64]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Between two runs that never settled (+∞) the quantile is +∞, not NaN.
+    #[test]
+    fn linear_between_infinities_is_infinite() {
+        assert_eq!(
+            linear_between(f64::INFINITY, f64::INFINITY, 0.5),
+            f64::INFINITY
+        );
+        assert_eq!(linear_between(1.0, f64::INFINITY, 0.5), f64::INFINITY);
+        assert_eq!(linear_between(1.0, 3.0, 0.25), 1.5);
+    }
     use Interpolation::*;
 
     /// The array of numpy's `percentile` documentation, `[[10, 7, 4], [3, 2, 1]]`

@@ -350,17 +350,7 @@ fn uncapped_times(runs: &DesignRuns) -> Vec<f64> {
 /// The q-quantile by linear interpolation (polars's rule); +∞ values are
 /// allowed and give +∞ when the quantile falls among them.
 fn quantile(values: &[f64], q: f64) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let h = q * (v.len() - 1) as f64;
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    if v[lo] == v[hi] {
-        return Some(v[lo]);
-    }
-    Some(v[lo] + (h - lo as f64) * (v[hi] - v[lo]))
+    crate::stats::quantile::quantile(values, q, crate::stats::quantile::Interpolation::Linear)
 }
 
 impl TryFrom<String> for Criterion {

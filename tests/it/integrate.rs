@@ -6,28 +6,12 @@
 
 use std::cell::Cell;
 
+use crate::ode_problems::*;
+
 use autobal::integrate::{
     DenseOutput, Failure, Flow, Method, NoObserver, OdeSystem, SolveReport, SolverOptions, Stats,
     Status, Step, StepObserver, solve,
 };
-
-/// y'' = −y as a first-order system; exact solution (cos t, −sin t).
-struct Oscillator;
-
-impl OdeSystem for Oscillator {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
-        dydt[0] = y[1];
-        dydt[1] = -y[0];
-    }
-}
-
-fn oscillator_exact(t: f64, y: &mut [f64]) {
-    y[0] = t.cos();
-    y[1] = -t.sin();
-}
 
 /// The oscillator with its analytic Jacobian.
 struct OscillatorWithJacobian;
@@ -45,23 +29,6 @@ impl OdeSystem for OscillatorWithJacobian {
     }
 }
 
-/// y' = cos(t)·y, y(0) = 1: time-dependent, exact solution exp(sin t). A stage
-/// evaluated at the wrong time shows up here and not on autonomous problems.
-struct Forced;
-
-impl OdeSystem for Forced {
-    fn dim(&self) -> usize {
-        1
-    }
-    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
-        dydt[0] = t.cos() * y[0];
-    }
-}
-
-fn forced_exact(t: f64, y: &mut [f64]) {
-    y[0] = t.sin().exp();
-}
-
 /// y' = y², y(0) = 1: blows up at t = 1.
 struct BlowUp;
 
@@ -74,64 +41,9 @@ impl OdeSystem for BlowUp {
     }
 }
 
-/// x'' + c·x' + x = 0: a heavily over-damped mode, eigenvalues ≈ −1/c (slow)
-/// and ≈ −c (fast), like a balancer in a very viscous fluid.
-struct OverDamped(f64);
-
-impl OdeSystem for OverDamped {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
-        dydt[0] = y[1];
-        dydt[1] = -y[0] - self.0 * y[1];
-    }
-}
-
-impl OverDamped {
-    /// Exact solution from x(0) = 1, x'(0) = 0.
-    fn exact(&self, t: f64, y: &mut [f64]) {
-        let c = self.0;
-        let root = (c * c - 4.0).sqrt();
-        let (slow, fast) = (-2.0 / (c + root), -(c + root) / 2.0);
-        let (a, b) = (fast / (fast - slow), -slow / (fast - slow));
-        y[0] = a * (slow * t).exp() + b * (fast * t).exp();
-        y[1] = a * slow * (slow * t).exp() + b * fast * (fast * t).exp();
-    }
-}
-
-/// The over-damped mode with c = 1000 used in the tables.
-const OVER_DAMPED: OverDamped = OverDamped(1000.0);
-
-fn over_damped_exact(t: f64, y: &mut [f64]) {
-    OVER_DAMPED.exact(t, y);
-}
-
-/// Robertson's chemical kinetics: the classic stiff test problem.
-struct Robertson;
-
-impl OdeSystem for Robertson {
-    fn dim(&self) -> usize {
-        3
-    }
-    fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
-        dydt[0] = -0.04 * y[0] + 1e4 * y[1] * y[2];
-        dydt[2] = 3e7 * y[1] * y[1];
-        dydt[1] = -dydt[0] - dydt[2];
-    }
-}
-
 /// Robertson at t = 40 as published (Hairer & Wanner, Solving ODEs II,
 /// section IV.10), to 10 digits.
 const ROBERTSON_40: [f64; 3] = [0.715_827_068_7, 0.918_553_476_4e-5, 0.284_163_745_7];
-
-/// The same to 13 digits: Radau5 and DOP853 at rtol = 1e-13 agree on these
-/// (and with the published digits); used where 10 digits are too few.
-const ROBERTSON_40_TIGHT: [f64; 3] = [
-    0.715_827_068_719_4,
-    9.185_534_764_56e-6,
-    0.284_163_745_745_8,
-];
 
 fn options(rtol: f64, atol: f64) -> SolverOptions {
     SolverOptions {
@@ -166,67 +78,6 @@ fn run<S: OdeSystem + ?Sized>(
     report
 }
 
-/// A reference problem for the work-precision table.
-struct Problem {
-    name: &'static str,
-    system: &'static dyn OdeSystem,
-    y0: &'static [f64],
-    t_end: f64,
-    /// Absolute tolerance per component as a multiple of rtol.
-    atol_scale: &'static [f64],
-    /// The solution at t_end.
-    reference: fn() -> Vec<f64>,
-    /// Errors are relative to max(|y_ref|, this).
-    error_floor: f64,
-}
-
-fn exact(f: fn(f64, &mut [f64]), n: usize, t: f64) -> Vec<f64> {
-    let mut y = vec![0.0; n];
-    f(t, &mut y);
-    y
-}
-
-fn problems() -> [Problem; 4] {
-    [
-        Problem {
-            name: "oscillator, t ≤ 20",
-            system: &Oscillator,
-            y0: &[1.0, 0.0],
-            t_end: 20.0,
-            atol_scale: &[1.0],
-            reference: || exact(oscillator_exact, 2, 20.0),
-            error_floor: 1.0,
-        },
-        Problem {
-            name: "y' = cos(t)·y, t ≤ 10",
-            system: &Forced,
-            y0: &[1.0],
-            t_end: 10.0,
-            atol_scale: &[1.0],
-            reference: || exact(forced_exact, 1, 10.0),
-            error_floor: 1.0,
-        },
-        Problem {
-            name: "over-damped c = 1000, t ≤ 1000",
-            system: &OVER_DAMPED,
-            y0: &[1.0, 0.0],
-            t_end: 1000.0,
-            atol_scale: &[1e-2],
-            reference: || exact(over_damped_exact, 2, 1000.0),
-            error_floor: 1.0,
-        },
-        Problem {
-            name: "Robertson, t ≤ 40",
-            system: &Robertson,
-            y0: &[1.0, 0.0, 0.0],
-            t_end: 40.0,
-            atol_scale: &[1e-2, 1e-6, 1e-2],
-            reference: || ROBERTSON_40_TIGHT.to_vec(),
-            error_floor: 0.0,
-        },
-    ]
-}
-
 /// Largest component error of `y` against `exact` at t.
 fn error_at(exact: fn(f64, &mut [f64]), t: f64, y: &[f64]) -> f64 {
     let mut want = vec![0.0; y.len()];
@@ -234,14 +85,6 @@ fn error_at(exact: fn(f64, &mut [f64]), t: f64, y: &[f64]) -> f64 {
     y.iter()
         .zip(&want)
         .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max)
-}
-
-/// Largest |y_i − ref_i| / max(|ref_i|, floor) over the components.
-fn max_rel_error(y: &[f64], reference: &[f64], floor: f64) -> f64 {
-    y.iter()
-        .zip(reference)
-        .map(|(a, b)| (a - b).abs() / b.abs().max(floor))
         .fold(0.0, f64::max)
 }
 
@@ -972,40 +815,6 @@ fn malformed_problems_fail_cleanly() {
         report.status,
         Status::Failed(autobal::integrate::Failure::TooManySteps { .. })
     ));
-}
-
-/// Prints the work-precision table of `docs/integrators.md`:
-/// `cargo test --test it work_precision_table -- --ignored --nocapture`.
-#[test]
-#[ignore = "prints the table for docs/integrators.md"]
-fn work_precision_table() {
-    for p in problems() {
-        println!("\n{}\n", p.name);
-        println!("| method | rtol | steps | rejected | RHS calls | Jacobians | LUs | error |");
-        println!("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-        let reference = (p.reference)();
-        for &m in Method::ALL {
-            for tol in [1e-4, 1e-6, 1e-8, 1e-10] {
-                let o = SolverOptions {
-                    rtol: tol,
-                    atol: p.atol_scale.iter().map(|s| s * tol).collect(),
-                    ..SolverOptions::default()
-                };
-                let r = run(m, p.system, p.y0, p.t_end, &o);
-                let err = max_rel_error(&r.y, &reference, p.error_floor);
-                let s = r.stats;
-                println!(
-                    "| {} | {tol:.0e} | {} | {} | {} | {} | {} | {err:.1e} |",
-                    m.name(),
-                    s.steps,
-                    s.rejected,
-                    s.rhs_calls,
-                    s.jacobians,
-                    s.factorizations
-                );
-            }
-        }
-    }
 }
 
 #[allow(dead_code)]
