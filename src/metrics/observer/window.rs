@@ -1,0 +1,105 @@
+//! The hold window: r² of its latest samples (for the residual, an RMS)
+//! and the "holds continuously" rule that decides settling.
+
+/// r² of the last hold window's samples, for the residual (an RMS).
+#[derive(Debug, Clone)]
+pub(super) struct SquareRing {
+    values: Vec<f64>,
+    pos: usize,
+    filled: usize,
+}
+
+impl SquareRing {
+    pub(super) fn new(len: usize) -> Self {
+        SquareRing {
+            values: vec![0.0; len],
+            pos: 0,
+            filled: 0,
+        }
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    pub(super) fn push(&mut self, r2: f64) {
+        self.values[self.pos] = r2;
+        // A compare, not `%`: an integer division per sample is measurable.
+        self.pos += 1;
+        if self.pos == self.values.len() {
+            self.pos = 0;
+        }
+        self.filled = (self.filled + 1).min(self.values.len());
+    }
+
+    /// Σ of the `count` most recent values (all there are, if fewer).
+    pub(super) fn latest_sum(&self, count: usize) -> f64 {
+        let (older, newer) = self.latest(count);
+        older.iter().chain(newer).sum()
+    }
+
+    /// The `count` most recent values (all there are, if fewer), as the
+    /// older and the newer part of the storage.
+    pub(super) fn latest(&self, count: usize) -> (&[f64], &[f64]) {
+        let count = count.min(self.filled);
+        let newer = &self.values[self.pos.saturating_sub(count)..self.pos];
+        let older_len = count - newer.len();
+        let older = &self.values[self.values.len() - older_len..];
+        (older, newer)
+    }
+
+    /// The largest of the `count` most recent values (0 when empty).
+    pub(super) fn latest_max(&self, count: usize) -> f64 {
+        let (older, newer) = self.latest(count);
+        older.iter().chain(newer).fold(0.0, |m, &v| f64::max(m, v))
+    }
+
+    /// sqrt of the mean, 0 when empty; sums in storage order, as always.
+    pub(super) fn rms(&self) -> f64 {
+        if self.filled == 0 {
+            return 0.0;
+        }
+        let sum: f64 = if self.filled == self.values.len() {
+            self.values.iter().sum()
+        } else {
+            self.values[..self.filled].iter().sum()
+        };
+        (sum / self.filled as f64).sqrt()
+    }
+}
+
+/// x ≤ limit, false for NaN: a prediction that is not a number bounds nothing.
+pub(super) fn inside(x: f64, limit: f64) -> bool {
+    x <= limit
+}
+
+/// Tracks one "holds continuously" rule (r ≤ band or ε ≤ band).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Hold {
+    pub(super) stretch_start: Option<f64>,
+    pub(super) met_at: Option<f64>,
+}
+
+impl Hold {
+    pub(super) fn update(&mut self, t: f64, inside: bool, window: f64) {
+        if self.met_at.is_some() {
+            return;
+        }
+        if inside {
+            let start = *self.stretch_start.get_or_insert(t);
+            if t - start >= window {
+                self.met_at = Some(start);
+            }
+        } else {
+            self.stretch_start = None;
+        }
+    }
+
+    /// t_s under the rule "for W revolutions or until the end", and whether the full window held.
+    pub(super) fn settling_time(&self) -> (Option<f64>, bool) {
+        match self.met_at {
+            Some(t) => (Some(t), true),
+            None => (self.stretch_start, false),
+        }
+    }
+}
