@@ -2,10 +2,10 @@
 //! detects settling, watches for divergence, and optionally records a series.
 //!
 //! Its concerns live in files of their own, each an `impl` of the observer
-//! or the types it holds: [`window`] (the hold window and its rule),
-//! [`twins`] (identical weights that meet), [`repeats`] (the never-settles
-//! watch), [`tail`] (the certified tail on the tracked flow), [`series`]
-//! (the recorded history) and [`finish`] (metrics and outcome at the end).
+//! or the types it holds: `window` (the hold window and its rule),
+//! `twins` (identical weights that meet), `repeats` (the never-settles
+//! watch), `tail` (the certified tail on the tracked flow), `series`
+//! (the recorded history) and `finish` (metrics and outcome at the end).
 //! This file keeps the state, the sampling and the divergence test.
 
 use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, Tracked, residual_share};
