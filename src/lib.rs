@@ -34,6 +34,7 @@ pub mod claims;
 pub mod design;
 pub mod input_file;
 pub mod integrate;
+pub mod invalid_key;
 pub mod metrics;
 pub mod model;
 pub mod number_text;

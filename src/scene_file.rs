@@ -154,16 +154,26 @@ impl SceneFile {
                 reason,
             }));
         }
-        if let Err((field, value, reason)) = self.metrics.validate() {
+        if let Err(crate::invalid_key::InvalidKey {
+            key: field,
+            value,
+            reason,
+        }) = self.metrics.validate()
+        {
             return Err(invalid(SceneError::Invalid {
-                field: field.into(),
+                field,
                 value,
                 reason,
             }));
         }
-        if let Err((field, value, reason)) = self.solver.validate() {
+        if let Err(crate::invalid_key::InvalidKey {
+            key: field,
+            value,
+            reason,
+        }) = self.solver.validate()
+        {
             return Err(invalid(SceneError::Invalid {
-                field: field.into(),
+                field,
                 value,
                 reason,
             }));

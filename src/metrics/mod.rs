@@ -30,6 +30,7 @@
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
 //! the ramp's final speed or the motor's synchronous speed).
 
+use crate::invalid_key::InvalidKey;
 pub mod balance_angle;
 pub mod bearing_orbit;
 pub mod certify;
@@ -395,9 +396,13 @@ pub const MAX_WINDOW_SAMPLES: f64 = 1e7;
 
 impl MetricOptions {
     /// Check each definition's parameter; on failure the key, the value and the rule.
-    pub fn validate(&self) -> Result<(), (&'static str, String, String)> {
+    pub fn validate(&self) -> Result<(), InvalidKey> {
         let fail = |key, value: f64, rule: &str| {
-            Err((key, crate::model::validate::shown(value), rule.to_string()))
+            Err(InvalidKey::new(
+                key,
+                crate::model::validate::shown(value),
+                rule.to_string(),
+            ))
         };
         if !(self.delta > 0.0 && self.delta < 1.0) {
             return fail(

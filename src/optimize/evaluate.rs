@@ -118,7 +118,7 @@ impl Evaluator<'_> {
             self.plan
                 .file
                 .resolve_design(u32::MAX, s)
-                .map_err(|(key, value, reason)| format!("{key} = {value}: {reason}"))
+                .map_err(|e| e.to_string())
         };
         let mut design = resolve(spec(c.kind, c.n, c.rho, 0))?;
         if let Some(p) = c.plane1 {

@@ -2,6 +2,7 @@
 //! budget) and how the dimensionless tolerance maps onto the state.
 
 use crate::integrate::Method;
+use crate::invalid_key::InvalidKey;
 use crate::model::system::RotorSystem;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -100,10 +101,10 @@ impl SolverSettings {
     }
 
     /// Check the tolerances and budget; on failure the key, the value and the rule.
-    pub fn validate(&self) -> Result<(), (&'static str, String, String)> {
+    pub fn validate(&self) -> Result<(), InvalidKey> {
         let (lo, hi) = RTOL_RANGE;
         if !(lo..=hi).contains(&self.rtol) {
-            return Err((
+            return Err(InvalidKey::new(
                 "solver.rtol",
                 self.rtol.to_string(),
                 format!("must lie in [{lo:e}, {hi:e}]"),
@@ -113,7 +114,7 @@ impl SolverSettings {
         if let Some(atol) = self.atol
             && !(lo..=hi).contains(&atol)
         {
-            return Err((
+            return Err(InvalidKey::new(
                 "solver.atol",
                 atol.to_string(),
                 format!(
@@ -122,13 +123,13 @@ impl SolverSettings {
             ));
         }
         if self.max_steps == 0 {
-            return Err(("solver.max_steps", "0".into(), "must be positive".into()));
+            return Err(InvalidKey::new("solver.max_steps", "0", "must be positive"));
         }
         if !(self.max_wall_seconds.is_finite() && self.max_wall_seconds > 0.0) {
-            return Err((
+            return Err(InvalidKey::new(
                 "solver.max_wall_seconds",
                 self.max_wall_seconds.to_string(),
-                "must be a positive number of seconds".into(),
+                "must be a positive number of seconds",
             ));
         }
         Ok(())

@@ -9,6 +9,7 @@
 pub use super::design::{Design, MAX_WEIGHTS, OneOrMany};
 pub use super::distribution::{DirectionSpec, Distribution, InitialSpec, Scale, UnbalanceSpec};
 use crate::design::geometry::check_fits;
+use crate::invalid_key::InvalidKey;
 use crate::metrics::MetricOptions;
 use crate::model::balancer::Kind;
 use crate::model::effect::Effects;
@@ -359,6 +360,12 @@ impl StudyFile {
             value,
             reason: reason.to_string(),
         };
+        let refused = |e: InvalidKey| StudyError::Invalid {
+            path: path.to_string(),
+            key: e.key,
+            value: e.value,
+            reason: e.reason,
+        };
         let name = match &self.name {
             Some(n) => n.clone(),
             None => std::path::Path::new(path)
@@ -435,15 +442,24 @@ impl StudyFile {
                 }
             }
         }
-        super::distribution::check(&s.unbalance.distribution)
-            .map_err(|(k, v, r)| invalid(&format!("sampling.unbalance.{k}"), v, r))?;
+        super::distribution::check(&s.unbalance.distribution).map_err(|e| {
+            refused(InvalidKey::new(
+                format!("sampling.unbalance.{}", e.key),
+                e.value,
+                e.reason,
+            ))
+        })?;
         if let Some(couple) = &s.couple {
             super::couple::validate(couple, &self.scene.rotor, |u| {
-                super::distribution::check(&u.distribution).map_err(|(k, v, r)| {
-                    (format!("sampling.couple.unbalance.{k}"), v, r.to_string())
+                super::distribution::check(&u.distribution).map_err(|e| {
+                    InvalidKey::new(
+                        format!("sampling.couple.unbalance.{}", e.key),
+                        e.value,
+                        e.reason,
+                    )
                 })
             })
-            .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+            .map_err(refused)?;
         }
         if let DirectionSpec::Fixed(d) = s.direction
             && !d.is_finite()
@@ -463,12 +479,8 @@ impl StudyFile {
                 "must be finite",
             ));
         }
-        if let Err((key, value, reason)) = self.metrics.validate() {
-            return Err(invalid(key, value, &reason));
-        }
-        if let Err((key, value, reason)) = self.solver.validate() {
-            return Err(invalid(key, value, &reason));
-        }
+        self.metrics.validate().map_err(refused)?;
+        self.solver.validate().map_err(refused)?;
         if let Err(crate::model::validate::SceneError::Invalid {
             field,
             value,
@@ -496,7 +508,13 @@ impl StudyFile {
             &self.designs.per_plane,
             self.scene.rotor.as_rotor().planes(),
         )
-        .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+        .map_err(
+            |InvalidKey {
+                 key: k,
+                 value: v,
+                 reason: r,
+             }| invalid(&k, v, &r),
+        )?;
         let planes = self.scene.rotor.as_rotor().planes();
         if !self.designs.per_plane.is_empty() && self.optimize.is_some() && planes != 2 {
             // The optimiser searches plane 0's and plane 1's radius ratios.
@@ -541,16 +559,25 @@ impl StudyFile {
                 ),
             ));
         }
-        let designs = self
-            .resolve_designs()
-            .map_err(|(k, v, r)| invalid(&k, v, &r))?;
+        let designs = self.resolve_designs().map_err(
+            |InvalidKey {
+                 key: k,
+                 value: v,
+                 reason: r,
+             }| invalid(&k, v, &r),
+        )?;
         if let Some(t) = &s.tolerances {
             let facts = crate::model::effect::SceneFacts {
                 planes: self.scene.rotor.as_rotor().planes(),
                 prescribed_speed: self.scene.speed.is_prescribed(),
             };
-            super::tolerance::validate(t, &designs, &facts)
-                .map_err(|(k, v, r)| invalid(&format!("sampling.tolerances.{k}"), v, &r))?;
+            super::tolerance::validate(t, &designs, &facts).map_err(
+                |InvalidKey {
+                     key: k,
+                     value: v,
+                     reason: r,
+                 }| invalid(&format!("sampling.tolerances.{k}"), v, &r),
+            )?;
         }
         let demand = self.effects_capacity_demand();
         if demand > 0.0 && s.require_balanceable {
@@ -676,11 +703,7 @@ impl StudyFile {
     /// Validate one design of this study's scene and compute its mass and capacity.
     ///
     /// Errors are (key, value, reason) in the study file's terms.
-    pub fn resolve_design(
-        &self,
-        id: u32,
-        spec: DesignSpec,
-    ) -> Result<Design, (String, String, String)> {
+    pub fn resolve_design(&self, id: u32, spec: DesignSpec) -> Result<Design, InvalidKey> {
         let (kind, n) = (spec.kind, spec.n);
         let scene = Scene {
             rotor: self.scene.rotor.without_unbalance(),
@@ -692,14 +715,14 @@ impl StudyFile {
         };
         scene.validate().map_err(|e| scene_error_key(e, kind, n))?;
         let geometry = spec.geometry().map_err(|e| {
-            (
+            InvalidKey::new(
                 "designs.rho".to_string(),
                 format!("{:?}", spec.rho),
                 e.to_string(),
             )
         })?;
         check_fits(n, geometry.rho).map_err(|e| {
-            (
+            InvalidKey::new(
                 "designs.rho".to_string(),
                 geometry.rho.to_string(),
                 e.to_string(),
@@ -708,7 +731,7 @@ impl StudyFile {
         let cargo = kind
             .model()
             .cargo(&geometry)
-            .map_err(|e| ("designs".to_string(), kind.to_string(), e.to_string()))?;
+            .map_err(|e| InvalidKey::new("designs", kind.to_string(), e.to_string()))?;
         let capacity = match kind {
             Kind::Pendulum => f64::from(n) * cargo.unbalance(),
             _ => crate::design::capacity::capacity_from_mass(
@@ -717,7 +740,7 @@ impl StudyFile {
                 cargo.mass,
                 spec.race_radius,
             )
-            .map_err(|e| ("designs".to_string(), kind.to_string(), e.to_string()))?,
+            .map_err(|e| InvalidKey::new("designs", kind.to_string(), e.to_string()))?,
         };
         Ok(Design {
             id,
@@ -734,10 +757,10 @@ impl StudyFile {
 
     /// A balancer of plane 1, 2, … checked as plane 0's are, its errors named
     /// by its `[[designs.per_plane]]` entry.
-    fn resolve_plane_design(&self, spec: DesignSpec) -> Result<Design, (String, String, String)> {
+    fn resolve_plane_design(&self, spec: DesignSpec) -> Result<Design, InvalidKey> {
         let plane = spec.plane;
         self.resolve_design(0, spec)
-            .map_err(|(key, value, reason)| {
+            .map_err(|InvalidKey { key, value, reason }| {
                 let entry = self.designs.per_plane.iter().position(|a| a.plane == plane);
                 let key = match (entry, key.strip_prefix("designs.")) {
                     (Some(i), Some(rest)) if ["n", "rho", "kind", "drag"].contains(&rest) => {
@@ -745,11 +768,11 @@ impl StudyFile {
                     }
                     _ => key,
                 };
-                (key, value, format!("{reason} (plane {plane})"))
+                InvalidKey::new(key, value, format!("{reason} (plane {plane})"))
             })
     }
 
-    fn resolve_designs(&self) -> Result<Vec<Design>, (String, String, String)> {
+    fn resolve_designs(&self) -> Result<Vec<Design>, InvalidKey> {
         let g = &self.designs;
         let mut designs = Vec::new();
         let (kinds, ns, rhos, drags) = (
@@ -766,7 +789,7 @@ impl StudyFile {
             ("designs.drag", drags.is_empty()),
         ] {
             if empty {
-                return Err((key.into(), "[]".into(), "needs at least one value".into()));
+                return Err(InvalidKey::new(key, "[]", "needs at least one value"));
             }
         }
         for kind in &kinds {
@@ -823,27 +846,27 @@ impl StudyFile {
 impl StudyFile {
     /// The grid's stall torques: `[None]` when it sweeps none, else each
     /// value checked (positive, finite, a motor to apply it to).
-    fn stall_torques(&self) -> Result<Vec<Option<f64>>, (String, String, String)> {
+    fn stall_torques(&self) -> Result<Vec<Option<f64>>, InvalidKey> {
         let Some(list) = &self.designs.stall_torque else {
             return Ok(vec![None]);
         };
         let key = "designs.stall_torque".to_string();
         let values = list.values();
         if !matches!(self.scene.speed, SpeedLaw::Motor { .. }) {
-            return Err((
+            return Err(InvalidKey::new(
                 key,
                 format!("{values:?}"),
-                "a stall torque needs a motor: set scene.speed.mode = \"motor\"".into(),
+                "a stall torque needs a motor: set scene.speed.mode = \"motor\"",
             ));
         }
         if values.is_empty() {
-            return Err((key, "[]".into(), "needs at least one value".into()));
+            return Err(InvalidKey::new(key, "[]", "needs at least one value"));
         }
         if let Some(bad) = values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-            return Err((
+            return Err(InvalidKey::new(
                 key,
                 bad.to_string(),
-                "a stall torque (N·m) must be positive and finite".into(),
+                "a stall torque (N·m) must be positive and finite",
             ));
         }
         Ok(values.into_iter().map(Some).collect())
@@ -851,7 +874,7 @@ impl StudyFile {
 }
 
 /// Map a scene validation error onto the study file's keys.
-fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String) {
+fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> InvalidKey {
     match e {
         SceneError::Invalid {
             field,
@@ -863,7 +886,7 @@ fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String
             } else {
                 format!("scene.{field}")
             };
-            (key, value, reason)
+            InvalidKey::new(key, value, reason)
         }
         SceneError::Design(d) => {
             let key = match d.key() {
@@ -876,13 +899,13 @@ fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> (String, String, String
             match message.split_once(": ") {
                 Some((lhs, reason)) if lhs.contains(" = ") => {
                     let value = lhs.split_once(" = ").map_or(lhs, |(_, v)| v).to_string();
-                    (
+                    InvalidKey::new(
                         key,
                         value,
                         format!("{reason} (in the design {kind} n = {n})"),
                     )
                 }
-                _ => (key, format!("{kind} n = {n}"), message),
+                _ => InvalidKey::new(key, format!("{kind} n = {n}"), message),
             }
         }
     }

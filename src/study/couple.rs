@@ -20,6 +20,7 @@
 use super::design::Design;
 use super::distribution::{DirectionSpec, Scale, UnbalanceSpec, draw_value};
 use super::stream::{Purpose, stream};
+use crate::invalid_key::InvalidKey;
 use crate::model::rotor::RotorModel;
 use crate::model::rotor::two_support::PointUnbalance;
 use rand::RngExt;
@@ -65,77 +66,76 @@ pub struct SampledCouple {
 pub fn validate(
     spec: &CoupleSpec,
     rotor: &RotorModel,
-    check_distribution: impl Fn(&UnbalanceSpec) -> Result<(), (String, String, String)>,
-) -> Result<(), (String, String, String)> {
+    check_distribution: impl Fn(&UnbalanceSpec) -> Result<(), InvalidKey>,
+) -> Result<(), InvalidKey> {
     let planes = match rotor {
         RotorModel::TwoSupport(r) => Some(r.planes.len()),
         _ => None,
     };
     match (planes, spec.at) {
         (None, _) => {
-            return Err((
-                "sampling.couple".into(),
+            return Err(InvalidKey::new(
+                "sampling.couple",
                 format!("rotor.model = \"{}\"", rotor.as_rotor().name()),
-                "a couple unbalance needs a rotor on two supports (rotor.model = \"two_support\")"
-                    .into(),
+                "a couple unbalance needs a rotor on two supports (rotor.model = \"two_support\")",
             ));
         }
         (Some(n), None) if n != 2 => {
-            return Err((
-                "sampling.couple.at".into(),
-                "(missing)".into(),
+            return Err(InvalidKey::new(
+                "sampling.couple.at",
+                "(missing)",
                 format!(
                     "the rotor has {n} balancer plane(s): give the axial positions [z1, z2] (m) of the two planes the static and couple parts sit in"
                 ),
             ));
         }
         (_, Some([a, b])) if !(a.is_finite() && b.is_finite() && a != b) => {
-            return Err((
-                "sampling.couple.at".into(),
+            return Err(InvalidKey::new(
+                "sampling.couple.at",
                 format!("[{a}, {b}]"),
-                "two distinct finite axial positions (m)".into(),
+                "two distinct finite axial positions (m)",
             ));
         }
         _ => {}
     }
     match (&spec.unbalance, spec.follows_static) {
-        (Some(_), Some(c)) => Err((
-            "sampling.couple.follows_static".into(),
+        (Some(_), Some(c)) => Err(InvalidKey::new(
+            "sampling.couple.follows_static",
             c.to_string(),
-            "give either `unbalance` (drawn on its own) or `follows_static` (tied to the static part), not both".into(),
+            "give either `unbalance` (drawn on its own) or `follows_static` (tied to the static part), not both",
         )),
-        (None, None) => Err((
-            "sampling.couple".into(),
-            "{}".into(),
-            "give `unbalance` (a distribution with relative_to, drawn on its own) or `follows_static` (U_c = factor × U_s)".into(),
+        (None, None) => Err(InvalidKey::new(
+            "sampling.couple",
+            "{}",
+            "give `unbalance` (a distribution with relative_to, drawn on its own) or `follows_static` (U_c = factor × U_s)",
         )),
-        (None, Some(c)) if !c.is_finite() => Err((
-            "sampling.couple.follows_static".into(),
+        (None, Some(c)) if !c.is_finite() => Err(InvalidKey::new(
+            "sampling.couple.follows_static",
             c.to_string(),
-            "must be finite (−1 to 1 for a load between the planes)".into(),
+            "must be finite (−1 to 1 for a load between the planes)",
         )),
         (None, Some(_)) => match spec.phase {
             DirectionSpec::Uniform => Ok(()),
-            DirectionSpec::Fixed(d) => Err((
-                "sampling.couple.phase".into(),
+            DirectionSpec::Fixed(d) => Err(InvalidKey::new(
+                "sampling.couple.phase",
                 d.to_string(),
-                "a couple that follows the static part has its direction; leave phase out".into(),
+                "a couple that follows the static part has its direction; leave phase out",
             )),
         },
         (Some(u), None) => {
             if u.relative_to.is_none() {
-                return Err((
-                    "sampling.couple.unbalance.relative_to".into(),
-                    "(missing)".into(),
-                    "required: \"capacity\" (fractions of each plane's design capacity) or \"absolute\" (kg·m per plane)".into(),
+                return Err(InvalidKey::new(
+                    "sampling.couple.unbalance.relative_to",
+                    "(missing)",
+                    "required: \"capacity\" (fractions of each plane's design capacity) or \"absolute\" (kg·m per plane)",
                 ));
             }
             check_distribution(u)?;
             match spec.phase {
-                DirectionSpec::Fixed(d) if !d.is_finite() => Err((
-                    "sampling.couple.phase.fixed".into(),
+                DirectionSpec::Fixed(d) if !d.is_finite() => Err(InvalidKey::new(
+                    "sampling.couple.phase.fixed",
                     d.to_string(),
-                    "must be finite".into(),
+                    "must be finite",
                 )),
                 _ => Ok(()),
             }

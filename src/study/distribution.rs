@@ -7,6 +7,7 @@
 //! part, [`super::couple`]) and the draws of a run ([`super::sample`]) share
 //! them without importing the study file that holds them.
 
+use crate::invalid_key::InvalidKey;
 use crate::model::validate::shown;
 use rand::RngExt;
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -181,12 +182,16 @@ pub enum InitialSpec {
 }
 
 /// The domain of a distribution's keys: (key, value, reason) on failure.
-pub fn check(d: &Distribution) -> Result<(), (String, String, &'static str)> {
+pub fn check(d: &Distribution) -> Result<(), InvalidKey> {
     let pos = |k: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err((k.to_string(), shown(v), "must be positive and finite"))
+            Err(InvalidKey::new(
+                k.to_string(),
+                shown(v),
+                "must be positive and finite",
+            ))
         }
     };
     match *d {
@@ -195,7 +200,7 @@ pub fn check(d: &Distribution) -> Result<(), (String, String, &'static str)> {
             pos("min", min)?;
             pos("max", max)?;
             if max < min {
-                return Err(("max".into(), shown(max), "must not be below min"));
+                return Err(InvalidKey::new("max", shown(max), "must not be below min"));
             }
             Ok(())
         }
@@ -209,27 +214,27 @@ pub fn check(d: &Distribution) -> Result<(), (String, String, &'static str)> {
             pos("min", min)?;
             pos("max", max)?;
             if max <= min {
-                return Err((
-                    "max".into(),
+                return Err(InvalidKey::new(
+                    "max",
                     shown(max),
                     "must be above min (a single value is `distribution = \"fixed\"`)",
                 ));
             }
             if !mean.is_finite() {
-                return Err(("mean".into(), shown(mean), "must be finite"));
+                return Err(InvalidKey::new("mean", shown(mean), "must be finite"));
             }
             // Rejection sampling needs a reasonable acceptance rate.
             if (min - mean) / std > 5.0 || (mean - max) / std > 5.0 {
-                return Err((
-                    "mean".into(),
+                return Err(InvalidKey::new(
+                    "mean",
                     shown(mean),
                     "lies more than 5 std outside [min, max]",
                 ));
             }
             let mass = super::truncated::accepted_mass(mean, std, min, max);
             if mass < super::truncated::MIN_ACCEPTED_MASS {
-                return Err((
-                    "std".into(),
+                return Err(InvalidKey::new(
+                    "std",
                     shown(std),
                     "leaves less than 0.1 % of the normal inside [min, max]: each draw would need over 1 000 tries; narrow std or widen [min, max]",
                 ));

@@ -9,6 +9,7 @@
 //! columns of their own (`kind_plane0`, `n_plane1`, …).
 
 use super::design::{Design, MAX_WEIGHTS, OneOrMany};
+use crate::invalid_key::InvalidKey;
 use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
 use polars::prelude::*;
@@ -36,21 +37,21 @@ pub struct PlaneAxes {
 }
 
 /// A bad `[[designs.per_plane]]` entry: (key, value, reason).
-type Refusal = (String, String, String);
+type Refusal = InvalidKey;
 
 /// Check the entries against a rotor with `planes` balancer planes.
 pub fn validate(axes: &[PlaneAxes], planes: usize) -> Result<(), Refusal> {
     for (i, a) in axes.iter().enumerate() {
         let key = |k: &str| format!("designs.per_plane[{i}].{k}");
         if planes < 2 {
-            return Err((
-                "designs.per_plane".into(),
+            return Err(InvalidKey::new(
+                "designs.per_plane",
                 format!("plane {}", a.plane),
-                "the rotor has one balancer plane: a design per plane needs a rotor with several (rotor.model = \"two_support\" or \"flexible\")".into(),
+                "the rotor has one balancer plane: a design per plane needs a rotor with several (rotor.model = \"two_support\" or \"flexible\")",
             ));
         }
         if a.plane == 0 || a.plane >= planes {
-            return Err((
+            return Err(InvalidKey::new(
                 key("plane"),
                 a.plane.to_string(),
                 format!(
@@ -60,10 +61,10 @@ pub fn validate(axes: &[PlaneAxes], planes: usize) -> Result<(), Refusal> {
             ));
         }
         if axes[..i].iter().any(|b| b.plane == a.plane) {
-            return Err((
+            return Err(InvalidKey::new(
                 key("plane"),
                 a.plane.to_string(),
-                "this plane already has an entry".into(),
+                "this plane already has an entry",
             ));
         }
         let empty = [
@@ -79,13 +80,13 @@ pub fn validate(axes: &[PlaneAxes], planes: usize) -> Result<(), Refusal> {
             ),
         ];
         if let Some((k, _)) = empty.iter().find(|(_, e)| *e) {
-            return Err((key(k), "[]".into(), "needs at least one value".into()));
+            return Err(InvalidKey::new(key(k), "[]", "needs at least one value"));
         }
         if let Some(n) =
             a.n.as_ref()
                 .and_then(|v| v.values().into_iter().find(|&n| n > MAX_WEIGHTS))
         {
-            return Err((
+            return Err(InvalidKey::new(
                 key("n"),
                 n.to_string(),
                 format!("at most {} weights per balancer", MAX_WEIGHTS),

@@ -31,6 +31,7 @@
 
 use super::design::Design;
 use super::stream::{Purpose, stream};
+use crate::invalid_key::InvalidKey;
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
 use crate::model::effect::SceneFacts;
@@ -118,7 +119,7 @@ pub struct SampledWeights {
 }
 
 /// A bad tolerance: (key under `sampling.tolerances`, value, reason).
-pub type ToleranceError = (String, String, String);
+pub type ToleranceError = InvalidKey;
 
 /// Check the table against its domain and against every design (masses
 /// and radii stay positive, the largest weights still fit, every radius in
@@ -133,18 +134,17 @@ pub fn validate(
         let key = |k: &str| format!("eccentricity.{k}");
         check_spread("eccentricity", tol)?;
         if tol.relative {
-            return Err((
+            return Err(InvalidKey::new(
                 key("relative"),
-                "true".into(),
-                "an offset has no nominal size to be relative to: give sigma in m".into(),
+                "true",
+                "an offset has no nominal size to be relative to: give sigma in m",
             ));
         }
         if !facts.prescribed_speed {
-            return Err((
+            return Err(InvalidKey::new(
                 key("sigma"),
                 tol.sigma.to_string(),
-                "race eccentricity is modelled at a prescribed speed (constant or ramp) only"
-                    .into(),
+                "race eccentricity is modelled at a prescribed speed (constant or ramp) only",
             ));
         }
     }
@@ -154,7 +154,7 @@ pub fn validate(
         let key = |k: &str| format!("{name}.{k}");
         check_spread(name, tol)?;
         if tol.relative && tol.limit * tol.sigma >= 1.0 {
-            return Err((
+            return Err(InvalidKey::new(
                 key("sigma"),
                 tol.sigma.to_string(),
                 format!(
@@ -174,7 +174,7 @@ pub fn validate(
             };
             let reach = tol.reach(nominal);
             if reach >= nominal {
-                return Err((
+                return Err(InvalidKey::new(
                     key("sigma"),
                     tol.sigma.to_string(),
                     format!(
@@ -197,7 +197,7 @@ pub fn validate(
                             .map_err(|e| e.to_string())
                     });
                 if let Err(why) = fits {
-                    return Err((
+                    return Err(InvalidKey::new(
                         key("sigma"),
                         tol.sigma.to_string(),
                         format!(
@@ -221,17 +221,17 @@ pub fn validate(
 /// under the floor of `truncated::MIN_ACCEPTED_MASS`'s order).
 fn check_spread(name: &str, tol: &Tolerance) -> Result<(), ToleranceError> {
     if !(tol.sigma.is_finite() && tol.sigma >= 0.0) {
-        return Err((
+        return Err(InvalidKey::new(
             format!("{name}.sigma"),
             tol.sigma.to_string(),
-            "a standard deviation: finite and ≥ 0".into(),
+            "a standard deviation: finite and ≥ 0",
         ));
     }
     if !(tol.limit >= 0.01 && tol.limit <= 10.0) {
-        return Err((
+        return Err(InvalidKey::new(
             format!("{name}.limit"),
             tol.limit.to_string(),
-            "a truncation in standard deviations, in [0.01, 10] (narrower keeps too few draws to end)".into(),
+            "a truncation in standard deviations, in [0.01, 10] (narrower keeps too few draws to end)",
         ));
     }
     Ok(())
