@@ -1,0 +1,130 @@
+//! The notes under the ranking that read the summary's other columns:
+//! merged runs, the dead band of rolling resistance, contact between the
+//! weights, and a stall-torque sweep's passage through resonance.
+
+use super::*;
+
+/// Runs that ended `merged`: how many, of which designs, and the way out.
+pub(super) fn merged_line(sum: &Summary, order: &[usize]) -> Result<String, UserError> {
+    let Ok(column) = sum.0.column("merged") else {
+        return Ok(String::new());
+    };
+    let merged: Vec<u64> = column
+        .u64()?
+        .iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let ids = design_ids(sum)?;
+    let parts: Vec<String> = order
+        .iter()
+        .filter(|&&i| merged[i] > 0)
+        .map(|&i| format!("{} in design {}", merged[i], ids[i]))
+        .collect();
+    if parts.is_empty() {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "merged: {} runs ended when two identical weights coincided ({}), a state the equations never leave and real parts never reach: they count as not settled and their residuals are left out; give the weights their tolerances in [sampling.tolerances] (docs/model.md, \"Identical weights that meet\")\n",
+        merged.iter().sum::<u64>(),
+        parts.join(", ")
+    ))
+}
+
+/// With rolling resistance: the dead band μ_s·l beside the band δ·A_ref.
+pub(super) fn dead_band_line(sum: &Summary, order: &[usize]) -> Result<String, UserError> {
+    let dead = sum.f("dead_band_m")?;
+    if dead.iter().all(Option::is_none) {
+        return Ok(String::new());
+    }
+    let band = sum.f("settling_band_m")?;
+    let ids = design_ids(sum)?;
+    let parts: Vec<String> = order
+        .iter()
+        .map(|&i| {
+            format!(
+                "design {} {} µm vs {} µm",
+                ids[i],
+                num(dead[i].map(|d| d * 1e6), 2),
+                num(band[i].map(|b| b * 1e6), 2)
+            )
+        })
+        .collect();
+    Ok(format!(
+        "dead band μ_s·l (l the track radius) against the settling band δ·A_ref (median A_ref), in ranking order: {}\n",
+        parts.join(", ")
+    ))
+}
+
+/// Whether the weights were solid, said under every ranking: a study that
+/// switched contact off prints numbers for weights that pass through each other.
+pub(super) fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
+    let contact = summary.column("contact")?.bool()?;
+    let deepest = summary
+        .column("max_overlap_fraction")?
+        .f64()?
+        .iter()
+        .flatten()
+        .reduce(f64::max);
+    let closest = deepest.map_or(String::new(), |f| {
+        format!(
+            "; deepest overlap {:.2} % of the angle at which two weights touch (2α)",
+            100.0 * f
+        )
+    });
+    let off = contact.iter().filter(|c| *c == Some(false)).count();
+    Ok(if off == 0 {
+        format!("contact between the weights: on{closest}\n")
+    } else {
+        format!(
+            "contact between the weights: OFF in {} of {} designs (the study switched it off: weights may pass through each other){closest}\n",
+            off,
+            summary.height()
+        )
+    })
+}
+
+/// For a study that sweeps the motor's stall torque: per design, how many
+/// runs reached the operating speed and where the rest were held (the
+/// Sommerfeld effect, docs/realism.md); empty otherwise.
+pub(super) fn passage_table(summary: &DataFrame) -> Result<String, UserError> {
+    let Ok(torque) = summary.column("stall_torque") else {
+        return Ok(String::new());
+    };
+    let torque: Vec<Option<f64>> = torque.f64()?.iter().collect();
+    if torque.iter().all(Option::is_none) {
+        return Ok(String::new());
+    }
+    let sum = Summary(summary);
+    let kind = sum.s("kind")?;
+    let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
+    let runs = sum.u("runs")?;
+    let reached = sum.u("reached_operating_speed")?;
+    let t_op = sum.f("operating_time_s_median")?;
+    let spin = sum.f("final_spin_rate_median")?;
+    let ids = design_ids(&sum)?;
+    let rows: Vec<Vec<String>> = (0..summary.height())
+        .map(|i| {
+            vec![
+                ids[i].to_string(),
+                kind[i].clone().unwrap_or_else(|| "–".into()),
+                n[i].map_or("–".into(), |v| v.to_string()),
+                num(torque[i], 3),
+                format!("{}/{}", reached[i], runs[i]),
+                num(t_op[i], 2),
+                num(spin[i], 1),
+            ]
+        })
+        .collect();
+    Ok(text_table(
+        &[
+            "design",
+            "kind",
+            "n",
+            "M_s (N·m)",
+            "reached operating speed",
+            "after (s, median)",
+            "final φ̇ median (rad/s)",
+        ],
+        &rows,
+    ) + "(passage through resonance: a run that never reached |φ̇ − ω_sync| ≤ δ ω_sync was held below it for the whole run)\n")
+}
