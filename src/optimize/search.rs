@@ -1,6 +1,11 @@
 //! The continuous searches (argmin): Brent over ρ for each kind and n, with a
 //! noise-aware stop, or Nelder–Mead over (ρ, ln β). The integer n is enumerated
 //! by the caller.
+//!
+//! About 640 lines of code: the scan that brackets ρ, the Brent pass, its
+//! noise-aware stop and the neighbour check, and the simplex's restarts share
+//! one evaluation budget and one record of the evaluations, so they are one
+//! file rather than parts passing that state around.
 
 use super::evaluate::{Candidate, Evaluation, Evaluator};
 use super::noisy_simplex::{self, SimplexStop, Vertex};

@@ -1,6 +1,9 @@
 //! Censoring-aware settling statistics: each run either settles at `time` or is right-censored
 //! there (still unsettled when the simulation stopped).
 //!
+//! Over 600 lines with its unit tests (the code is under 400): each
+//! estimator is checked here against published values.
+//!
 //! Estimators and references:
 //! - Kaplan–Meier product-limit estimate of S(t) = P(not yet settled at t) (Kaplan & Meier
 //!   1958, JASA 53:457–481) with Greenwood's (1926) variance.

@@ -2,6 +2,11 @@
 //! that count every run (unsettled ones as censored), paired when the
 //! designs met the same sampled unbalances (common random numbers), and the
 //! best design against every other with Holm's correction.
+//!
+//! Over 600 lines with its unit tests (the code is about 550): the rules a
+//! verdict rests on (what balances, what works, a material effect, which
+//! measure favours which design, a winner on the edge of a sweep) are kept
+//! together so that one reading gives them all.
 
 use super::criterion::{Criterion, sign_difference};
 pub use super::design_runs::{SettlingClock, design_runs, measure_scale, settling_horizon};

@@ -1,0 +1,113 @@
+//! One run assembled from a plan: its draws, its scene and simulation, and
+//! the record it leaves (also for designs outside the grid, as the
+//! optimiser's candidates are).
+
+use super::*;
+
+/// Execute one run of the plan. Never panics: a failed run is a row with a reason.
+pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
+    let samples = u64::from(plan.file.sampling.samples);
+    let design = &plan.designs[(run_id / samples) as usize];
+    run_design_sample(plan, design, run_id % samples, run_id)
+}
+
+/// Sample `sample_id` of `design` and the simulation a study runs for it
+/// (the plan's start, solver and metric settings); the one place a run's
+/// inputs are assembled.
+pub fn sample_simulation(
+    plan: &StudyPlan,
+    design: &Design,
+    sample_id: u64,
+) -> (Sample, Simulation) {
+    let mut sample = draw_sample(plan, design, sample_id);
+    let mut scene = plan.scene(design, sample.unbalance, sample.direction);
+    // Without designs of their own, the design sits in every balancer plane,
+    // and so do its start angles (the sampled unbalance is placed in every
+    // plane at one direction too).
+    let planes = plan.file.scene.rotor.as_rotor().planes().max(1);
+    if planes > 1 && design.plane_designs.is_empty() {
+        sample.initial_angles = sample.initial_angles.repeat(planes);
+    }
+    if let Some(couple) = &sample.couple {
+        let planes =
+            super::super::couple::plane_unbalances((sample.unbalance, sample.direction), couple);
+        let at = plan.file.sampling.couple.as_ref().and_then(|c| c.at);
+        super::super::couple::apply(&mut scene.rotor, at, &planes);
+    }
+    sample.weights = draw_weights(plan, design, sample_id, &mut scene);
+    let simulation = Simulation {
+        scene,
+        start: plan.file.scene.start,
+        initial_angles: sample.initial_angles.clone(),
+        solver: plan.file.solver.clone(),
+        metrics: plan.file.metrics.clone(),
+    };
+    (sample, simulation)
+}
+
+/// Execute sample `sample_id` of any design (also one outside the plan's grid,
+/// as the optimiser's candidates are), recorded under `run_id`.
+pub fn run_design_sample(
+    plan: &StudyPlan,
+    design: &Design,
+    sample_id: u64,
+    run_id: u64,
+) -> RunRecord {
+    let (sample, simulation) = sample_simulation(plan, design, sample_id);
+    let contact = simulation
+        .scene
+        .effects
+        .contact
+        .as_ref()
+        .is_some_and(|c| c.enabled);
+    let clock = Instant::now();
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| simulation.run(false)));
+    let metrics = match result {
+        Ok(Ok(r)) => r.metrics,
+        Ok(Err(e)) => failed(format!("invalid scene: {e}")),
+        Err(panic) => {
+            let why = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            failed(format!("internal error: {why}"))
+        }
+    };
+    RunRecord {
+        run_id,
+        design_id: design.id,
+        sample_id: sample_id as u32,
+        kind: design.spec.kind.name().to_string(),
+        n: design.spec.n,
+        rho: design.rho,
+        race_radius: design.spec.race_radius,
+        weight_mass: design.weight_mass,
+        capacity: design.capacity,
+        drag: design.spec.drag,
+        unbalance: sample.unbalance,
+        unbalance_fraction: sample.fraction,
+        direction_deg: sample.direction.to_degrees(),
+        initial_angles_deg: sample
+            .initial_angles
+            .iter()
+            .map(|a| a.to_degrees())
+            .collect(),
+        method: if metrics.method.is_empty() {
+            plan.file.solver.method.name().to_string()
+        } else {
+            metrics.method.clone()
+        },
+        metrics,
+        contact,
+        stall_torque: design.stall_torque,
+        wall_time_s: clock.elapsed().as_secs_f64(),
+        weights: sample.weights,
+        couple: sample.couple,
+    }
+}
+
+/// Metrics of a run that could not be simulated at all.
+fn failed(reason: String) -> RunMetrics {
+    RunMetrics::not_integrated(0.0, Outcome::SolverFailed, reason, "")
+}
