@@ -19,6 +19,7 @@
 //! m R² terms of eqs 22–23 (their motion with the tilting disc, about
 //! m R²/J = 4 m/M of the tilt inertia) are added by `weights_tilt_inertia`.
 
+use super::centre_unbalance::{CentreUnbalance, planar_size};
 use super::{DofVec, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, finite, non_negative, positive};
 use schemars::JsonSchema;
@@ -151,29 +152,25 @@ impl Rotor for FlexibleShaft {
     }
 
     fn spin_coupling(&self, phi: f64, q: &[f64]) -> DofVec {
-        let me = self.mass * self.eccentricity;
-        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
+        let [u, v] = self.centre().coupling(phi);
         let half = 0.5 * self.polar_inertia;
-        [-me * s, me * c, half * q[3], -half * q[2]]
+        [u, v, half * q[3], -half * q[2]]
     }
 
     fn unbalance_forces(&self, phi: f64, spin_rate: f64, f: &mut DofVec) {
-        let me = self.mass * self.eccentricity * spin_rate * spin_rate;
-        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
-        f[0] += me * c;
-        f[1] += me * s;
+        self.centre().add_forces(phi, spin_rate, f);
     }
 
     fn static_unbalance(&self) -> (f64, f64) {
-        (self.mass * self.eccentricity, self.unbalance_angle)
+        self.centre().static_unbalance()
     }
 
     fn own_unbalance(&self) -> f64 {
-        self.mass * self.eccentricity
+        self.centre().size()
     }
 
     fn unbalance_size(&self, f: &DofVec) -> f64 {
-        f[0].hypot(f[1])
+        planar_size(f)
     }
 }
 
@@ -197,5 +194,16 @@ impl RotorParams for FlexibleShaft {
 
     fn clear_unbalance(&mut self) {
         self.eccentricity = 0.0;
+    }
+}
+
+impl FlexibleShaft {
+    /// The rotor's own unbalance, as the mass centre's offset.
+    fn centre(&self) -> CentreUnbalance {
+        CentreUnbalance {
+            mass: self.mass,
+            eccentricity: self.eccentricity,
+            angle: self.unbalance_angle,
+        }
     }
 }

@@ -13,6 +13,7 @@
 //! to the `rotor_registry!` call below.
 
 mod angle_deg;
+mod centre_unbalance;
 pub mod flexible;
 pub mod plane;
 pub mod two_support;

@@ -2,6 +2,7 @@
 //! viscoelastic supports (k_x, k_y, b_x, b_y); one balancer plane at the
 //! shaft centre. Coordinates x, y of the shaft centre from static equilibrium.
 
+use super::centre_unbalance::{CentreUnbalance, planar_size};
 use super::{DofVec, IsotropicPlane, MAX_DOF, Rotor, RotorParams};
 use crate::model::validate::{SceneError, invalid, non_negative, positive};
 use schemars::JsonSchema;
@@ -90,24 +91,20 @@ impl Rotor for PlaneRotor {
     }
 
     fn spin_coupling(&self, phi: f64, _q: &[f64]) -> DofVec {
-        let me = self.mass * self.eccentricity;
-        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
-        [-me * s, me * c, 0.0, 0.0]
+        let [u, v] = self.centre().coupling(phi);
+        [u, v, 0.0, 0.0]
     }
 
     fn unbalance_forces(&self, phi: f64, spin_rate: f64, f: &mut DofVec) {
-        let me = self.mass * self.eccentricity * spin_rate * spin_rate;
-        let (s, c) = crate::model::trig::sin_cos(phi + self.unbalance_angle);
-        f[0] += me * c;
-        f[1] += me * s;
+        self.centre().add_forces(phi, spin_rate, f);
     }
 
     fn static_unbalance(&self) -> (f64, f64) {
-        (self.mass * self.eccentricity, self.unbalance_angle)
+        self.centre().static_unbalance()
     }
 
     fn own_unbalance(&self) -> f64 {
-        self.mass * self.eccentricity
+        self.centre().size()
     }
 
     fn isotropic_plane(&self) -> Result<IsotropicPlane, &'static str> {
@@ -118,13 +115,13 @@ impl Rotor for PlaneRotor {
             mass: self.mass,
             stiffness: self.kx,
             damping: self.bx,
-            unbalance: self.mass * self.eccentricity,
+            unbalance: self.centre().size(),
             unbalance_angle: self.unbalance_angle,
         })
     }
 
     fn unbalance_size(&self, f: &DofVec) -> f64 {
-        f[0].hypot(f[1])
+        planar_size(f)
     }
 }
 
@@ -154,5 +151,16 @@ impl RotorParams for PlaneRotor {
 
     fn clear_unbalance(&mut self) {
         self.eccentricity = 0.0;
+    }
+}
+
+impl PlaneRotor {
+    /// The rotor's own unbalance, as the mass centre's offset.
+    fn centre(&self) -> CentreUnbalance {
+        CentreUnbalance {
+            mass: self.mass,
+            eccentricity: self.eccentricity,
+            angle: self.unbalance_angle,
+        }
     }
 }
