@@ -29,6 +29,16 @@ impl InvalidKey {
     }
 }
 
+impl InvalidKey {
+    /// The same refusal with its key under `prefix` (`max` → `sampling.unbalance.max`).
+    pub fn under(self, prefix: &str) -> Self {
+        InvalidKey {
+            key: format!("{prefix}.{}", self.key),
+            ..self
+        }
+    }
+}
+
 impl std::fmt::Display for InvalidKey {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{} = {}: {}", self.key, self.value, self.reason)

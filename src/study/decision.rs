@@ -11,6 +11,7 @@
 //! swept axis its [`Edge`]s.
 
 use super::criterion::Criterion;
+use super::summary_columns::SummaryColumns;
 use super::verdict::{Edge, Favours, Shortfall, edges, favoured, shortfalls};
 use crate::stats::paired_measures::Difference;
 use polars::prelude::{DataFrame, PolarsResult};
@@ -157,48 +158,6 @@ pub struct StudyDecision {
     pub recommendation: Recommendation,
 }
 
-/// Typed access to a summary's columns (absent optional columns: `None`s).
-struct Columns<'a>(&'a DataFrame);
-
-impl Columns<'_> {
-    fn f(&self, name: &str) -> PolarsResult<Vec<Option<f64>>> {
-        Ok(self.0.column(name)?.f64()?.iter().collect())
-    }
-    fn f_or_none(&self, name: &str) -> PolarsResult<Vec<Option<f64>>> {
-        match self.0.column(name) {
-            Ok(_) => self.f(name),
-            Err(_) => Ok(vec![None; self.0.height()]),
-        }
-    }
-    fn s(&self, name: &str) -> PolarsResult<Vec<Option<String>>> {
-        Ok(self
-            .0
-            .column(name)?
-            .str()?
-            .iter()
-            .map(|s| s.map(str::to_string))
-            .collect())
-    }
-    fn s_or_none(&self, name: &str) -> PolarsResult<Vec<Option<String>>> {
-        match self.0.column(name) {
-            Ok(_) => self.s(name),
-            Err(_) => Ok(vec![None; self.0.height()]),
-        }
-    }
-    fn b(&self, name: &str) -> PolarsResult<Vec<bool>> {
-        Ok(self
-            .0
-            .column(name)?
-            .bool()?
-            .iter()
-            .map(Option::unwrap_or_default)
-            .collect())
-    }
-    fn u32s(&self, name: &str) -> PolarsResult<Vec<Option<u32>>> {
-        Ok(self.0.column(name)?.u32()?.iter().collect())
-    }
-}
-
 /// The summary column holding each reported measure's value.
 fn value_column(m: Criterion) -> &'static str {
     match m {
@@ -212,7 +171,7 @@ fn value_column(m: Criterion) -> &'static str {
 impl StudyDecision {
     /// The decision a summary records.
     pub fn from_summary(summary: &DataFrame) -> PolarsResult<Self> {
-        let c = Columns(summary);
+        let c = SummaryColumns(summary);
         let criterion = c
             .s("rank_by")?
             .into_iter()
@@ -289,7 +248,7 @@ impl StudyDecision {
 }
 
 /// The verdict on #1.
-fn crown(c: &Columns, ranked: &[RankedDesign]) -> PolarsResult<Crown> {
+fn crown(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Crown> {
     let Some(best) = ranked.first() else {
         return Ok(Crown::Alone);
     };
@@ -324,7 +283,7 @@ fn crown(c: &Columns, ranked: &[RankedDesign]) -> PolarsResult<Crown> {
 
 /// Every design better than #1 on a reported measure other than the criterion.
 fn disagreements(
-    c: &Columns,
+    c: &SummaryColumns,
     ranked: &[RankedDesign],
     criterion: Criterion,
     alpha: f64,
@@ -373,7 +332,7 @@ fn disagreements(
 }
 
 /// The recommendation: #1 with its part, cautions and edges, or none.
-fn recommendation(c: &Columns, ranked: &[RankedDesign]) -> PolarsResult<Recommendation> {
+fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Recommendation> {
     let Some(best) = ranked.first() else {
         return Ok(Recommendation::NoDesigns);
     };

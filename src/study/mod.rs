@@ -19,6 +19,7 @@
 //! - [`failures`]: runs that did not finish, and the setting to change.
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
 //! - [`compare_designs`]: two designs of one or two results folders (`study compare`).
+//! - [`summary_columns`]: typed access to `summary.parquet`'s columns.
 //! - [`decision`]: which design to build, or why none, typed, as `summary.parquet` records it.
 //! - [`merge`]: combining shard outputs.
 //! - [`study_folder`]: the study's folder as another verb's destination (tradeoff, optimize).
@@ -52,6 +53,7 @@ pub mod sample;
 pub mod stability_map;
 pub mod stream;
 pub mod study_folder;
+pub mod summary_columns;
 pub mod sweep;
 pub mod tolerance;
 pub mod truncated;

@@ -103,22 +103,12 @@ impl StudyFile {
                 }
             }
         }
-        super::super::distribution::check(&s.unbalance.distribution).map_err(|e| {
-            refused(InvalidKey::new(
-                format!("sampling.unbalance.{}", e.key),
-                e.value,
-                e.reason,
-            ))
-        })?;
+        super::super::distribution::check(&s.unbalance.distribution)
+            .map_err(|e| refused(e.under("sampling.unbalance")))?;
         if let Some(couple) = &s.couple {
             super::super::couple::validate(couple, &self.scene.rotor, |u| {
-                super::super::distribution::check(&u.distribution).map_err(|e| {
-                    InvalidKey::new(
-                        format!("sampling.couple.unbalance.{}", e.key),
-                        e.value,
-                        e.reason,
-                    )
-                })
+                super::super::distribution::check(&u.distribution)
+                    .map_err(|e| e.under("sampling.couple.unbalance"))
             })
             .map_err(refused)?;
         }

@@ -16,41 +16,8 @@ mod notes;
 use findings::{disagreement_line, recommendation_line, verdict_line};
 use notes::{contact_line, dead_band_line, merged_line, passage_table};
 
-/// Typed access to the summary's columns.
-struct Summary<'a>(&'a DataFrame);
-
-impl Summary<'_> {
-    fn f(&self, name: &str) -> Result<Vec<Option<f64>>, UserError> {
-        Ok(self.0.column(name)?.f64()?.iter().collect())
-    }
-    fn s(&self, name: &str) -> Result<Vec<Option<String>>, UserError> {
-        Ok(self
-            .0
-            .column(name)?
-            .str()?
-            .iter()
-            .map(|s| s.map(str::to_string))
-            .collect())
-    }
-    fn u(&self, name: &str) -> Result<Vec<u64>, UserError> {
-        Ok(self
-            .0
-            .column(name)?
-            .u64()?
-            .iter()
-            .map(Option::unwrap_or_default)
-            .collect())
-    }
-    fn b(&self, name: &str) -> Result<Vec<bool>, UserError> {
-        Ok(self
-            .0
-            .column(name)?
-            .bool()?
-            .iter()
-            .map(Option::unwrap_or_default)
-            .collect())
-    }
-}
+/// The summary's columns by name (the library's reader).
+use autobal::study::summary_columns::SummaryColumns as Summary;
 
 /// A parameter to four significant digits (`10`, `0.5`, not
 /// `0.05000000000000001`), or "–".
@@ -197,14 +164,12 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         sum.f("rank_value")?,
     );
     // Older summaries lack the absolute residual and the speed's period.
-    let optional = |name: &str| -> Result<Vec<Option<f64>>, UserError> {
-        match summary.column(name) {
-            Ok(_) => sum.f(name),
-            Err(_) => Ok(vec![None; summary.height()]),
-        }
-    };
-    let res_abs95 = optional("residual_abs_p95")?;
-    let seconds_per_rev = optional("seconds_per_rev")?.into_iter().flatten().next();
+    let res_abs95 = sum.f_or_none("residual_abs_p95")?;
+    let seconds_per_rev = sum
+        .f_or_none("seconds_per_rev")?
+        .into_iter()
+        .flatten()
+        .next();
     let failed: Vec<u64> = sum
         .u("solver_failed")?
         .iter()
@@ -288,10 +253,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .collect();
     // A stall-torque sweep gets its own column after β (designs differ by
     // it alone); other studies print without it.
-    let torque: Vec<Option<f64>> = match summary.column("stall_torque") {
-        Ok(c) => c.f64()?.iter().collect(),
-        Err(_) => vec![None; summary.height()],
-    };
+    let torque = sum.f_or_none("stall_torque")?;
     let swept = torque.iter().any(Option::is_some);
     let rows: Vec<Vec<String>> = if swept {
         rows.into_iter()
@@ -414,10 +376,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     };
     // Which ρ came from a rule rather than a number: the value alone does
     // not say that 0.364 is the Table-1 optimum.
-    let rules: Vec<Option<String>> = match summary.column("rho_rule") {
-        Ok(_) => sum.s("rho_rule")?,
-        Err(_) => vec![None; summary.height()],
-    };
+    let rules = sum.s_or_none("rho_rule")?;
     let mut rule_notes = Vec::new();
     for rule in ["optimal", "half_race"] {
         let mut with: Vec<(u32, Option<f64>)> = (0..summary.height())
