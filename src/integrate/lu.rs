@@ -1,338 +1,289 @@
-//! Dense LU factorisation with partial pivoting, real and complex, in place,
-//! for the Newton matrices of the implicit stepper.
+//! Dense LU factorisation with partial pivoting, in place, one kernel for
+//! real and complex matrices: the Newton matrices of the implicit stepper
+//! and the small reduced systems of the structured ones.
 //!
 //! Hand-written rather than nalgebra's: the matrices are small (a rotor with
 //! a few balancers has tens of states), the buffers are allocated once per
 //! solve and reused for every factorisation (nalgebra's `LU` takes its matrix
-//! by value and allocates its permutation each time), the complex matrix
-//! (α + iβ)·I − J is kept as two real arrays without a complex-number crate,
-//! and in the test profile only this crate is optimised, so a dependency's
-//! generic code would run at opt-level 0.
+//! by value and allocates its permutation each time), and in the test
+//! profile only this crate is optimised, so a dependency's generic code
+//! would run at opt-level 0.
 
-/// LU factors of s·I − J with row pivoting.
-pub(crate) struct RealLu {
+use num_complex::Complex64;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// The arithmetic a factorisation needs, for real and complex entries.
+pub(crate) trait Scalar:
+    Copy
+    + PartialEq
+    + From<f64>
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// Real parts a vector splits into (1 or 2).
+    const PARTS: usize;
+    /// Size for pivoting (|x|, or |re| + |im|).
+    fn mag(self) -> f64;
+    /// Neither NaN nor infinite.
+    fn finite(self) -> bool;
+    /// Real part `k` (0: real, 1: imaginary).
+    fn part(x: Self, k: usize) -> f64;
+    /// The value from its parts.
+    fn assemble(re: f64, im: f64) -> Self;
+}
+
+impl Scalar for f64 {
+    const PARTS: usize = 1;
+    fn mag(self) -> f64 {
+        self.abs()
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+    fn part(x: Self, _k: usize) -> f64 {
+        x
+    }
+    fn assemble(re: f64, _im: f64) -> Self {
+        re
+    }
+}
+
+impl Scalar for Complex64 {
+    const PARTS: usize = 2;
+    fn mag(self) -> f64 {
+        self.l1_norm()
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+    fn part(x: Self, k: usize) -> f64 {
+        if k == 0 { x.re } else { x.im }
+    }
+    fn assemble(re: f64, im: f64) -> Self {
+        Complex64::new(re, im)
+    }
+}
+
+/// Factor the n×n row-major `a` in place (L's multipliers below the
+/// diagonal, U on and above), the row interchanges into `piv`; false if a
+/// pivot is zero or not finite. Ties for the pivot go to the first row.
+pub(crate) fn factor_in_place<S: Scalar>(a: &mut [S], piv: &mut [usize], n: usize) -> bool {
+    let a = &mut a[..n * n];
+    for k in 0..n {
+        let mut p = k;
+        let mut amax = a[k * n + k].mag();
+        for i in k + 1..n {
+            let v = a[i * n + k].mag();
+            if v > amax {
+                amax = v;
+                p = i;
+            }
+        }
+        piv[k] = p;
+        if amax == 0.0 || !amax.is_finite() {
+            return false;
+        }
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+        }
+        let (upper, lower) = a.split_at_mut((k + 1) * n);
+        let pivot_row = &upper[k * n..];
+        let pivot = pivot_row[k];
+        let zero = S::from(0.0);
+        for row in lower.chunks_exact_mut(n) {
+            let l = row[k] / pivot;
+            row[k] = l;
+            if l != zero {
+                for (x, &u) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
+                    *x = *x - l * u;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Overwrite b with the solution of A·x = b, A factored by
+/// [`factor_in_place`].
+pub(crate) fn solve_in_place<S: Scalar>(a: &[S], piv: &[usize], n: usize, b: &mut [S]) {
+    // The few-weight sizes with the size known to the compiler: loops
+    // unrolled, the same operations in the same order (the same bits).
+    match n {
+        3 => solve_sized::<S, 3>(a, piv, b),
+        4 => solve_sized::<S, 4>(a, piv, b),
+        5 => solve_sized::<S, 5>(a, piv, b),
+        6 => solve_sized::<S, 6>(a, piv, b),
+        7 => solve_sized::<S, 7>(a, piv, b),
+        8 => solve_sized::<S, 8>(a, piv, b),
+        _ => solve_any(a, piv, n, b),
+    }
+}
+
+/// [`solve_in_place`] for n = N.
+fn solve_sized<S: Scalar, const N: usize>(a: &[S], piv: &[usize], b: &mut [S]) {
+    let b: &mut [S; N] = (&mut b[..N]).try_into().expect("n = N");
+    let a = &a[..N * N];
+    for (k, &p) in piv[..N].iter().enumerate() {
+        b.swap(k, p);
+    }
+    for i in 0..N {
+        let mut s = b[i];
+        for k in 0..i {
+            s = s - a[i * N + k] * b[k];
+        }
+        b[i] = s;
+    }
+    for i in (0..N).rev() {
+        let mut s = b[i];
+        for k in i + 1..N {
+            s = s - a[i * N + k] * b[k];
+        }
+        b[i] = s / a[i * N + i];
+    }
+}
+
+/// [`solve_in_place`] for any n.
+fn solve_any<S: Scalar>(a: &[S], piv: &[usize], n: usize, b: &mut [S]) {
+    let b = &mut b[..n];
+    // Every interchange first: the factorisation swapped whole rows, its
+    // multipliers included.
+    for (k, &p) in piv[..n].iter().enumerate() {
+        b.swap(k, p);
+    }
+    // Slices rather than indices: no bounds checks in the inner loops,
+    // the same operations in the same order.
+    for (i, row) in a[..n * n].chunks_exact(n).enumerate() {
+        let (done, rest) = b.split_at_mut(i);
+        let mut s = rest[0];
+        for (&l, &x) in row[..i].iter().zip(done.iter()) {
+            s = s - l * x;
+        }
+        rest[0] = s;
+    }
+    for (i, row) in a[..n * n].chunks_exact(n).enumerate().rev() {
+        let (head, done) = b.split_at_mut(i + 1);
+        let mut s = head[i];
+        for (&u, &x) in row[i + 1..].iter().zip(done.iter()) {
+            s = s - u * x;
+        }
+        head[i] = s / row[i];
+    }
+}
+
+/// LU factors of an n×n matrix and its interchanges, with its buffers.
+pub(crate) struct DenseLu<S> {
     n: usize,
-    a: Vec<f64>,
+    a: Vec<S>,
     piv: Vec<usize>,
 }
 
-impl RealLu {
+impl<S: Scalar> DenseLu<S> {
     /// Buffers for an n×n matrix.
     pub(crate) fn new(n: usize) -> Self {
-        RealLu {
+        DenseLu {
             n,
-            a: vec![0.0; n * n],
+            a: vec![S::from(0.0); n * n],
             piv: vec![0; n],
         }
     }
 
-    /// Factor s·I − J (J row-major); false if singular or not finite.
-    pub(crate) fn factor_shifted(&mut self, s: f64, jac: &[f64]) -> bool {
+    /// Factor c·I − J (J real, row-major); false if singular or not finite.
+    fn factor_shifted_by(&mut self, c: S, jac: &[f64]) -> bool {
         let n = self.n;
-        if !s.is_finite() || jac.iter().any(|v| !v.is_finite()) {
+        if !c.finite() || jac.iter().any(|v| !v.is_finite()) {
             return false;
         }
-        for (a, j) in self.a.iter_mut().zip(jac) {
-            *a = -j;
+        for (a, &j) in self.a.iter_mut().zip(jac) {
+            *a = S::from(-j);
         }
         for i in 0..n {
-            self.a[i * n + i] += s;
+            self.a[i * n + i] = self.a[i * n + i] + c;
         }
-        self.factor()
+        factor_in_place(&mut self.a, &mut self.piv, n)
+    }
+
+    /// Overwrite b with the solution of the factored system.
+    fn solve_scalars(&self, b: &mut [S]) {
+        solve_in_place(&self.a, &self.piv, self.n, b);
+    }
+}
+
+/// LU factors of s·I − J with row pivoting.
+pub(crate) type RealLu = DenseLu<f64>;
+
+impl DenseLu<f64> {
+    /// Factor s·I − J (J row-major); false if singular or not finite.
+    pub(crate) fn factor_shifted(&mut self, s: f64, jac: &[f64]) -> bool {
+        self.factor_shifted_by(s, jac)
     }
 
     /// Factor the matrix that `fill` writes (row-major, n×n); false if
     /// singular or not finite.
     pub(crate) fn factor_from(&mut self, fill: impl FnOnce(&mut [f64])) -> bool {
         fill(&mut self.a);
-        self.a.iter().all(|v| v.is_finite()) && self.factor()
-    }
-
-    /// Factor the buffer in place.
-    fn factor(&mut self) -> bool {
-        let n = self.n;
-        let a = &mut self.a;
-        for k in 0..n {
-            let mut p = k;
-            let mut amax = a[k * n + k].abs();
-            for i in k + 1..n {
-                let v = a[i * n + k].abs();
-                if v > amax {
-                    amax = v;
-                    p = i;
-                }
-            }
-            self.piv[k] = p;
-            if amax == 0.0 || !amax.is_finite() {
-                return false;
-            }
-            if p != k {
-                for j in 0..n {
-                    a.swap(k * n + j, p * n + j);
-                }
-            }
-            let (upper, lower) = a.split_at_mut((k + 1) * n);
-            let pivot_row = &upper[k * n..];
-            let pivot = pivot_row[k];
-            for row in lower.chunks_exact_mut(n) {
-                let l = row[k] / pivot;
-                row[k] = l;
-                if l != 0.0 {
-                    for (x, u) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
-                        *x -= l * u;
-                    }
-                }
-            }
-        }
-        true
+        self.a.iter().all(|v| v.is_finite()) && factor_in_place(&mut self.a, &mut self.piv, self.n)
     }
 
     /// Overwrite b with the solution x of (s·I − J)·x = b (or of the matrix
     /// given to [`RealLu::factor_from`]).
     pub(crate) fn solve(&self, b: &mut [f64]) {
-        // The few-weight sizes with the size known to the compiler: loops
-        // unrolled, the same operations in the same order (the same bits).
-        match self.n {
-            3 => self.solve_sized::<3>(b),
-            4 => self.solve_sized::<4>(b),
-            5 => self.solve_sized::<5>(b),
-            6 => self.solve_sized::<6>(b),
-            7 => self.solve_sized::<7>(b),
-            8 => self.solve_sized::<8>(b),
-            _ => self.solve_any(b),
-        }
-    }
-
-    /// [`Self::solve`] for n = N.
-    fn solve_sized<const N: usize>(&self, b: &mut [f64]) {
-        let b: &mut [f64; N] = (&mut b[..N]).try_into().expect("n = N");
-        let a = &self.a[..N * N];
-        for (k, &p) in self.piv[..N].iter().enumerate() {
-            b.swap(k, p);
-        }
-        for i in 0..N {
-            let mut s = b[i];
-            for k in 0..i {
-                s -= a[i * N + k] * b[k];
-            }
-            b[i] = s;
-        }
-        for i in (0..N).rev() {
-            let mut s = b[i];
-            for k in i + 1..N {
-                s -= a[i * N + k] * b[k];
-            }
-            b[i] = s / a[i * N + i];
-        }
-    }
-
-    /// [`Self::solve`] for any n.
-    fn solve_any(&self, b: &mut [f64]) {
-        let n = self.n;
-        let b = &mut b[..n];
-        for (k, &p) in self.piv.iter().enumerate() {
-            b.swap(k, p);
-        }
-        // Slices rather than indices: no bounds checks in the inner loops,
-        // the same operations in the same order.
-        for (i, row) in self.a.chunks_exact(n).enumerate() {
-            let (done, rest) = b.split_at_mut(i);
-            let mut s = rest[0];
-            for (l, x) in row[..i].iter().zip(done.iter()) {
-                s -= l * x;
-            }
-            rest[0] = s;
-        }
-        for (i, row) in self.a.chunks_exact(n).enumerate().rev() {
-            let (head, done) = b.split_at_mut(i + 1);
-            let mut s = head[i];
-            for (u, x) in row[i + 1..].iter().zip(done.iter()) {
-                s -= u * x;
-            }
-            head[i] = s / row[i];
-        }
+        self.solve_scalars(b);
     }
 }
 
-/// LU factors of (α + iβ)·I − J with row pivoting, as real and imaginary parts.
+/// LU factors of (α + iβ)·I − J with row pivoting; right-hand sides and
+/// solutions as real and imaginary parts, as the implicit stepper keeps them.
 pub(crate) struct ComplexLu {
-    n: usize,
+    lu: DenseLu<Complex64>,
+    /// The parts a caller fills, and the packed right-hand side.
     re: Vec<f64>,
     im: Vec<f64>,
-    piv: Vec<usize>,
+    packed: Vec<Complex64>,
 }
 
 impl ComplexLu {
     /// Buffers for an n×n matrix.
     pub(crate) fn new(n: usize) -> Self {
         ComplexLu {
-            n,
+            lu: DenseLu::new(n),
             re: vec![0.0; n * n],
             im: vec![0.0; n * n],
-            piv: vec![0; n],
+            packed: vec![Complex64::new(0.0, 0.0); n],
         }
     }
 
     /// Factor (α + iβ)·I − J (J row-major); false if singular or not finite.
     pub(crate) fn factor_shifted(&mut self, alpha: f64, beta: f64, jac: &[f64]) -> bool {
-        let n = self.n;
-        if !(alpha.is_finite() && beta.is_finite()) || jac.iter().any(|v| !v.is_finite()) {
-            return false;
-        }
-        for (a, j) in self.re.iter_mut().zip(jac) {
-            *a = -j;
-        }
-        self.im.fill(0.0);
-        for i in 0..n {
-            self.re[i * n + i] += alpha;
-            self.im[i * n + i] = beta;
-        }
-        self.factor()
+        self.lu.factor_shifted_by(Complex64::new(alpha, beta), jac)
     }
 
     /// Factor the matrix whose real and imaginary parts `fill` writes
     /// (row-major, n×n); false if singular or not finite.
     pub(crate) fn factor_from(&mut self, fill: impl FnOnce(&mut [f64], &mut [f64])) -> bool {
         fill(&mut self.re, &mut self.im);
-        self.re.iter().chain(&self.im).all(|v| v.is_finite()) && self.factor()
-    }
-
-    /// Factor the buffers in place.
-    fn factor(&mut self) -> bool {
-        let n = self.n;
-        let (re, im) = (&mut self.re, &mut self.im);
-        for k in 0..n {
-            let mut p = k;
-            let mut amax = re[k * n + k].abs() + im[k * n + k].abs();
-            for i in k + 1..n {
-                let v = re[i * n + k].abs() + im[i * n + k].abs();
-                if v > amax {
-                    amax = v;
-                    p = i;
-                }
-            }
-            self.piv[k] = p;
-            if amax == 0.0 || !amax.is_finite() {
-                return false;
-            }
-            if p != k {
-                for j in 0..n {
-                    re.swap(k * n + j, p * n + j);
-                    im.swap(k * n + j, p * n + j);
-                }
-            }
-            let (re_upper, re_lower) = re.split_at_mut((k + 1) * n);
-            let (im_upper, im_lower) = im.split_at_mut((k + 1) * n);
-            let (ur_row, ui_row) = (&re_upper[k * n..], &im_upper[k * n..]);
-            let (pr, pi) = (ur_row[k], ui_row[k]);
-            let den = pr * pr + pi * pi;
-            for (row_r, row_i) in re_lower
-                .chunks_exact_mut(n)
-                .zip(im_lower.chunks_exact_mut(n))
-            {
-                let (ar, ai) = (row_r[k], row_i[k]);
-                // l = a / pivot
-                let lr = (ar * pr + ai * pi) / den;
-                let li = (ai * pr - ar * pi) / den;
-                row_r[k] = lr;
-                row_i[k] = li;
-                if lr != 0.0 || li != 0.0 {
-                    let pivot_part = ur_row[k + 1..].iter().zip(&ui_row[k + 1..]);
-                    let row_part = row_r[k + 1..].iter_mut().zip(row_i[k + 1..].iter_mut());
-                    for ((xr, xi), (ur, ui)) in row_part.zip(pivot_part) {
-                        *xr -= lr * ur - li * ui;
-                        *xi -= lr * ui + li * ur;
-                    }
-                }
-            }
+        for ((a, &r), &i) in self.lu.a.iter_mut().zip(&self.re).zip(&self.im) {
+            *a = Complex64::new(r, i);
         }
-        true
+        self.lu.a.iter().all(|v| v.is_finite())
+            && factor_in_place(&mut self.lu.a, &mut self.lu.piv, self.lu.n)
     }
 
     /// Overwrite (br, bi) with the solution of ((α + iβ)·I − J)·x = br + i·bi
     /// (or of the matrix given to [`ComplexLu::factor_from`]).
-    pub(crate) fn solve(&self, br: &mut [f64], bi: &mut [f64]) {
-        // As [`RealLu::solve`]: the few-weight sizes known to the compiler.
-        match self.n {
-            3 => self.solve_sized::<3>(br, bi),
-            4 => self.solve_sized::<4>(br, bi),
-            5 => self.solve_sized::<5>(br, bi),
-            6 => self.solve_sized::<6>(br, bi),
-            7 => self.solve_sized::<7>(br, bi),
-            8 => self.solve_sized::<8>(br, bi),
-            _ => self.solve_any(br, bi),
+    pub(crate) fn solve(&mut self, br: &mut [f64], bi: &mut [f64]) {
+        let n = self.lu.n;
+        for ((p, &r), &i) in self.packed.iter_mut().zip(&br[..n]).zip(&bi[..n]) {
+            *p = Complex64::new(r, i);
         }
-    }
-
-    /// [`Self::solve`] for n = N.
-    fn solve_sized<const N: usize>(&self, br: &mut [f64], bi: &mut [f64]) {
-        let br: &mut [f64; N] = (&mut br[..N]).try_into().expect("n = N");
-        let bi: &mut [f64; N] = (&mut bi[..N]).try_into().expect("n = N");
-        let (re, im) = (&self.re[..N * N], &self.im[..N * N]);
-        for (k, &p) in self.piv[..N].iter().enumerate() {
-            br.swap(k, p);
-            bi.swap(k, p);
-        }
-        for i in 0..N {
-            let (mut sr, mut si) = (br[i], bi[i]);
-            for k in 0..i {
-                let (lr, li) = (re[i * N + k], im[i * N + k]);
-                sr -= lr * br[k] - li * bi[k];
-                si -= lr * bi[k] + li * br[k];
-            }
-            br[i] = sr;
-            bi[i] = si;
-        }
-        for i in (0..N).rev() {
-            let (mut sr, mut si) = (br[i], bi[i]);
-            for k in i + 1..N {
-                let (ur, ui) = (re[i * N + k], im[i * N + k]);
-                sr -= ur * br[k] - ui * bi[k];
-                si -= ur * bi[k] + ui * br[k];
-            }
-            let (dr, di) = (re[i * N + i], im[i * N + i]);
-            let den = dr * dr + di * di;
-            br[i] = (sr * dr + si * di) / den;
-            bi[i] = (si * dr - sr * di) / den;
-        }
-    }
-
-    /// [`Self::solve`] for any n.
-    fn solve_any(&self, br: &mut [f64], bi: &mut [f64]) {
-        let n = self.n;
-        let (br, bi) = (&mut br[..n], &mut bi[..n]);
-        for (k, &p) in self.piv.iter().enumerate() {
-            br.swap(k, p);
-            bi.swap(k, p);
-        }
-        let rows = || self.re.chunks_exact(n).zip(self.im.chunks_exact(n));
-        // Slices rather than indices: no bounds checks in the inner loops,
-        // the same operations in the same order.
-        for (i, (row_r, row_i)) in rows().enumerate() {
-            let (done_r, rest_r) = br.split_at_mut(i);
-            let (done_i, rest_i) = bi.split_at_mut(i);
-            let (mut sr, mut si) = (rest_r[0], rest_i[0]);
-            let factors = row_r[..i].iter().zip(&row_i[..i]);
-            for ((lr, li), (xr, xi)) in factors.zip(done_r.iter().zip(done_i.iter())) {
-                sr -= lr * xr - li * xi;
-                si -= lr * xi + li * xr;
-            }
-            rest_r[0] = sr;
-            rest_i[0] = si;
-        }
-        for (i, (row_r, row_i)) in rows().enumerate().rev() {
-            let (head_r, done_r) = br.split_at_mut(i + 1);
-            let (head_i, done_i) = bi.split_at_mut(i + 1);
-            let (mut sr, mut si) = (head_r[i], head_i[i]);
-            let factors = row_r[i + 1..].iter().zip(&row_i[i + 1..]);
-            for ((ur, ui), (xr, xi)) in factors.zip(done_r.iter().zip(done_i.iter())) {
-                sr -= ur * xr - ui * xi;
-                si -= ur * xi + ui * xr;
-            }
-            let (dr, di) = (row_r[i], row_i[i]);
-            let den = dr * dr + di * di;
-            head_r[i] = (sr * dr + si * di) / den;
-            head_i[i] = (si * dr - sr * di) / den;
+        self.lu.solve_scalars(&mut self.packed);
+        for ((p, r), i) in self.packed.iter().zip(&mut br[..n]).zip(&mut bi[..n]) {
+            *r = p.re;
+            *i = p.im;
         }
     }
 }
@@ -398,22 +349,27 @@ mod tests {
             assert!(real.factor_shifted(0.7, &jac));
             let (mut x, mut y) = (b.clone(), b.clone());
             real.solve(&mut x);
-            real.solve_any(&mut y);
+            solve_any(&real.a, &real.piv, n, &mut y);
             assert_eq!(
                 x.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
                 y.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
                 "real n = {n}"
             );
-            let mut complex = ComplexLu::new(n);
-            assert!(complex.factor_shifted(0.7, -1.3, &jac));
-            let (mut xr, mut xi, mut yr, mut yi) = (b.clone(), bi.clone(), b.clone(), bi.clone());
-            complex.solve(&mut xr, &mut xi);
-            complex.solve_any(&mut yr, &mut yi);
+            let mut complex = DenseLu::<Complex64>::new(n);
+            assert!(complex.factor_shifted_by(Complex64::new(0.7, -1.3), &jac));
+            let mut x: Vec<Complex64> = b
+                .iter()
+                .zip(&bi)
+                .map(|(&r, &i)| Complex64::new(r, i))
+                .collect();
+            let mut y = x.clone();
+            complex.solve_scalars(&mut x);
+            solve_any(&complex.a, &complex.piv, n, &mut y);
             assert!(
-                xr.iter()
-                    .chain(&xi)
-                    .zip(yr.iter().chain(&yi))
-                    .all(|(p, q)| p.to_bits() == q.to_bits()),
+                x.iter()
+                    .zip(&y)
+                    .all(|(p, q)| p.re.to_bits() == q.re.to_bits()
+                        && p.im.to_bits() == q.im.to_bits()),
                 "complex n = {n}"
             );
         }

@@ -193,7 +193,7 @@ impl NewtonMatrices {
     ) {
         let dense = match self {
             NewtonMatrices::Structured(s) => return s.solve_complex(system, br, bi, stats),
-            dense => &*dense,
+            dense => dense,
         };
         match dense {
             NewtonMatrices::Structured(_) => unreachable!("returned above"),
@@ -202,9 +202,10 @@ impl NewtonMatrices {
                 m,
                 complex,
                 lower_left,
-                inv_shift: (alp, bet),
+                inv_shift,
                 ..
             } => {
+                let (alp, bet) = *inv_shift;
                 let (fr, gr) = br.split_at_mut(*m);
                 let (fi, gi) = bi.split_at_mut(*m);
                 // f ← f/(α + iβ) = f·(alp − i·bet).

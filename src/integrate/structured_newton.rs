@@ -27,9 +27,9 @@
 //! Written by hand: no Rust crate offers a tridiagonal-plus-low-rank solve,
 //! and the matrix-free correction is specific to this structure.
 
+use super::lu::{Scalar, factor_in_place, solve_in_place};
 use super::{CouplingStructure, HeadEquation, OdeSystem, Stats};
 use num_complex::Complex64;
-use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// Radau5's unit roundoff for difference increments.
 const UROUND: f64 = 1e-16;
@@ -42,61 +42,6 @@ const MAX_HEAD: usize = 8;
 /// 16 weights and 7 % slower at 24. The shipped studies (n ≤ 8) keep their
 /// bits.
 pub(crate) const MIN_RING_COORDINATES: usize = 20;
-
-/// The arithmetic the solve needs, for real and complex matrices.
-trait Scalar:
-    Copy
-    + PartialEq
-    + From<f64>
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
-{
-    /// Real parts a vector splits into (1 or 2).
-    const PARTS: usize;
-    /// Size for pivoting.
-    fn mag(self) -> f64;
-    /// Neither NaN nor infinite.
-    fn finite(self) -> bool;
-    /// Real part `k` (0: real, 1: imaginary).
-    fn part(x: Self, k: usize) -> f64;
-    /// The value from its parts.
-    fn assemble(re: f64, im: f64) -> Self;
-}
-
-impl Scalar for f64 {
-    const PARTS: usize = 1;
-    fn mag(self) -> f64 {
-        self.abs()
-    }
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
-    fn part(x: Self, _k: usize) -> f64 {
-        x
-    }
-    fn assemble(re: f64, _im: f64) -> Self {
-        re
-    }
-}
-
-impl Scalar for Complex64 {
-    const PARTS: usize = 2;
-    fn mag(self) -> f64 {
-        self.l1_norm()
-    }
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
-    fn part(x: Self, k: usize) -> f64 {
-        if k == 0 { x.re } else { x.im }
-    }
-    fn assemble(re: f64, im: f64) -> Self {
-        Complex64::new(re, im)
-    }
-}
 
 /// One half (∂/∂q or ∂/∂q̇) of the local Jacobian L, per ring position.
 #[derive(Default)]
@@ -284,7 +229,7 @@ impl Local {
                 for r in 0..h {
                     col[r] = rows[r * 2 * m + off + i];
                 }
-                small_solve(a, piv, h, &mut col[..h]);
+                solve_in_place(a, piv, h, &mut col[..h]);
                 for r in 0..h {
                     rows[r * 2 * m + off + i] = col[r];
                 }
@@ -615,7 +560,7 @@ impl<S: Scalar> Shifted<S> {
         let mut s = std::mem::take(&mut self.s);
         s.clear();
         s.extend(self.units.iter().map(|&u| v[u]));
-        small_solve(&self.k_in, &self.k_in_piv, r, &mut s);
+        solve_in_place(&self.k_in, &self.k_in_piv, r, &mut s);
         for (col, &t) in self.z_in.chunks_exact(m).zip(&s) {
             for (x, z) in v.iter_mut().zip(col) {
                 *x = *x - *z * t;
@@ -640,7 +585,7 @@ impl<S: Scalar> Shifted<S> {
         for (i, t) in t.iter_mut().enumerate().take(h) {
             *t = read_head(probe, i);
         }
-        small_solve(&self.k_out, &self.k_out_piv, h, &mut t[..h]);
+        solve_in_place(&self.k_out, &self.k_out_piv, h, &mut t[..h]);
         for (col, &t) in self.z_out.chunks_exact(2 * m).zip(&t[..h]) {
             for (v, z) in x.iter_mut().zip(col) {
                 *v = *v + *z * t;
@@ -752,53 +697,11 @@ fn gttrs<S: Scalar>(dl: &[S], d: &[S], du: &[S], du2: &[S], pivoted: &[bool], b:
     }
 }
 
-/// LU with partial pivoting of the r×r row-major `a` (K, a few rows); false
-/// if singular or not finite.
+/// Factor the r×r `a` in place ([`factor_in_place`]), every entry finite.
 fn small_lu<S: Scalar>(a: &mut [S], piv: &mut Vec<usize>, r: usize) -> bool {
     piv.clear();
-    for k in 0..r {
-        let p = (k..r)
-            .max_by(|&x, &y| a[x * r + k].mag().total_cmp(&a[y * r + k].mag()))
-            .unwrap_or(k);
-        piv.push(p);
-        if a[p * r + k].mag() == 0.0 || !a[p * r + k].finite() {
-            return false;
-        }
-        if p != k {
-            for j in 0..r {
-                a.swap(k * r + j, p * r + j);
-            }
-        }
-        for i in k + 1..r {
-            let l = a[i * r + k] / a[k * r + k];
-            a[i * r + k] = l;
-            for j in k + 1..r {
-                a[i * r + j] = a[i * r + j] - l * a[k * r + j];
-            }
-        }
-    }
-    a.iter().all(|v| v.finite())
-}
-
-/// Solve with [`small_lu`]'s factors in place.
-fn small_solve<S: Scalar>(a: &[S], piv: &[usize], r: usize, b: &mut [S]) {
-    // Every interchange first: the factor swapped whole rows, its
-    // multipliers included.
-    for (k, &p) in piv.iter().enumerate().take(r) {
-        b.swap(k, p);
-    }
-    for k in 0..r {
-        for i in k + 1..r {
-            b[i] = b[i] - a[i * r + k] * b[k];
-        }
-    }
-    for i in (0..r).rev() {
-        let mut s = b[i];
-        for j in i + 1..r {
-            s = s - a[i * r + j] * b[j];
-        }
-        b[i] = s / a[i * r + i];
-    }
+    piv.resize(r, 0);
+    factor_in_place(a, piv, r) && a.iter().all(|v| v.finite())
 }
 
 /// The structured reduced Newton matrices of one Jacobian and step size.
@@ -1331,7 +1234,7 @@ mod tests {
             let (mut lu, mut p) = (a.clone(), Vec::new());
             assert!(small_lu(&mut lu, &mut p, n));
             let mut x = b.clone();
-            small_solve(&lu, &p, n, &mut x);
+            solve_in_place(&lu, &p, n, &mut x);
             for i in 0..n {
                 let r: f64 = (0..n).map(|k| a[i * n + k] * x[k]).sum::<f64>() - b[i];
                 assert!(r.abs() < 1e-12, "dense n = {n}, row {i}: {r}");
