@@ -30,6 +30,7 @@
 //! A "revolution" is 2π/ω at the scene's nominal speed (the constant speed,
 //! the ramp's final speed or the motor's synchronous speed).
 
+use crate::integrate::Failure;
 use crate::invalid_key::InvalidKey;
 pub mod balance_angle;
 pub mod bearing_orbit;
@@ -171,7 +172,17 @@ pub enum Budget {
 }
 
 impl Budget {
-    /// The budget named by a `budget_exceeded` run's reason.
+    /// The budget a solver failure exhausted, if it was a budget.
+    pub fn of_failure(failure: &Failure) -> Option<Budget> {
+        match failure {
+            Failure::TooManySteps { .. } => Some(Budget::Steps),
+            Failure::WallTimeExceeded { .. } => Some(Budget::WallTime),
+            _ => None,
+        }
+    }
+
+    /// The budget named by a `budget_exceeded` run's recorded reason (the
+    /// failure's text, as [`Budget::of_failure`] classed it when written).
     pub fn of_reason(reason: &str) -> Budget {
         if reason.contains("wall-time") {
             Budget::WallTime
@@ -487,7 +498,7 @@ impl MetricOptions {
 
 #[cfg(test)]
 mod tests {
-    use super::{Budget, Outcome};
+    use super::{Budget, Failure, Outcome};
 
     /// Every name reads back as its outcome, and nothing else reads as one.
     #[test]
@@ -514,10 +525,21 @@ mod tests {
         for o in Outcome::ALL {
             assert!(!(o.is_failure() && o.has_residual()), "{o:?}");
         }
-        assert_eq!(
-            Budget::of_reason("wall-time budget of 5 s exhausted at t = 1.2"),
-            Budget::WallTime
-        );
-        assert_eq!(Budget::of_reason("max_steps = 150 reached"), Budget::Steps);
+        // The reader recovers from the written text what the writer typed.
+        let failures = [
+            Failure::TooManySteps { t: 1.5, max: 150 },
+            Failure::WallTimeExceeded {
+                t: 1.2,
+                limit_s: 5.0,
+            },
+            Failure::StepSizeUnderflow { t: 0.1, h: 1e-300 },
+        ];
+        for f in &failures {
+            match Budget::of_failure(f) {
+                Some(b) => assert_eq!(Budget::of_reason(&f.to_string()), b, "{f}"),
+                None => assert!(matches!(f, Failure::StepSizeUnderflow { .. })),
+            }
+        }
+        assert_eq!(Budget::of_failure(&failures[1]), Some(Budget::WallTime));
     }
 }

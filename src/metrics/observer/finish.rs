@@ -2,6 +2,7 @@
 //! the run's metrics, its outcome classified.
 
 use super::*;
+use crate::metrics::Budget;
 
 impl SettlingObserver<'_> {
     /// Turn the observations and the solver's report into the run's metrics.
@@ -49,12 +50,9 @@ impl SettlingObserver<'_> {
             (None, Status::Failed(Failure::NonFinite { t })) => {
                 (Outcome::Diverged, format!("non-finite state at t = {t}"))
             }
-            (
-                None,
-                Status::Failed(
-                    f @ (Failure::TooManySteps { .. } | Failure::WallTimeExceeded { .. }),
-                ),
-            ) => (Outcome::BudgetExceeded, f.to_string()),
+            (None, Status::Failed(f)) if Budget::of_failure(f).is_some() => {
+                (Outcome::BudgetExceeded, f.to_string())
+            }
             (None, Status::Failed(f)) => (Outcome::SolverFailed, f.to_string()),
             (None, _) if merged_apart.is_some() => {
                 (Outcome::Merged, merged_apart.clone().unwrap_or_default())
