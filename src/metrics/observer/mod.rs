@@ -2,19 +2,20 @@
 //! detects settling, watches for divergence, and optionally records a series.
 //!
 //! Its concerns live in files of their own, each an `impl` of the observer
-//! or the types it holds: `window` (the hold window and its rule),
-//! `twins` (identical weights that meet), `repeats` (the never-settles
-//! watch), `tail` (the certified tail on the tracked flow), `series`
-//! (the recorded history) and `finish` (metrics and outcome at the end).
-//! This file keeps the state, the sampling and the divergence test.
+//! or the types it holds, and a sample passes through them in a loop
+//! ([`SettlingObserver::PARTS`]): `window` (the hold window, the holds and
+//! the planes' watch), `twins` (identical weights that meet), `series` (the
+//! recorded history), `repeats` (the never-settles watch), `tail` (the
+//! certified tail on the tracked flow) and `finish` (metrics and outcome at
+//! the end). This file keeps the state, the measurement of a sample and the
+//! divergence test.
 
 use super::certify::{BOUND_SLACK, ERROR_GROWTH, HoldCertifier, MARGIN, Tracked, residual_share};
 use super::never_settles::{
     Criteria, FIRST_REVS, LAG, NeverSettles, RepeatWatch, Stroboscope, WINDOW,
 };
 use super::reference::{
-    a_ref, balancing_error, plane_a_refs, plane_balancing_errors, plane_whirls,
-    reference_unbalance, vibration,
+    a_ref, balancing_error, plane_a_refs, plane_balancing_errors, reference_unbalance, vibration,
 };
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
@@ -33,7 +34,7 @@ mod twins;
 mod window;
 
 pub use series::Series;
-use tail::{CONTACT_MARGIN, READY_FRACTION, TailPlan};
+use tail::{CONTACT_MARGIN, TailPlan};
 use twins::{coincident_pair, identical_pairs};
 use window::{Hold, SquareRing, inside};
 
@@ -94,6 +95,25 @@ pub struct SettlingObserver<'a> {
     /// The certificate that ended the run as never settling, the boundary
     /// time and the state there.
     never: Option<(NeverSettles, f64, Vec<f64>)>,
+}
+
+/// One step of the per-sample pipeline ([`SettlingObserver::PARTS`]).
+type Part<'a> = fn(&mut SettlingObserver<'a>, &mut Sample) -> Flow;
+
+/// What one sample measured, handed to each part in turn; the planes' part
+/// adds its verdict for the whirl's hold.
+struct Sample {
+    t: f64,
+    /// The whirl r.
+    r: f64,
+    /// ε, when it was computed rather than decided by a bound.
+    eps: Option<f64>,
+    /// ε ≤ δ.
+    eps_inside: bool,
+    /// At the operating speed.
+    operating: bool,
+    /// Every watched plane inside its band (true for a single plane).
+    planes_inside: bool,
 }
 
 /// Each watched plane's A_ref, its whirl at the latest sample and r² over
@@ -260,8 +280,36 @@ impl<'a> SettlingObserver<'a> {
         out
     }
 
-    /// Process one sample; returns Stop when the run should end.
+    /// Process one sample: measure it, then hand it to each part in turn,
+    /// in [`Self::PARTS`]' order, until one ends the run.
     fn sample(&mut self, t: f64) -> Flow {
+        let mut sample = self.measure(t);
+        for part in Self::PARTS {
+            if part(self, &mut sample) == Flow::Stop {
+                return Flow::Stop;
+            }
+        }
+        Flow::Continue
+    }
+
+    /// The parts a sample passes through, as SciML's `CallbackSet` composes
+    /// callbacks: each one concern, in its own file, reading what the parts
+    /// before it wrote. The order is the measurement's: a diverged sample
+    /// feeds no hold, the planes' verdict feeds the whirl's hold, and only a
+    /// run that has not stopped is watched for repeats or certified.
+    const PARTS: [Part<'a>; 8] = [
+        Self::watch_divergence,
+        Self::watch_twins,
+        Self::watch_planes,
+        Self::hold,
+        Self::record,
+        Self::stop_if_settled,
+        Self::watch_repeats,
+        Self::certify_tail,
+    ];
+
+    /// r, ε (or only whether ε ≤ δ) and the speed at sample time t.
+    fn measure(&mut self, t: f64) -> Sample {
         let operating = self.at_operating_speed(t);
         let lay = self.system.layout();
         let y = &self.scratch;
@@ -278,13 +326,30 @@ impl<'a> SettlingObserver<'a> {
             BandCheck::Decided(inside) => (inside, None),
             BandCheck::Computed(eps) => (eps <= self.options.delta, Some(eps)),
         };
-        if !r.is_finite() || eps.is_some_and(|e| !e.is_finite()) {
+        Sample {
+            t,
+            r,
+            eps,
+            eps_inside,
+            operating,
+            planes_inside: true,
+        }
+    }
+
+    /// A non-finite sample, or a whirl beyond what the unbalance and the
+    /// weights can drive, ends the run as diverged; else the peak and the
+    /// closest approach take the sample.
+    fn watch_divergence(&mut self, s: &mut Sample) -> Flow {
+        let (t, r) = (s.t, s.r);
+        if !r.is_finite() || s.eps.is_some_and(|e| !e.is_finite()) {
             self.diverged = Some(format!("non-finite state at t = {t}"));
             return Flow::Stop;
         }
         self.peak_r = self.peak_r.max(r);
         if let Some(gauge) = &self.gap {
-            self.closest.sample(gauge, psi);
+            let lay = self.system.layout();
+            self.closest
+                .sample(gauge, &self.scratch[lay.head()..lay.nq()]);
         }
         if r > self.options.divergence_factor * self.divergence_scale {
             self.diverged = Some(format!(
@@ -292,93 +357,6 @@ impl<'a> SettlingObserver<'a> {
                 self.options.divergence_factor, self.divergence_scale
             ));
             return Flow::Stop;
-        }
-        if self.merged.is_none() {
-            self.merged = self.coincident().map(|(i, j)| (i, j, t));
-        }
-        self.ring.push(r * r);
-        let mut planes_inside = true;
-        if let Some(pw) = &mut self.planes {
-            plane_whirls(self.system, &self.scratch, &mut pw.r);
-            for (((ring, r), hold), a_ref) in pw
-                .rings
-                .iter_mut()
-                .zip(&pw.r)
-                .zip(&mut pw.holds)
-                .zip(&pw.a_ref)
-            {
-                ring.push(r * r);
-                let inside = *r <= self.options.delta * a_ref;
-                hold.update(t, operating && inside, self.window);
-                planes_inside &= inside;
-            }
-        }
-        self.r_hold
-            .update(t, operating && r <= self.band && planes_inside, self.window);
-        self.eps_hold
-            .update(t, operating && eps_inside, self.window);
-        if let Some(series) = &mut self.series {
-            series.t.push(t);
-            // The rotating frame integrates (u, v): report inertial (x, y).
-            let (x, yy) = match self.frame {
-                Some(w) => {
-                    let (s, c) = (w * t).sin_cos();
-                    (y[0] * c - y[1] * s, y[0] * s + y[1] * c)
-                }
-                None => (y[0], y[1]),
-            };
-            series.x.push(x);
-            series.y.push(yy);
-            series.r.push(r);
-            series.eps.push(eps.unwrap_or(f64::NAN));
-            for (j, p) in psi.iter().enumerate() {
-                series.psi[j].push(*p);
-            }
-        }
-        if self.options.stop_when_settled && self.r_hold.met_at.is_some() {
-            return Flow::Stop;
-        }
-        // A run that settled (and goes on, `stop_when_settled = false`) has
-        // its answer; identical weights that coincided end as `merged` or
-        // not at all.
-        // Revolution boundaries are counted, not computed: a compare per sample.
-        let boundary = self.repeats.is_some() && self.next_index - 1 == self.next_watch;
-        if boundary {
-            self.next_watch += self.per_rev();
-        }
-        if boundary && self.r_hold.met_at.is_none() && self.merged.is_none() && self.watch_open(t) {
-            let state = self.stroboscope(t);
-            // The stroboscope's last entry is the spin rate over ω.
-            let spin_ratio = state.smooth.last().copied().unwrap_or(1.0);
-            let criteria = self.repeat_criteria(t, operating, spin_ratio);
-            if let Some(watch) = &mut self.repeats
-                && let Some(never) = watch.observe(state, criteria)
-                && self.eps_at_horizon(t).is_some()
-            {
-                self.never = Some((never, t, self.scratch.clone()));
-                return Flow::Stop;
-            }
-        }
-        if self.certifier.is_none() {
-            return Flow::Continue;
-        }
-        let Some(start) = self.r_hold.stretch_start else {
-            return Flow::Continue;
-        };
-        // Linearising costs a Newton solve: only once r is deep inside the
-        // band, and never with two weights within CONTACT_MARGIN of touching
-        // (the kink of the contact law, where no linearisation holds).
-        let wants = self
-            .certifier
-            .as_ref()
-            .is_some_and(|c| c.wants_to_start(t, start));
-        let ready =
-            wants && self.recent_peak() <= READY_FRACTION * self.band && self.contacts_settled();
-        if let Some(certifier) = &mut self.certifier
-            && let Some(tracked) =
-                certifier.observe(t, &self.scratch, r / self.a_ref, Some(start), ready)
-        {
-            return self.end_on_flow(&tracked);
         }
         Flow::Continue
     }

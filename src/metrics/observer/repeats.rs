@@ -5,6 +5,34 @@
 use super::*;
 
 impl SettlingObserver<'_> {
+    /// The part that, once per revolution, asks the watch whether the state
+    /// repeats outside the band; a certain repeat ends the run.
+    pub(super) fn watch_repeats(&mut self, s: &mut Sample) -> Flow {
+        // A run that settled (and goes on, `stop_when_settled = false`) has
+        // its answer; identical weights that coincided end as `merged` or
+        // not at all.
+        // Revolution boundaries are counted, not computed: a compare per sample.
+        let t = s.t;
+        let boundary = self.repeats.is_some() && self.next_index - 1 == self.next_watch;
+        if boundary {
+            self.next_watch += self.per_rev();
+        }
+        if boundary && self.r_hold.met_at.is_none() && self.merged.is_none() && self.watch_open(t) {
+            let state = self.stroboscope(t);
+            // The stroboscope's last entry is the spin rate over ω.
+            let spin_ratio = state.smooth.last().copied().unwrap_or(1.0);
+            let criteria = self.repeat_criteria(t, s.operating, spin_ratio);
+            if let Some(watch) = &mut self.repeats
+                && let Some(never) = watch.observe(state, criteria)
+                && self.eps_at_horizon(t).is_some()
+            {
+                self.never = Some((never, t, self.scratch.clone()));
+                return Flow::Stop;
+            }
+        }
+        Flow::Continue
+    }
+
     /// Whether, at revolution boundary t, the horizon is more than a hold
     /// window away (a later hold could still complete before it).
     pub(super) fn watch_open(&self, t: f64) -> bool {

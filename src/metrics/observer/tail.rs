@@ -33,6 +33,34 @@ const TAIL_CHECK_STRIDE: usize = 4;
 pub(super) const READY_FRACTION: f64 = 0.2;
 
 impl SettlingObserver<'_> {
+    /// The part that, inside the band, tracks the linearised flow and ends
+    /// the run when it certifies the rest of the hold window.
+    pub(super) fn certify_tail(&mut self, s: &mut Sample) -> Flow {
+        if self.certifier.is_none() {
+            return Flow::Continue;
+        }
+        let Some(start) = self.r_hold.stretch_start else {
+            return Flow::Continue;
+        };
+        let t = s.t;
+        // Linearising costs a Newton solve: only once r is deep inside the
+        // band, and never with two weights within CONTACT_MARGIN of touching
+        // (the kink of the contact law, where no linearisation holds).
+        let wants = self
+            .certifier
+            .as_ref()
+            .is_some_and(|c| c.wants_to_start(t, start));
+        let ready =
+            wants && self.recent_peak() <= READY_FRACTION * self.band && self.contacts_settled();
+        if let Some(certifier) = &mut self.certifier
+            && let Some(tracked) =
+                certifier.observe(t, &self.scratch, s.r / self.a_ref, Some(start), ready)
+        {
+            return self.end_on_flow(&tracked);
+        }
+        Flow::Continue
+    }
+
     /// The run has tracked a flow up to this sample: if the flow bounds the
     /// rest of the hold window (see [`super::certify`]), take its samples
     /// for the rest and stop; otherwise go on integrating, and tell the

@@ -1,7 +1,8 @@
 //! Identical weights that meet: the pairs that can coincide, and the test
 //! that two did (docs/model.md, "Identical weights that meet").
 
-use super::SettlingObserver;
+use super::{Sample, SettlingObserver};
+use crate::integrate::Flow;
 
 /// Pairs (i, j) of weights in the same plane with identical parameters:
 /// the only ones whose states can become equal and then stay equal. With
@@ -55,6 +56,15 @@ pub(super) fn coincident_pair(
 }
 
 impl SettlingObserver<'_> {
+    /// The part that notes the first pair of identical weights to coincide,
+    /// and when.
+    pub(super) fn watch_twins(&mut self, s: &mut Sample) -> Flow {
+        if self.merged.is_none() {
+            self.merged = self.coincident().map(|(i, j)| (i, j, s.t));
+        }
+        Flow::Continue
+    }
+
     /// The first pair of identical weights whose angles (mod 2π) and rates
     /// are equal to the last bits in the scratch state, if any.
     pub(super) fn coincident(&self) -> Option<(usize, usize)> {

@@ -1,5 +1,10 @@
 //! The hold window: r² of its latest samples (for the residual, an RMS)
-//! and the "holds continuously" rule that decides settling.
+//! and the "holds continuously" rule that decides settling; the parts that
+//! hold each sample to it, per watched plane and for the whole rotor.
+
+use super::{Sample, SettlingObserver};
+use crate::integrate::Flow;
+use crate::metrics::reference::plane_whirls;
 
 /// r² of the last hold window's samples, for the residual (an RMS).
 #[derive(Debug, Clone)]
@@ -100,6 +105,52 @@ impl Hold {
         match self.met_at {
             Some(t) => (Some(t), true),
             None => (self.stretch_start, false),
+        }
+    }
+}
+
+impl SettlingObserver<'_> {
+    /// The part that holds each watched plane (rotors with several) to its
+    /// own band; the sample is inside only when every plane is.
+    pub(super) fn watch_planes(&mut self, s: &mut Sample) -> Flow {
+        if let Some(pw) = &mut self.planes {
+            plane_whirls(self.system, &self.scratch, &mut pw.r);
+            for (((ring, r), hold), a_ref) in pw
+                .rings
+                .iter_mut()
+                .zip(&pw.r)
+                .zip(&mut pw.holds)
+                .zip(&pw.a_ref)
+            {
+                ring.push(r * r);
+                let inside = *r <= self.options.delta * a_ref;
+                hold.update(s.t, s.operating && inside, self.window);
+                s.planes_inside &= inside;
+            }
+        }
+        Flow::Continue
+    }
+
+    /// The part that keeps the window's r² and updates the r and ε holds.
+    pub(super) fn hold(&mut self, s: &mut Sample) -> Flow {
+        self.ring.push(s.r * s.r);
+        self.r_hold.update(
+            s.t,
+            s.operating && s.r <= self.band && s.planes_inside,
+            self.window,
+        );
+        self.eps_hold
+            .update(s.t, s.operating && s.eps_inside, self.window);
+        Flow::Continue
+    }
+
+    /// The part that ends a settled run when the options say so (after the
+    /// sample is recorded).
+    pub(super) fn stop_if_settled(&mut self, _: &mut Sample) -> Flow {
+        if self.options.stop_when_settled && self.r_hold.met_at.is_some() {
+            Flow::Stop
+        } else {
+            Flow::Continue
         }
     }
 }
