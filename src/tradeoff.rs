@@ -32,7 +32,7 @@ pub struct Setting {
 impl Setting {
     /// "rotating/radau5/1e-6".
     pub fn label(&self) -> String {
-        if matches!(self.fidelity, Fidelity::Analytic | Fidelity::Linear) {
+        if self.fidelity.is_estimate() {
             self.fidelity.name().into()
         } else {
             format!(
@@ -49,7 +49,7 @@ impl Setting {
     /// The study-file keys that select this setting, as a user writes them.
     pub fn keys(&self) -> String {
         let fidelity = format!("[solver] fidelity = \"{}\"", self.fidelity.name());
-        if matches!(self.fidelity, Fidelity::Analytic | Fidelity::Linear) {
+        if self.fidelity.is_estimate() {
             fidelity
         } else {
             format!(

@@ -242,4 +242,10 @@ impl Fidelity {
             Fidelity::Auto => "auto",
         }
     }
+
+    /// A rung that predicts settling in closed form or from the linear
+    /// analysis, integrating nothing: its runs are estimates.
+    pub fn is_estimate(self) -> bool {
+        matches!(self, Fidelity::Analytic | Fidelity::Linear)
+    }
 }

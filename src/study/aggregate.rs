@@ -86,11 +86,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
     };
     let criterion = plan.file.summary.rank_by;
     // The analytic and linear rungs predict settling; they integrate nothing.
-    let estimated = matches!(
-        plan.file.solver.fidelity,
-        crate::simulation::settings::Fidelity::Analytic
-            | crate::simulation::settings::Fidelity::Linear
-    );
+    let estimated = plan.file.solver.fidelity.is_estimate();
     let verdicts = best_versus_rest(
         &by_design,
         criterion,
