@@ -3,6 +3,7 @@
 //! output and early stop, and stiffness detection with the switch to the
 //! implicit method. A [`Stepper`] supplies only the method itself.
 
+use super::cost::{CostTrial, StallWindow, TRIAL_STEPS, TrialWindow};
 use super::norm::check_step;
 use super::stepper::{Stepper, Trial};
 use super::stiffness::{StiffnessWatch, Verdict};
@@ -15,7 +16,10 @@ const WALL_CHECK_EVERY: u64 = 256;
 
 /// Run `St` from (t0, y0) towards t_end until it finishes, the observer
 /// stops it or it fails. The observer's `start` is the caller's business, so
-/// that a run can continue in a second segment with another stepper.
+/// that a run can continue in a second segment with another stepper. With a
+/// `trial`, the segment stops with [`Failure::Dearer`] when it proves
+/// dearer than the method it took over from.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn drive<St, S, O>(
     system: &S,
     t0: f64,
@@ -24,6 +28,7 @@ pub(super) fn drive<St, S, O>(
     options: &SolverOptions,
     deadline: Option<std::time::Instant>,
     observer: &mut O,
+    trial: Option<CostTrial>,
 ) -> SolveReport
 where
     St: Stepper,
@@ -35,17 +40,20 @@ where
     let mut y = y0.to_vec();
     let h_max = options.h_max.min(t_end - t0);
     let watch_stiffness = options.stiffness.is_watched();
-    let report = |status, t, y, stats| SolveReport {
+    let mut window = StallWindow::new(t0, 0);
+    let mut trial_window = TrialWindow::new(t0, 0);
+    let report = |status, t, y, stats, window: &StallWindow| SolveReport {
         status,
         t,
         y,
         stats,
         switched: None,
+        cost_rate: window.rate(),
     };
 
     let mut h = match stepper.start(system, t0, &y, h_max, &mut stats) {
         Ok(h) => h.min(h_max),
-        Err(f) => return report(Status::Failed(f), t0, y, stats),
+        Err(f) => return report(Status::Failed(f), t0, y, stats, &window),
     };
     let mut t = t0;
     let mut last_rejected = false;
@@ -53,7 +61,7 @@ where
 
     loop {
         if let Err(f) = check_step(t, h, &stats, options) {
-            return report(Status::Failed(f), t, y, stats);
+            return report(Status::Failed(f), t, y, stats, &window);
         }
         // The clock is read every WALL_CHECK_EVERY attempts: a few ns per step.
         if let Some(deadline) = deadline
@@ -62,14 +70,14 @@ where
         {
             let limit_s = options.max_wall.map_or(0.0, |d| d.as_secs_f64());
             let f = Failure::WallTimeExceeded { t, limit_s };
-            return report(Status::Failed(f), t, y, stats);
+            return report(Status::Failed(f), t, y, stats, &window);
         }
         let last = t + stepper.end_stretch() * h >= t_end;
         if last {
             h = t_end - t;
         }
         let h_new = match stepper.attempt(system, t, &y, h, &mut stats) {
-            Trial::Failed(f) => return report(Status::Failed(f), t, y, stats),
+            Trial::Failed(f) => return report(Status::Failed(f), t, y, stats, &window),
             Trial::Rejected { h_new } => {
                 stats.rejected += 1;
                 h = h_new;
@@ -87,14 +95,14 @@ where
             }
             if verdict == Verdict::Stiff {
                 let f = Failure::StiffnessDetected { t };
-                return report(Status::Failed(f), t, y, stats);
+                return report(Status::Failed(f), t, y, stats, &window);
             }
         }
         let t_prev = t;
         let committed = stepper.accept(system, t, h, &mut y, &mut stats);
         t = t_prev + h;
         if let Err(f) = committed {
-            return report(Status::Failed(f), t, y, stats);
+            return report(Status::Failed(f), t, y, stats, &window);
         }
         let flow = observer.step(&Step {
             t_prev,
@@ -102,14 +110,26 @@ where
             y: &y,
             dense: stepper.dense(),
         });
+        window.record(t, stats.rhs_calls);
+        if trial.is_some() {
+            trial_window.record(t, stats.rhs_calls);
+        }
         if flow == Flow::Stop {
-            return report(Status::Stopped, t, y, stats);
+            return report(Status::Stopped, t, y, stats, &window);
         }
         if last || t >= t_end {
-            return report(Status::Finished, t, y, stats);
+            return report(Status::Finished, t, y, stats, &window);
+        }
+        if let Some(trial) = &trial
+            && stats.steps.is_multiple_of(TRIAL_STEPS)
+            && let Some(rate) = trial_window.rate()
+            && let Some(ratio) = trial.dearer(rate)
+        {
+            let f = Failure::Dearer { t, rate, ratio };
+            return report(Status::Failed(f), t, y, stats, &window);
         }
         if let Err(f) = stepper.advance(system, t, &y, &mut stats) {
-            return report(Status::Failed(f), t, y, stats);
+            return report(Status::Failed(f), t, y, stats, &window);
         }
         // A step right after a rejection does not grow (Hairer).
         let mut h_next = h_new.min(h_max);

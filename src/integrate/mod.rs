@@ -14,6 +14,7 @@
 //! `docs/integrators.md` for the numbers).
 
 pub mod controller;
+mod cost;
 pub mod dop853;
 pub mod dp5;
 mod driver;
@@ -194,10 +195,11 @@ macro_rules! method_registry {
             options: &SolverOptions,
             deadline: Option<std::time::Instant>,
             observer: &mut O,
+            trial: Option<cost::CostTrial>,
         ) -> SolveReport {
             match method {
                 $( Method::$variant => driver::drive::<$stepper, _, _>(
-                    system, t0, y0, t_end, options, deadline, observer,
+                    system, t0, y0, t_end, options, deadline, observer, trial,
                 ), )*
             }
         }
@@ -275,6 +277,10 @@ pub struct SolverOptions {
     /// when it has many ring coordinates: O(m) instead of O(m³) work, the
     /// same answer up to the finite differences' accuracy.
     pub structured_newton: bool,
+    /// After a hand-over to Radau5 ([`Stiffness::SwitchToImplicit`]), return
+    /// to the explicit method for the rest of the run when Radau5 proves
+    /// dearer in RHS calls per unit time (see `cost.rs`).
+    pub return_when_dearer: bool,
 }
 
 /// What the driver does about stiffness met by an explicit method.
@@ -310,6 +316,7 @@ impl Default for SolverOptions {
             stiffness: Stiffness::Ignore,
             reduce_second_order: true,
             structured_newton: true,
+            return_when_dearer: true,
         }
     }
 }
@@ -384,6 +391,18 @@ pub enum Failure {
         /// Time reached.
         t: f64,
     },
+    /// A method that took over from another made more RHS calls per unit
+    /// time than the other had (by `ratio`): the run changes back
+    /// ([`SolverOptions::return_when_dearer`]).
+    #[error("{ratio:.1} times the other method's RHS calls per unit time at t = {t}")]
+    Dearer {
+        /// Time reached.
+        t: f64,
+        /// This method's RHS calls per unit time.
+        rate: f64,
+        /// Over the other method's.
+        ratio: f64,
+    },
     /// The problem itself is malformed (e.g. wrong atol length).
     #[error("invalid problem: {0}")]
     Invalid(String),
@@ -413,6 +432,9 @@ pub struct SolveReport {
     pub stats: Stats,
     /// When the explicit method handed over to Radau5 ([`Stiffness::SwitchToImplicit`]).
     pub switched: Option<Switch>,
+    /// RHS calls per unit time over the last segment's latest accepted
+    /// steps (`None` for a segment too short to say).
+    pub cost_rate: Option<f64>,
 }
 
 /// A hand-over from an explicit method to the implicit one during a run.
@@ -426,6 +448,29 @@ pub struct Switch {
     pub why: Failure,
     /// Work done by the explicit method before the hand-over.
     pub before: Stats,
+    /// When Radau5 proved dearer and the run returned to the explicit method
+    /// ([`SolverOptions::return_when_dearer`]).
+    pub back: Option<Return>,
+}
+
+/// A return from Radau5 to the explicit method, when Radau5 proved dearer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Return {
+    /// Time of the return.
+    pub t: f64,
+    /// Radau5's RHS calls per unit time over the explicit method's.
+    pub ratio: f64,
+}
+
+impl SolveReport {
+    /// The method the run ended on, begun with `method`.
+    pub fn ended_with(&self, method: Method) -> Method {
+        match &self.switched {
+            Some(Switch { back: Some(_), .. }) => method,
+            Some(_) => IMPLICIT_FALLBACK,
+            None => method,
+        }
+    }
 }
 
 /// Integrate `system` from (t0, y0) to t_end with `method`, reporting every
@@ -445,13 +490,16 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
         y: y.to_vec(),
         stats,
         switched: None,
+        cost_rate: None,
     };
     if let Err(reason) = norm::validate(system.dim(), y0, t0, t_end, options) {
         return invalid(reason, t0, y0, Stats::default());
     }
     observer.start(t0, y0);
     let deadline = options.max_wall.map(|d| std::time::Instant::now() + d);
-    let first = drive_method(method, system, t0, y0, t_end, options, deadline, observer);
+    let first = drive_method(
+        method, system, t0, y0, t_end, options, deadline, observer, None,
+    );
     let switch = options.stiffness == Stiffness::SwitchToImplicit
         && !method.is_implicit()
         && driver::stalled(&first.status);
@@ -466,6 +514,13 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     if let Err(reason) = norm::validate(system.dim(), &first.y, first.t, t_end, options) {
         return invalid(reason, first.t, &first.y, first.stats);
     }
+    let trial = first
+        .cost_rate
+        .filter(|_| options.return_when_dearer)
+        .map(|rival_rate| cost::CostTrial {
+            rival_rate,
+            margin: cost::DEARER_BY,
+        });
     let mut rest = drive_method(
         IMPLICIT_FALLBACK,
         system,
@@ -475,13 +530,31 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
         options,
         deadline,
         observer,
+        trial,
     );
+    let mut back = None;
+    if let Status::Failed(Failure::Dearer { t, ratio, .. }) = rest.status {
+        // Back for the rest of the run, deaf to stiffness: the measured cost
+        // says the explicit method is the cheaper one here.
+        let deaf = SolverOptions {
+            stiffness: Stiffness::Ignore,
+            ..options.clone()
+        };
+        let last = drive_method(
+            method, system, rest.t, &rest.y, t_end, &deaf, deadline, observer, None,
+        );
+        let implicit = rest.stats;
+        rest = last;
+        rest.stats += implicit;
+        back = Some(Return { t, ratio });
+    }
     rest.stats += first.stats;
     rest.switched = Some(Switch {
         from: method,
         t: first.t,
         why,
         before: first.stats,
+        back,
     });
     rest
 }

@@ -41,9 +41,14 @@ pub struct SolverSettings {
     /// as `budget_exceeded` and the study goes on.
     pub max_wall_seconds: f64,
     /// When an explicit method finds the problem stiff, runs out of steps or
-    /// underflows its step size, re-run the whole simulation with Radau5 and
+    /// underflows its step size, continue the run from there with Radau5 and
     /// record the switch (`method` becomes e.g. "dp5→radau5").
     pub implicit_fallback: bool,
+    /// After that hand-over, return to the explicit method for the rest of
+    /// the run when Radau5 makes more than 1.5 times the RHS calls per unit
+    /// time the explicit method made just before it (as on a contact law's
+    /// kink); `method` becomes e.g. "dp5→radau5→dp5".
+    pub return_when_dearer: bool,
     /// Radau5 solves its full Newton systems instead of the reduced ones of
     /// a second-order system (the reference for the reduction's test; not a
     /// file key).
@@ -66,6 +71,7 @@ impl Default for SolverSettings {
             max_steps: 5_000_000,
             max_wall_seconds: 600.0,
             implicit_fallback: true,
+            return_when_dearer: true,
             full_newton: false,
             dense_newton: false,
         }

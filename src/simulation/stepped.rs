@@ -14,7 +14,7 @@
 //! measures the steady amplitude at each speed before stepping on.
 
 use super::Simulation;
-use crate::integrate::{IMPLICIT_FALLBACK, NoObserver, Status, solve};
+use crate::integrate::{NoObserver, Status, solve};
 use crate::metrics::bearing_orbit::{Orbit, integrate_revolution};
 use crate::metrics::reference::{a_ref, balancing_error, reference_unbalance};
 use crate::model::forced::{harmonic_response, plane_orbit_radius, unbalance_forcing};
@@ -153,7 +153,7 @@ impl Simulation {
                 why,
             };
             // Up to the last revolution (none when the dwell is exactly one).
-            let (t_settled, y_settled, switched) = if dwell > rev {
+            let (t_settled, y_settled, measure_with) = if dwell > rev {
                 let settle = solve(
                     method,
                     &system,
@@ -166,11 +166,11 @@ impl Simulation {
                 if let Status::Failed(why) = &settle.status {
                     return Err(fail(why.to_string(), &points));
                 }
-                (settle.t, settle.y, settle.switched.is_some())
+                let ended_with = settle.ended_with(method);
+                (settle.t, settle.y, ended_with)
             } else {
-                (t0, y0, false)
+                (t0, y0, method)
             };
-            let measure_with = if switched { IMPLICIT_FALLBACK } else { method };
             let watch = system.watch_maps().to_vec();
             let bearings = system.rotor().bearing_maps();
             let maps: Vec<_> = watch.iter().chain(&bearings).copied().collect();

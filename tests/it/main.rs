@@ -44,6 +44,7 @@ mod race_eccentricity;
 mod report;
 mod results_columns;
 mod results_folder;
+mod return_when_dearer;
 mod rolling_resistance;
 mod sample_bounds;
 mod schema;
