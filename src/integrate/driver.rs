@@ -4,6 +4,7 @@
 //! implicit method. A [`Stepper`] supplies only the method itself.
 
 use super::cost::{CostTrial, StallWindow, TRIAL_STEPS, TrialWindow};
+use super::events::{EventFlow, crossed, first_root};
 use super::norm::check_step;
 use super::stepper::{Stepper, Trial};
 use super::stiffness::{StiffnessWatch, Verdict};
@@ -58,6 +59,18 @@ where
     let mut t = t0;
     let mut last_rejected = false;
     let mut watch = StiffnessWatch::new(St::STIFF_BOUND);
+    // The events' values at the current point, a step's end, and scratch.
+    let events = system.events();
+    let n_events = events.map_or(0, |e| e.count());
+    let (mut g_now, mut g_end, mut g_probe) = (
+        vec![0.0; n_events],
+        vec![0.0; n_events],
+        vec![0.0; n_events],
+    );
+    let mut probe = vec![0.0; if n_events > 0 { y.len() } else { 0 }];
+    if let Some(ev) = events {
+        ev.values(t, &y, &mut g_now);
+    }
 
     loop {
         if let Err(f) = check_step(t, h, &stats, options) {
@@ -104,6 +117,33 @@ where
         if let Err(f) = committed {
             return report(Status::Failed(f), t, y, stats, &window);
         }
+        // The earliest event within the step, if any: the step ends there.
+        let mut event = None;
+        if let Some(ev) = events {
+            ev.values(t, &y, &mut g_end);
+            for k in 0..n_events {
+                if !crossed(g_now[k], g_end[k]) {
+                    continue;
+                }
+                let dense = stepper.dense();
+                let at = first_root(
+                    |s| {
+                        dense.eval(s, &mut probe);
+                        ev.values(s, &probe, &mut g_probe);
+                        g_probe[k]
+                    },
+                    (t_prev, g_now[k]),
+                    (t, g_end[k]),
+                );
+                if event.is_none_or(|(first, _)| at < first) {
+                    event = Some((at, k));
+                }
+            }
+            if let Some((at, _)) = event {
+                t = at;
+                stepper.dense().eval(at, &mut y);
+            }
+        }
         let flow = observer.step(&Step {
             t_prev,
             t,
@@ -117,6 +157,22 @@ where
         if flow == Flow::Stop {
             return report(Status::Stopped, t, y, stats, &window);
         }
+        if let (Some(ev), Some((_, k))) = (events, event) {
+            // The system acts at the event; the method starts afresh from
+            // the state it leaves (its history belongs to the old one).
+            if ev.handle(t, &mut y, k, g_now[k] > 0.0) == EventFlow::Stop {
+                return report(Status::Stopped, t, y, stats, &window);
+            }
+            ev.values(t, &y, &mut g_now);
+            h = match stepper.start(system, t, &y, h_max.min(t_end - t), &mut stats) {
+                Ok(h0) => h0.min(h_max),
+                Err(f) => return report(Status::Failed(f), t, y, stats, &window),
+            };
+            watch = StiffnessWatch::new(St::STIFF_BOUND);
+            last_rejected = false;
+            continue;
+        }
+        std::mem::swap(&mut g_now, &mut g_end);
         if last || t >= t_end {
             return report(Status::Finished, t, y, stats, &window);
         }

@@ -18,6 +18,7 @@ mod cost;
 pub mod dop853;
 pub mod dp5;
 mod driver;
+pub mod events;
 pub(crate) mod lu;
 mod newton_matrices;
 pub mod norm;
@@ -26,6 +27,7 @@ pub mod stepper;
 mod stiffness;
 mod structured_newton;
 
+pub use events::{EventFlow, Events};
 pub use stepper::{Stepper, Trial};
 
 use serde::{Deserialize, Serialize};
@@ -61,6 +63,12 @@ pub trait OdeSystem {
     /// differences of the right-hand side, which cost a call per use.
     fn head_equation(&self, _t: f64, _y: &[f64], _f: &[f64], _out: &mut HeadEquation) -> bool {
         false
+    }
+    /// The system's events ([`events`]): functions whose zero crossings
+    /// the driver locates and lets the system act on. None (the default):
+    /// a smooth system.
+    fn events(&self) -> Option<&dyn Events> {
+        None
     }
 }
 

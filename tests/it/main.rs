@@ -19,6 +19,7 @@ mod decisions;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;
+mod events;
 mod every_rotor;
 mod extremes;
 mod fixtures;

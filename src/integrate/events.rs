@@ -1,0 +1,117 @@
+//! Events of a hybrid system, as SciPy's `solve_ivp(events=…)` and Hairer's
+//! SOLOUT locate them: state functions g_k(t, y) whose zero crossing changes
+//! the system (an impact, a contact that opens) or ends the run. After each
+//! accepted step the driver compares every g_k at the step's two ends; where
+//! one changed sign it finds the crossing on the step's dense output, hands
+//! the observer the step up to it, lets the system change its state there,
+//! and restarts the method from that state.
+//!
+//! Like SciPy's, the test sees sign changes at step ends only: a function
+//! that crosses zero twice within one step is not seen. Written here because
+//! the root is sought on this crate's own dense output (no root-finding
+//! crate takes an interpolant by reference without allocating per call).
+
+/// What the run does after an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventFlow {
+    /// Go on from the (possibly changed) state.
+    Continue,
+    /// End the run at the event.
+    Stop,
+}
+
+/// The event functions of a hybrid system and what happens at their zeros.
+pub trait Events {
+    /// Number of event functions.
+    fn count(&self) -> usize;
+    /// g_k(t, y) for every k into `out` (length [`Events::count`]).
+    fn values(&self, t: f64, y: &[f64], out: &mut [f64]);
+    /// Function `k` reached zero at (t, y), falling (from positive) when
+    /// `falling`: change `y` in place (an impulse, a new mode) and say
+    /// whether the run goes on.
+    fn handle(&self, t: f64, y: &mut [f64], k: usize, falling: bool) -> EventFlow;
+}
+
+/// Whether g went from one side of zero to the other (or onto it) between
+/// two step ends; a function that starts the step at zero (just handled)
+/// has not crossed.
+pub(crate) fn crossed(before: f64, after: f64) -> bool {
+    (before > 0.0 && after <= 0.0) || (before < 0.0 && after >= 0.0)
+}
+
+/// Iterations of the root search at most: the Illinois method gains about
+/// 1.44 digits per evaluation; 100 halve any bracket well past rounding.
+const MAX_ITERATIONS: usize = 100;
+
+/// The time in (a, b] at which g, continuous with g(a) = ga and g(b) = gb of
+/// opposite signs (or gb = 0), reaches zero: the Illinois variant of regula
+/// falsi (Dowell and Jarratt 1971), to within a few units of rounding in t.
+/// The result is the bracket's end on the far side, so that the state there
+/// has crossed.
+pub(crate) fn first_root(
+    mut g: impl FnMut(f64) -> f64,
+    (mut a, mut ga): (f64, f64),
+    (mut b, mut gb): (f64, f64),
+) -> f64 {
+    if gb == 0.0 {
+        return b;
+    }
+    // Which end was retained last: -1 a, +1 b (halve its value, Illinois).
+    let mut side = 0i8;
+    for _ in 0..MAX_ITERATIONS {
+        let tol = 4.0 * f64::EPSILON * a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+        if b - a <= tol {
+            break;
+        }
+        let mut t = b - gb * (b - a) / (gb - ga);
+        // Stay strictly inside: a secant on rounding-level values can land
+        // on an end.
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+        let gt = g(t);
+        if gt == 0.0 {
+            return t;
+        }
+        if (gt > 0.0) == (ga > 0.0) {
+            a = t;
+            ga = gt;
+            if side == -1 {
+                gb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = t;
+            gb = gt;
+            if side == 1 {
+                ga *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_root_of_a_smooth_function_is_found_to_rounding() {
+        // "To rounding": within the search's own 4 ε·|t|.
+        let within = |t: f64, want: f64| (t - want).abs() <= 4.0 * f64::EPSILON * want;
+        let root = first_root(f64::cos, (0.0, 1.0), (3.0, 3f64.cos()));
+        assert!(within(root, std::f64::consts::FRAC_PI_2), "{root}");
+        // A flat end (the plain secant would crawl from one side).
+        let g = |t: f64| t.powi(5) - 0.5;
+        let root = first_root(g, (0.0, -0.5), (2.0, g(2.0)));
+        assert!(within(root, 0.5f64.powf(0.2)), "{root}");
+        assert!(g(root) >= 0.0, "the far side of the crossing");
+    }
+
+    #[test]
+    fn a_crossing_is_a_change_of_side() {
+        assert!(crossed(1.0, -1.0) && crossed(-1.0, 2.0) && crossed(1.0, 0.0));
+        assert!(!crossed(0.0, -1.0) && !crossed(1.0, 2.0) && !crossed(-1.0, -0.5));
+    }
+}
