@@ -27,6 +27,9 @@ pub struct Setting {
     pub method: MethodChoice,
     /// Relative tolerance (0 for the analytic estimate).
     pub rtol: f64,
+    /// Whether a run handed over to Radau5 may return to the explicit
+    /// method (`[solver] return_when_dearer`).
+    pub return_when_dearer: bool,
 }
 
 impl Setting {
@@ -35,8 +38,13 @@ impl Setting {
         if self.fidelity.is_estimate() {
             self.fidelity.name().into()
         } else {
+            let kept = if self.return_when_dearer {
+                ""
+            } else {
+                "/kept on radau5"
+            };
             format!(
-                "{}/{}/{:.0e}",
+                "{}/{}/{:.0e}{kept}",
                 self.fidelity.name(),
                 self.method.name(),
                 self.rtol
@@ -52,8 +60,13 @@ impl Setting {
         if self.fidelity.is_estimate() {
             fidelity
         } else {
+            let kept = if self.return_when_dearer {
+                ""
+            } else {
+                ", return_when_dearer = false"
+            };
             format!(
-                "{fidelity}, method = \"{}\", rtol = {:.0e}",
+                "{fidelity}, method = \"{}\", rtol = {:.0e}{kept}",
                 self.method.name(),
                 self.rtol
             )
@@ -119,12 +132,14 @@ pub struct SettingSummary {
 }
 
 /// The settings swept: analytic; linear; each applicable frame with its default
-/// method at rtol 1e-3 … 1e-10; and DOP853 in the inertial frame.
+/// method at rtol 1e-3 … 1e-10; DOP853 in the inertial frame; and DP5 in the
+/// inertial frame at the study's rtol kept on Radau5 once handed over.
 pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
     let estimate = |fidelity| Setting {
         fidelity,
         method: MethodChoice::Auto,
         rtol: 0.0,
+        return_when_dearer: true,
     };
     let mut v = Vec::new();
     let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
@@ -146,8 +161,20 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
                 fidelity,
                 method,
                 rtol: 10f64.powi(-e),
+                return_when_dearer: true,
             });
         }
+    }
+    // Where inertial runs may return from Radau5, the same runs kept on
+    // Radau5, at the study's tolerance: what the return costs in answers.
+    let solver = &plan.file.solver;
+    if solver.implicit_fallback && solver.return_when_dearer {
+        v.push(Setting {
+            fidelity: Fidelity::Full,
+            method: MethodChoice::Fixed(Method::Dp5),
+            rtol: solver.rtol,
+            return_when_dearer: false,
+        });
     }
     v
 }
@@ -159,6 +186,7 @@ fn simulate(plan: &StudyPlan, run_id: u64, setting: Setting) -> (RunMetrics, f64
     let (_, mut sim) = sample_simulation(plan, design, run_id % samples);
     sim.solver.fidelity = setting.fidelity;
     sim.solver.method = setting.method;
+    sim.solver.return_when_dearer = setting.return_when_dearer;
     if setting.rtol > 0.0 {
         sim.solver.rtol = setting.rtol;
         sim.solver.atol = None;
@@ -184,6 +212,7 @@ pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
         fidelity: Fidelity::Full,
         method: MethodChoice::Fixed(Method::Dop853),
         rtol: 1e-11,
+        return_when_dearer: true,
     };
     let mut rows = Vec::new();
     let samples = u64::from(plan.file.sampling.samples);
@@ -364,6 +393,12 @@ pub fn rows_frame(rows: &[TradeoffRow]) -> PolarsResult<DataFrame> {
             Column::new(
                 "rtol".into(),
                 rows.iter().map(|r| r.setting.rtol).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                "return_when_dearer".into(),
+                rows.iter()
+                    .map(|r| r.setting.return_when_dearer)
+                    .collect::<Vec<_>>(),
             ),
             Column::new(
                 "settling_revs".into(),

@@ -84,6 +84,13 @@ pub fn read_tradeoff(path: &Path) -> Result<Vec<TradeoffPoint>, PlotError> {
                 .collect()
         })
     });
+    // Runs kept on Radau5 once handed over are a series of their own (a
+    // table written before the column existed has none).
+    let kept: Option<Vec<bool>> = df.column("return_when_dearer").ok().and_then(|c| {
+        c.bool()
+            .ok()
+            .map(|b| b.iter().map(|v| v == Some(false)).collect())
+    });
     let fidelity: Vec<String> = column("fidelity")?
         .str()
         .map_err(|_| PlotError::invalid(format!("{shown}: column 'fidelity'"), "must be text"))?
@@ -100,9 +107,10 @@ pub fn read_tradeoff(path: &Path) -> Result<Vec<TradeoffPoint>, PlotError> {
         .filter(|&i| rhs[i] > 0.0)
         .filter_map(|i| {
             Some(TradeoffPoint {
-                fidelity: match &method {
-                    Some(m) => format!("{}/{}", fidelity[i], m[i]),
-                    None => fidelity[i].clone(),
+                fidelity: match (&method, kept.as_ref().is_some_and(|k| k[i])) {
+                    (Some(m), true) => format!("{}/{} kept on radau5", fidelity[i], m[i]),
+                    (Some(m), false) => format!("{}/{}", fidelity[i], m[i]),
+                    (None, _) => fidelity[i].clone(),
                 },
                 rtol: rtol[i],
                 median_error_revs: error[i]?,

@@ -94,3 +94,45 @@ t_end_revs = 300
         assert!(df.column(c).is_ok(), "{c}");
     }
 }
+
+/// Where runs may return from Radau5, the sweep measures the same runs kept
+/// on Radau5 at the study's tolerance, named by the key that selects it; a
+/// study that already keeps them gets no such setting.
+#[test]
+fn the_sweep_measures_runs_kept_on_radau5_beside_the_return() {
+    let study = |solver: &str| {
+        let text = [
+            SI_SCENE,
+            r#"
+[designs]
+kind = "ball"
+n = 3
+rho = "optimal"
+race_radius = 0.05
+drag = 2.0
+[sampling]
+samples = 1
+unbalance = { distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }
+"#,
+            solver,
+        ]
+        .concat();
+        StudyFile::parse(&text, "t.toml")
+            .unwrap()
+            .plan(&text, "t.toml")
+            .unwrap()
+    };
+    let all = settings(&study("[solver]\nrtol = 1e-7\n"));
+    let kept: Vec<_> = all.iter().filter(|s| !s.return_when_dearer).collect();
+    assert_eq!(kept.len(), 1, "{all:?}");
+    assert_eq!(kept[0].fidelity, Fidelity::Full);
+    assert_eq!(kept[0].rtol, 1e-7);
+    assert_eq!(kept[0].label(), "full/dp5/1e-7/kept on radau5");
+    assert!(
+        kept[0].keys().ends_with("return_when_dearer = false"),
+        "{}",
+        kept[0].keys()
+    );
+    let none = settings(&study("[solver]\nreturn_when_dearer = false\n"));
+    assert!(none.iter().all(|s| s.return_when_dearer), "{none:?}");
+}
