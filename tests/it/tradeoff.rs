@@ -5,17 +5,21 @@ use autobal::simulation::Fidelity;
 use autobal::study::config::StudyFile;
 use autobal::tradeoff::{measure, recommend, rows_frame, settings, spread_runs, summarize};
 
-#[test]
-fn tradeoff_measures_every_setting_and_recommends_within_budget() {
-    let text = &[
-        SI_SCENE,
-        r#"
+/// The designs of both studies here, up to their drag.
+const THREE_BALLS: &str = r#"
 [designs]
 kind = "ball"
 n = 3
 rho = "optimal"
 race_radius = 0.05
-drag = [2.0, 10.0]
+"#;
+
+#[test]
+fn tradeoff_measures_every_setting_and_recommends_within_budget() {
+    let text = &[
+        SI_SCENE,
+        THREE_BALLS,
+        r#"drag = [2.0, 10.0]
 [sampling]
 samples = 2
 unbalance = { distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }
@@ -103,13 +107,8 @@ fn the_sweep_measures_runs_kept_on_radau5_beside_the_return() {
     let study = |solver: &str| {
         let text = [
             SI_SCENE,
-            r#"
-[designs]
-kind = "ball"
-n = 3
-rho = "optimal"
-race_radius = 0.05
-drag = 2.0
+            THREE_BALLS,
+            r#"drag = 2.0
 [sampling]
 samples = 1
 unbalance = { distribution = "uniform", min = 0.2, max = 0.8, relative_to = "capacity" }
