@@ -5,7 +5,8 @@
 //! [`holm`]), censoring-aware settling statistics ([`survival`]: Kaplan–Meier,
 //! its median and restricted mean) and paired comparisons of designs that
 //! share their samples ([`paired`]: win shares, sign and signed-rank tests),
-//! and the rank correlation of two rankings ([`kendall`]).
+//! the rank correlation of two rankings ([`kendall`]), and the spending of
+//! a level over repeated looks at growing data ([`spending`]).
 //!
 //! Nothing here knows about rotors or studies; the analyses (`study`,
 //! `check`, `optimize`, `plot`, `tradeoff`) bring the data.
@@ -20,6 +21,7 @@ pub mod paired;
 pub mod paired_measures;
 pub mod proportion;
 pub mod quantile;
+pub mod spending;
 pub mod survival;
 #[cfg(test)]
 pub(crate) mod test_stream;
