@@ -19,7 +19,7 @@
 
 use super::design::Design;
 use super::distribution::{DirectionSpec, Scale, UnbalanceSpec, draw_value};
-use super::stream::{Purpose, stream};
+use super::stream::{Purpose, Sequence, draws};
 use crate::invalid_key::InvalidKey;
 use crate::model::rotor::RotorModel;
 use crate::model::rotor::two_support::PointUnbalance;
@@ -147,8 +147,7 @@ pub fn validate(
 /// (U_s, θ_s) drawn for it.
 pub fn draw(
     spec: &CoupleSpec,
-    seed: u64,
-    shared: Option<u32>,
+    (seed, shared, sequence): (u64, Option<u32>, Sequence),
     design: &Design,
     sample: u64,
     static_part: (f64, f64),
@@ -166,7 +165,7 @@ pub fn draw(
         .unbalance
         .as_ref()
         .expect("validated: unbalance or follows_static");
-    let mut rng = stream(seed, shared, sample, Purpose::Couple);
+    let mut rng = draws(seed, shared, sample, Purpose::Couple, sequence);
     let value = draw_value(&spec_u.distribution, &mut rng);
     let (unbalance, fraction) = match spec_u.scale() {
         Scale::Capacity => (value * design.capacity, value),

@@ -10,7 +10,6 @@
 use crate::invalid_key::InvalidKey;
 use crate::model::validate::shown;
 use rand::RngExt;
-use rand_xoshiro::Xoshiro256PlusPlus;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -245,7 +244,7 @@ pub fn check(d: &Distribution) -> Result<(), InvalidKey> {
 }
 
 /// One value of distribution `d` from `rng`.
-pub fn draw_value(d: &Distribution, rng: &mut Xoshiro256PlusPlus) -> f64 {
+pub fn draw_value<R: rand::Rng + ?Sized>(d: &Distribution, rng: &mut R) -> f64 {
     match *d {
         Distribution::Fixed { value } => value,
         Distribution::Uniform { min, max } => min + (max - min) * rng.random::<f64>(),

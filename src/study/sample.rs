@@ -11,6 +11,7 @@ use super::config::StudyPlan;
 use super::design::Design;
 pub use super::distribution::draw_value;
 use super::distribution::{DirectionSpec, InitialSpec, Scale};
+use super::stream::{Draws, draws};
 pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
 use crate::design::geometry::{half_angle, pressed_angles};
@@ -18,7 +19,6 @@ use crate::model::scene::Scene;
 use crate::model::start::balanced_fan;
 use rand::RngExt;
 use rand_distr::{Distribution as _, Exp1};
-use rand_xoshiro::Xoshiro256PlusPlus;
 use std::f64::consts::PI;
 
 /// What was drawn for one run.
@@ -44,7 +44,8 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     let s = &plan.file.sampling;
     let seed = plan.file.seed;
     let shared = shared(plan, design);
-    let mut rng = stream(seed, shared, sample, Purpose::Unbalance);
+    let sequence = s.sequence;
+    let mut rng = draws(seed, shared, sample, Purpose::Unbalance, sequence);
     let value = draw_value(&s.unbalance.distribution, &mut rng);
     let (unbalance, fraction) = match s.unbalance.scale() {
         Scale::Capacity => (value * design.capacity, value),
@@ -59,7 +60,7 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     let initial_angles = std::iter::once(design)
         .chain(&design.plane_designs)
         .flat_map(|d| {
-            let mut rng = stream(seed, shared, sample, Purpose::Initial);
+            let mut rng = draws(seed, shared, sample, Purpose::Initial, sequence);
             initial_angles(&s.initial, d, &mut rng, unbalance, direction)
         })
         .collect();
@@ -70,7 +71,13 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         initial_angles,
         weights: None,
         couple: s.couple.as_ref().map(|spec| {
-            super::couple::draw(spec, seed, shared, design, sample, (unbalance, direction))
+            super::couple::draw(
+                spec,
+                (seed, shared, sequence),
+                design,
+                sample,
+                (unbalance, direction),
+            )
         }),
     }
 }
@@ -98,8 +105,7 @@ pub fn draw_weights(
     let shared = shared(plan, design);
     Some(super::tolerance::apply(
         t,
-        plan.file.seed,
-        shared,
+        (plan.file.seed, shared, plan.file.sampling.sequence),
         design,
         sample,
         scene,
@@ -111,7 +117,7 @@ pub fn draw_weights(
 fn initial_angles(
     initial: &InitialSpec,
     design: &Design,
-    rng: &mut Xoshiro256PlusPlus,
+    rng: &mut Draws,
     unbalance: f64,
     direction: f64,
 ) -> Vec<f64> {
@@ -162,7 +168,7 @@ fn cluster(design: &Design, centre: f64) -> Vec<f64> {
 /// Uniformly random positions of n weights that may not overlap: the free
 /// arc 2π − 2nα is cut into n gaps with uniform spacings (normalised
 /// exponentials), which is exactly uniform over non-overlapping configurations.
-fn uniform_without_overlap(design: &Design, rng: &mut Xoshiro256PlusPlus) -> Vec<f64> {
+fn uniform_without_overlap(design: &Design, rng: &mut Draws) -> Vec<f64> {
     let n = design.spec.n as usize;
     let start = 2.0 * PI * rng.random::<f64>();
     if n == 1 {

@@ -9,7 +9,11 @@
 //! here.
 
 use rand::SeedableRng;
+use rand::{Rng, TryRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::convert::Infallible;
 
 /// One SplitMix64 step: a bijective 64-bit mixer (Steele, Lea & Flood 2014).
 pub fn splitmix64(mut z: u64) -> u64 {
@@ -50,4 +54,157 @@ pub fn stream(seed: u64, design: Option<u32>, sample: u64, purpose: Purpose) -> 
     h = splitmix64(h ^ sample);
     h = splitmix64(h ^ purpose as u64);
     Xoshiro256PlusPlus::seed_from_u64(h)
+}
+
+/// Where a study's sampled inputs come from (`[sampling] sequence`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Sequence {
+    /// Independent pseudo-random draws (xoshiro256++).
+    #[default]
+    Random,
+    /// Sample k's draws are point k of an Owen-scrambled Sobol sequence
+    /// (`sobol_burley`): the samples fill the unit cube more evenly; use a
+    /// power of two of them, at most 2¹⁶.
+    Sobol,
+}
+
+/// Most samples per design a Sobol study may draw (`sobol_burley`'s
+/// sequence length).
+pub const SOBOL_MAX_SAMPLES: u32 = 1 << 16;
+
+/// A run's draws for one purpose: its own pseudo-random stream, or its
+/// point of the study's scrambled Sobol sequence.
+#[derive(Debug, Clone)]
+pub enum Draws {
+    /// [`Sequence::Random`].
+    Random(Xoshiro256PlusPlus),
+    /// [`Sequence::Sobol`].
+    Sobol(SobolPoint),
+}
+
+/// Point `index` of an Owen-scrambled Sobol sequence, read one coordinate
+/// per draw. Each purpose scrambles with a seed of its own, so that its
+/// coordinates are stratified together (an unbalance's size and direction)
+/// and independent of the other purposes' (Owen's padding).
+#[derive(Debug, Clone)]
+pub struct SobolPoint {
+    index: u32,
+    seed: u64,
+    dimension: u32,
+}
+
+/// Coordinates of `sobol_burley`'s table; draws beyond it take the table
+/// again under another scramble.
+const SOBOL_DIMENSIONS: u32 = 256;
+
+impl SobolPoint {
+    /// The next coordinate as 64 bits: the scrambled coordinate's 24 bits
+    /// (`sobol_burley` returns f32 multiples of 2⁻²⁴) on top, and below them
+    /// 40 bits hashed from the point, the coordinate and the seed: a uniform
+    /// draw within the coordinate's finest stratum, so that a caller reading
+    /// 53 bits (an f64 in [0, 1)) gets no 2⁻²⁴ grid.
+    fn next(&mut self) -> u64 {
+        let round = self.dimension / SOBOL_DIMENSIONS;
+        let seed = splitmix64(self.seed ^ u64::from(round));
+        let x = sobol_burley::sample(
+            self.index,
+            self.dimension % SOBOL_DIMENSIONS,
+            (seed >> 32) as u32,
+        );
+        let top = (f64::from(x) * f64::from(1u32 << 24)) as u64;
+        let low =
+            splitmix64(seed ^ (u64::from(self.index) << 32 | u64::from(self.dimension))) >> 24;
+        self.dimension += 1;
+        (top << 40) | low
+    }
+}
+
+impl TryRng for Draws {
+    type Error = Infallible;
+
+    fn try_next_u32(&mut self) -> Result<u32, Infallible> {
+        Ok((self.try_next_u64()? >> 32) as u32)
+    }
+
+    fn try_next_u64(&mut self) -> Result<u64, Infallible> {
+        Ok(match self {
+            Draws::Random(r) => r.next_u64(),
+            Draws::Sobol(p) => p.next(),
+        })
+    }
+
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
+        for chunk in dst.chunks_mut(8) {
+            let bytes = self.try_next_u64()?.to_le_bytes();
+            chunk.copy_from_slice(&bytes[..chunk.len()]);
+        }
+        Ok(())
+    }
+}
+
+/// The draws of (seed, design, sample, purpose) under `sequence`; as
+/// [`stream`] for random draws.
+pub fn draws(
+    seed: u64,
+    design: Option<u32>,
+    sample: u64,
+    purpose: Purpose,
+    sequence: Sequence,
+) -> Draws {
+    match sequence {
+        Sequence::Random => Draws::Random(stream(seed, design, sample, purpose)),
+        Sequence::Sobol => {
+            let d = design.map_or(u64::MAX, u64::from);
+            let mut h = splitmix64(seed);
+            h = splitmix64(h ^ d);
+            h = splitmix64(h ^ purpose as u64);
+            Draws::Sobol(SobolPoint {
+                index: u32::try_from(sample).expect("validated: at most 2^16 samples"),
+                seed: h,
+                dimension: 0,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::RngExt;
+
+    /// The first 2^m points of one purpose's two coordinates put exactly one
+    /// point in each of the 2^m cells of a 2^(m/2) × 2^(m/2) grid (a
+    /// (0, m, 2)-net, which Owen scrambling keeps); random draws do not.
+    #[test]
+    fn sobol_draws_fill_the_square_one_point_per_cell() {
+        let cells_hit = |sequence| {
+            let mut seen = [false; 256];
+            for sample in 0..256u64 {
+                let mut d = draws(7, None, sample, Purpose::Unbalance, sequence);
+                let (x, y): (f64, f64) = (d.random(), d.random());
+                seen[(x * 16.0) as usize * 16 + (y * 16.0) as usize] = true;
+            }
+            seen.iter().filter(|s| **s).count()
+        };
+        assert_eq!(cells_hit(Sequence::Sobol), 256);
+        // 256 independent points miss about 256/e of the cells.
+        assert!(cells_hit(Sequence::Random) < 200);
+    }
+
+    /// Every draw is a uniform in [0, 1) with 53 bits, whatever the
+    /// coordinate (also past the table's 256), and another purpose or seed
+    /// scrambles differently.
+    #[test]
+    fn sobol_draws_are_uniform_and_differ_between_purposes() {
+        let mut d = draws(7, None, 3, Purpose::Initial, Sequence::Sobol);
+        let xs: Vec<f64> = (0..600).map(|_| d.random()).collect();
+        assert!(xs.iter().all(|x| (0.0..1.0).contains(x)));
+        let mean = xs.iter().sum::<f64>() / xs.len() as f64;
+        assert!((mean - 0.5).abs() < 0.05, "{mean}");
+        let first =
+            |purpose, seed| -> f64 { draws(seed, None, 3, purpose, Sequence::Sobol).random() };
+        assert_ne!(first(Purpose::Initial, 7), first(Purpose::Unbalance, 7));
+        assert_ne!(first(Purpose::Initial, 7), first(Purpose::Initial, 8));
+    }
 }

@@ -30,14 +30,13 @@
 //! at a prescribed speed; other studies are refused when validated.
 
 use super::design::Design;
-use super::stream::{Purpose, stream};
+use super::stream::{Purpose, Sequence, draws};
 use crate::invalid_key::InvalidKey;
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
 use crate::model::effect::SceneFacts;
 use crate::model::effect::race_eccentricity::RaceEccentricity;
 use crate::model::scene::Scene;
-use rand_xoshiro::Xoshiro256PlusPlus;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -258,7 +257,7 @@ fn nominal_geometry(d: &Design) -> Result<Geometry, String> {
 }
 
 /// A standard normal draw truncated to [−limit, limit] (redrawn beyond).
-fn truncated(rng: &mut Xoshiro256PlusPlus, limit: f64) -> f64 {
+fn truncated<R: rand::Rng + ?Sized>(rng: &mut R, limit: f64) -> f64 {
     // Normal(0, 1) draws the same bits as the standard normal (0 + 1·z).
     super::truncated::draw(rng, 0.0, 1.0, -limit, limit)
 }
@@ -273,8 +272,7 @@ fn truncated(rng: &mut Xoshiro256PlusPlus, limit: f64) -> f64 {
 /// this file; [`super::sample::draw_weights`] reads them from the plan.
 pub fn apply(
     t: &Tolerances,
-    seed: u64,
-    shared: Option<u32>,
+    (seed, shared, sequence): (u64, Option<u32>, Sequence),
     design: &Design,
     sample: u64,
     scene: &mut Scene,
@@ -287,8 +285,8 @@ pub fn apply(
         0 => design,
         p => design.plane_designs.get(p - 1).unwrap_or(design),
     };
-    let mut mass_rng = stream(seed, shared, sample, Purpose::MassTolerance);
-    let mut radius_rng = stream(seed, shared, sample, Purpose::RadiusTolerance);
+    let mut mass_rng = draws(seed, shared, sample, Purpose::MassTolerance, sequence);
+    let mut radius_rng = draws(seed, shared, sample, Purpose::RadiusTolerance, sequence);
     let mut cargo: Vec<Cargo> = Vec::with_capacity(nominal.len());
     for c in nominal {
         let mut c = match &t.radius {
@@ -325,7 +323,13 @@ pub fn apply(
         cargo.push(c);
     }
     if let Some(tol) = &t.eccentricity {
-        let mut rng = stream(seed, shared, sample, Purpose::EccentricityTolerance);
+        let mut rng = draws(
+            seed,
+            shared,
+            sample,
+            Purpose::EccentricityTolerance,
+            sequence,
+        );
         let (dx, dy) = (
             tol.sigma * truncated(&mut rng, tol.limit),
             tol.sigma * truncated(&mut rng, tol.limit),

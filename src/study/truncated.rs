@@ -5,7 +5,6 @@
 //! from the inverse CDF instead, so no input can make the loop endless.
 
 use rand_distr::{Distribution as _, Normal};
-use rand_xoshiro::Xoshiro256PlusPlus;
 use statrs::distribution::{ContinuousCDF, Normal as CdfNormal};
 
 /// Smallest share of the normal that may lie inside the bounds: at 10⁻³ a
@@ -24,7 +23,7 @@ pub fn accepted_mass(mean: f64, std: f64, min: f64, max: f64) -> f64 {
 }
 
 /// A draw of Normal(mean, std) truncated to [min, max] (std > 0, min ≤ max, finite).
-pub fn draw(rng: &mut Xoshiro256PlusPlus, mean: f64, std: f64, min: f64, max: f64) -> f64 {
+pub fn draw<R: rand::Rng + ?Sized>(rng: &mut R, mean: f64, std: f64, min: f64, max: f64) -> f64 {
     let normal = Normal::new(mean, std).expect("std validated positive and finite");
     for _ in 0..MAX_REJECTIONS {
         let v = normal.sample(rng);
@@ -44,6 +43,7 @@ pub fn draw(rng: &mut Xoshiro256PlusPlus, mean: f64, std: f64, min: f64, max: f6
 mod tests {
     use super::*;
     use rand::SeedableRng;
+    use rand_xoshiro::Xoshiro256PlusPlus;
 
     #[test]
     fn draws_stay_inside_and_end_even_where_nothing_is_accepted() {

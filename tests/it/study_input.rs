@@ -277,3 +277,38 @@ fn zero_threads_is_refused_and_too_many_are_capped() {
         "{err}"
     );
 }
+
+#[test]
+fn sobol_draws_need_a_power_of_two_of_samples() {
+    let sobol = |t: String, samples: &str| {
+        t.replace(
+            "samples = 2\n",
+            &format!("samples = {samples}\nsequence = \"sobol\"\n"),
+        )
+    };
+    rejects(
+        |t| sobol(t, "3"),
+        &["sampling.samples", "3", "power of two", "(e.g. 4)"],
+    );
+    rejects(
+        |t| sobol(t, "70000"),
+        &["sampling.samples", "70000", "up to 65536"],
+    );
+    rejects(
+        |t| {
+            sobol(t, "4").replace(
+                "[metrics]",
+                "batch = 3\nstop_when = { median_halfwidth_rel = 0.1 }\n[metrics]",
+            )
+        },
+        &["sampling.batch", "3", "power of two"],
+    );
+    rejects(
+        |t| t.replace("samples = 2\n", "samples = 2\nsequence = \"halton\"\n"),
+        &["sequence", "halton"],
+    );
+    // A power of two runs.
+    let tmp = tempfile::tempdir().unwrap();
+    let (code, err) = run(tmp.path(), &sobol(valid(&tmp.path().join("r")), "4"));
+    assert_eq!(code, Some(0), "{err}");
+}

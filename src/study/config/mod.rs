@@ -213,6 +213,10 @@ pub struct Sampling {
     /// `sampling.unbalance` is then the static part).
     #[serde(default)]
     pub couple: Option<super::couple::CoupleSpec>,
+    /// Where the sampled inputs come from: `random` (default) or `sobol`
+    /// (an Owen-scrambled Sobol sequence; a power of two of samples).
+    #[serde(default)]
+    pub sequence: super::stream::Sequence,
 }
 
 fn default_batch() -> u32 {

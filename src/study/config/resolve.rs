@@ -79,6 +79,29 @@ impl StudyFile {
                 "a batch holds at least one sample per design",
             ));
         }
+        if s.sequence == super::super::stream::Sequence::Sobol {
+            let max = super::super::stream::SOBOL_MAX_SAMPLES;
+            if s.samples > max || !s.samples.is_power_of_two() {
+                return Err(invalid(
+                    "sampling.samples",
+                    s.samples.to_string(),
+                    &format!(
+                        "with sequence = \"sobol\" a power of two up to {max} (e.g. {}): a Sobol sequence is even only over 2^m points",
+                        s.samples.next_power_of_two().min(max)
+                    ),
+                ));
+            }
+            if s.stop_when.is_some() && !s.batch.is_power_of_two() {
+                return Err(invalid(
+                    "sampling.batch",
+                    s.batch.to_string(),
+                    &format!(
+                        "with sequence = \"sobol\" a power of two (e.g. {}), so that every batch ends on an even prefix of the sequence",
+                        s.batch.next_power_of_two()
+                    ),
+                ));
+            }
+        }
         if let Some(stop) = &s.stop_when {
             let keys = [
                 ("median_halfwidth_rel", stop.median_halfwidth_rel),
