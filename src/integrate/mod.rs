@@ -468,13 +468,21 @@ pub struct Return {
     pub t: f64,
     /// Radau5's RHS calls per unit time over the explicit method's.
     pub ratio: f64,
+    /// When the explicit method then ran out of steps or step size and
+    /// Radau5 took the rest of the run.
+    pub stalled_at: Option<f64>,
 }
 
 impl SolveReport {
     /// The method the run ended on, begun with `method`.
     pub fn ended_with(&self, method: Method) -> Method {
         match &self.switched {
-            Some(Switch { back: Some(_), .. }) => method,
+            Some(Switch {
+                back: Some(Return {
+                    stalled_at: None, ..
+                }),
+                ..
+            }) => method,
             Some(_) => IMPLICIT_FALLBACK,
             None => method,
         }
@@ -548,13 +556,36 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
             stiffness: Stiffness::Ignore,
             ..options.clone()
         };
-        let last = drive_method(
+        let mut last = drive_method(
             method, system, rest.t, &rest.y, t_end, &deaf, deadline, observer, None,
         );
+        // Out of steps or below the step-size floor, the explicit method
+        // hands over as it did the first time, now for good.
+        let mut stalled_at = None;
+        if driver::stalled(&last.status) {
+            let explicit = last.stats;
+            stalled_at = Some(last.t);
+            last = drive_method(
+                IMPLICIT_FALLBACK,
+                system,
+                last.t,
+                &last.y,
+                t_end,
+                options,
+                deadline,
+                observer,
+                None,
+            );
+            last.stats += explicit;
+        }
         let implicit = rest.stats;
         rest = last;
         rest.stats += implicit;
-        back = Some(Return { t, ratio });
+        back = Some(Return {
+            t,
+            ratio,
+            stalled_at,
+        });
     }
     rest.stats += first.stats;
     rest.switched = Some(Switch {

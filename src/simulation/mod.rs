@@ -216,6 +216,13 @@ impl Simulation {
                     "{} (back to {from} at t = {:.4}: radau5 made {:.1} times its RHS calls per unit time)",
                     metrics.reason, back.t, back.ratio
                 );
+                if let Some(t) = back.stalled_at {
+                    metrics.method = format!("{}→{}", metrics.method, IMPLICIT_FALLBACK.name());
+                    metrics.reason = format!(
+                        "{} (radau5 again at t = {t:.4}: {from} ran out of steps or step size)",
+                        metrics.reason
+                    );
+                }
             }
         }
         (metrics, series)

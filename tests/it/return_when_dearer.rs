@@ -68,3 +68,26 @@ fn a_rotating_frame_run_stays_on_radau5() {
     }
     assert!(handed_over > 10, "{handed_over} runs handed over");
 }
+
+/// A run that returned to DP5 and then runs out of steps hands over to
+/// Radau5 again, for good, as it did the first time: it settles rather than
+/// end `budget_exceeded`.
+#[test]
+fn a_returned_run_out_of_steps_goes_back_to_radau5() {
+    let plan = shipped_plan(&drum(), 1, |s| s.max_steps = MAX_STEPS);
+    let mut again = 0;
+    for id in 0..plan.total_runs() {
+        let m = run_one(&plan, id).metrics;
+        assert_eq!(m.outcome.name(), "settled", "run {id}: {}", m.reason);
+        if m.method == "dp5→radau5→dp5→radau5" {
+            assert!(m.reason.contains("radau5 again at t = "), "{}", m.reason);
+            again += 1;
+        }
+    }
+    assert!(again > 0, "no run ran out of steps after its return");
+}
+
+/// A step budget per segment that a drum run's returned DP5 segment exceeds
+/// and its last Radau5 segment does not (when written: at 15 000 Radau5 ran
+/// out too, at 30 000 DP5 did not).
+const MAX_STEPS: u64 = 20_000;
