@@ -522,7 +522,7 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     if !switch {
         return first;
     }
-    let Status::Failed(why) = first.status else {
+    let Status::Failed(why) = first.status.clone() else {
         unreachable!("a stalled run has failed")
     };
     // The implicit method continues where the explicit one stalled, with a
@@ -537,17 +537,13 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
             rival_rate,
             margin: cost::DEARER_BY,
         });
-    let mut rest = drive_method(
-        IMPLICIT_FALLBACK,
-        system,
-        first.t,
-        &first.y,
-        t_end,
-        options,
-        deadline,
-        observer,
-        trial,
-    );
+    // Every later segment continues where the one before it ended.
+    let mut continue_from = |m, before: &SolveReport, o: &SolverOptions, trial| {
+        drive_method(
+            m, system, before.t, &before.y, t_end, o, deadline, observer, trial,
+        )
+    };
+    let mut rest = continue_from(IMPLICIT_FALLBACK, &first, options, trial);
     let mut back = None;
     if let Status::Failed(Failure::Dearer { t, ratio, .. }) = rest.status {
         // Back for the rest of the run, deaf to stiffness: the measured cost
@@ -556,26 +552,14 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
             stiffness: Stiffness::Ignore,
             ..options.clone()
         };
-        let mut last = drive_method(
-            method, system, rest.t, &rest.y, t_end, &deaf, deadline, observer, None,
-        );
+        let mut last = continue_from(method, &rest, &deaf, None);
         // Out of steps or below the step-size floor, the explicit method
         // hands over as it did the first time, now for good.
         let mut stalled_at = None;
         if driver::stalled(&last.status) {
             let explicit = last.stats;
             stalled_at = Some(last.t);
-            last = drive_method(
-                IMPLICIT_FALLBACK,
-                system,
-                last.t,
-                &last.y,
-                t_end,
-                options,
-                deadline,
-                observer,
-                None,
-            );
+            last = continue_from(IMPLICIT_FALLBACK, &last, options, None);
             last.stats += explicit;
         }
         let implicit = rest.stats;
