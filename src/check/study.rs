@@ -190,6 +190,8 @@ pub fn record_baseline(
     // Recording a baseline reruns the study into the check's scratch folder
     // (`<output>/check/<name>/`), never over the study's own results.
     let mut fresh = plan.clone();
+    // A baseline holds every sample of every design: a race would drop some.
+    fresh.file.sampling.racing = false;
     fresh.file.output = Path::new(&plan.file.output)
         .join("check")
         .display()
@@ -214,6 +216,8 @@ pub fn check_study(
         }
         None => {
             let mut fresh = plan.clone();
+            // Compared sample by sample with the baseline, which ran them all.
+            fresh.file.sampling.racing = false;
             fresh.file.seed = options.seed.unwrap_or(plan.file.seed);
             let root = options
                 .output_root

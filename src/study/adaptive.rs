@@ -13,14 +13,15 @@ use polars::prelude::*;
 use std::ops::Range;
 
 /// The sample ranges of the batches, in order (one batch of every sample
-/// when the study asks for no precision).
+/// when the study asks for no precision and races no designs).
 pub fn batches(plan: &StudyPlan) -> Vec<Range<u32>> {
     let s = &plan.file.sampling;
-    // Without a precision to reach, all samples form one batch.
-    let step = if s.stop_when.is_none() {
-        s.samples
-    } else {
+    let step = if s.stop_when.is_some() {
         s.batch
+    } else if super::racing::races(plan) {
+        super::racing::look_batch(s.samples)
+    } else {
+        s.samples
     };
     (0..s.samples)
         .step_by(step as usize)

@@ -10,10 +10,10 @@
 use super::config::StudyPlan;
 use super::criterion::Criterion;
 use super::diagnosis::{DesignFacts, dead_band, diagnose, settling_band};
-use super::measured_runs::{DesignRuns, Scale};
+use super::measured_runs::DesignRuns;
 use super::record::{RunRecord, to_dataframe};
 use super::verdict::{
-    BestVersusRest, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale,
+    BestVersusRest, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale, pareto_set,
 };
 use crate::metrics::Outcome;
 use crate::model::gap::GapGauge;
@@ -38,31 +38,6 @@ fn sorted_values(ca: &Float64Chunked) -> Vec<f64> {
 /// How runs that ended `diverged`, `solver_failed` or `budget_exceeded`
 /// enter the statistics (stored beside them in `summary.parquet`).
 pub const FAILED_RUNS_COUNTED: &str = "as not settled within the run (censored at the horizon τ) in every settling statistic; left out of the residual statistics";
-
-/// Design ids not dominated on `measures`: no other design is at least as
-/// good on every measure and better on one (a value beyond the run or
-/// missing counts as the worst).
-pub fn pareto_set(designs: &[DesignRuns], measures: &[Criterion], scale: &Scale) -> Vec<u32> {
-    let values: Vec<Vec<Option<f64>>> = designs
-        .iter()
-        .map(|d| measures.iter().map(|m| m.value(d, scale)).collect())
-        .collect();
-    let dominates = |x: usize, y: usize| {
-        let mut strictly = false;
-        for (k, m) in measures.iter().enumerate() {
-            match m.order(values[x][k], values[y][k]) {
-                std::cmp::Ordering::Greater => return false,
-                std::cmp::Ordering::Less => strictly = true,
-                std::cmp::Ordering::Equal => {}
-            }
-        }
-        strictly
-    };
-    (0..designs.len())
-        .filter(|&y| !(0..designs.len()).any(|x| x != y && dominates(x, y)))
-        .map(|y| designs[y].design_id)
-        .collect()
-}
 
 /// One row per design, in design order.
 pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame> {
@@ -96,6 +71,17 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         plan.file.seed,
     );
     let pareto = pareto_set(&by_design, &plan.file.summary.pareto, &scale);
+    // A raced design with fewer runs than the most any design has left the
+    // race after those samples (every run is a row, failed ones too).
+    let most_runs = by_design
+        .iter()
+        .map(|d| d.settling.len())
+        .max()
+        .unwrap_or(0);
+    let left_race_after = |id: u32| -> Option<u32> {
+        let runs = by_design.iter().find(|d| d.design_id == id)?.settling.len();
+        (super::racing::races(plan) && runs < most_runs).then_some(runs as u32)
+    };
     let rank_of = |id: u32| -> Option<u32> {
         match &verdicts {
             Some(v) => v.order.iter().position(|&d| d == id).map(|r| r as u32 + 1),
@@ -137,6 +123,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.race_radius.push(design.spec.race_radius);
         rows.weight_mass.push(design.weight_mass);
         rows.runs.push(runs_n);
+        rows.left_race_after.push(left_race_after(design.id));
         rows.settled.push(settled_n);
         rows.settled_fraction.push(if runs_n == 0 {
             0.0
@@ -287,6 +274,7 @@ struct SummaryColumns {
     settling_from: Vec<String>,
     pareto: Vec<bool>,
     balances: Vec<bool>,
+    left_race_after: Vec<Option<u32>>,
     /// Per reported measure (Criterion::REPORTED order): this − best, its
     /// interval and the Holm-adjusted p.
     vs_best_measure: [MeasureColumns; 4],
@@ -448,6 +436,7 @@ impl SummaryColumns {
             Column::new("race_radius".into(), self.race_radius),
             Column::new("weight_mass".into(), self.weight_mass),
             Column::new("runs".into(), self.runs),
+            Column::new("left_race_after".into(), self.left_race_after),
             Column::new("settled".into(), self.settled),
             Column::new("settled_fraction".into(), self.settled_fraction),
             Column::new("settled_fraction_lo".into(), self.settled_lo),

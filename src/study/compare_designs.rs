@@ -163,10 +163,12 @@ impl Side {
 }
 
 /// Why the runs of two sides cannot be paired, if they cannot: pairs must
-/// be the same samples and have met the same unbalance (fraction of
+/// be the same samples (or the first of the other's) and have met the same unbalance (fraction of
 /// capacity) from the same direction.
 pub fn pairing_refusal(a: &Side, b: &Side) -> Option<String> {
-    if a.runs.sample_ids != b.runs.sample_ids {
+    // A design that left a race ran the first samples of the others: the
+    // two pair on those.
+    if super::verdict::shared_prefix(&a.runs, &b.runs).is_none() {
         return Some(format!(
             "the designs have different samples ({} runs against {})",
             a.runs.sample_ids.len(),

@@ -28,6 +28,18 @@ pub struct DesignRuns {
 }
 
 impl DesignRuns {
+    /// Its first `n` runs (all of them when it has fewer).
+    pub fn first(&self, n: usize) -> DesignRuns {
+        let n = n.min(self.sample_ids.len());
+        DesignRuns {
+            design_id: self.design_id,
+            sample_ids: self.sample_ids[..n].to_vec(),
+            settling: self.settling[..n].to_vec(),
+            residual: self.residual[..n].to_vec(),
+            residual_abs: self.residual_abs[..n].to_vec(),
+        }
+    }
+
     /// The Kaplan–Meier estimate of its settling.
     pub fn kaplan_meier(&self) -> Option<KaplanMeier> {
         KaplanMeier::fit(&self.settling)

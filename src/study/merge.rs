@@ -137,8 +137,21 @@ pub fn merge(
         provenance.study_sha256 = sha.1;
     }
     let runs_path = dir.join("runs.parquet");
-    let runs = write_runs(&pieces, total, &runs_path, &provenance)?;
+    let mut runs = write_runs(&pieces, total, &runs_path, &provenance)?;
     drop(pieces);
+    // Shards cannot race (each lacks the others' runs): the race is
+    // replayed here on every run, and the merged files hold what an
+    // unsharded raced study makes.
+    let mut departures = None;
+    if super::racing::races(&plan) {
+        let batches = super::adaptive::batches(&plan);
+        let race =
+            super::racing::Race::replay(&plan, &batches, &read_summary_columns(&runs_path)?)?;
+        let mut made = race.made(&super::io::read_parquet(&runs_path)?)?;
+        runs = made.height() as u64;
+        write_parquet(&runs_path, &mut made, &provenance)?;
+        departures = Some(race.departures());
+    }
     let mut summary = summarize_table(&plan, &read_summary_columns(&runs_path)?)?;
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
     super::io::write_text(&dir.join("study.toml"), &plan.text).map_err(RunError::Io)?;
@@ -154,5 +167,7 @@ pub fn merge(
         summary: Some(summary),
         executed: 0,
         adaptive: None,
+        race: departures,
+        runs_planned: plan.total_runs(),
     })
 }

@@ -46,6 +46,7 @@ pub mod merge;
 pub mod optimize_spec;
 pub mod plane_designs;
 pub mod plane_summary;
+pub mod racing;
 pub mod record;
 pub mod run;
 pub mod runs_file;

@@ -43,6 +43,9 @@ pub enum Purpose {
     EccentricityTolerance = 7,
     /// The couple unbalance of a two-plane rotor ([`super::couple`]).
     Couple = 8,
+    /// Bootstrap resampling of a comparison at a look of a race
+    /// (`super::racing`).
+    Racing = 9,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for

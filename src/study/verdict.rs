@@ -25,9 +25,18 @@ use rayon::prelude::*;
 /// Level of every interval the comparisons report.
 pub const LEVEL: f64 = 0.95;
 
-/// Why two designs' runs cannot be paired.
+/// How many leading runs two designs share: the shorter one's, when its
+/// samples are the first of the longer one's (a raced design that left
+/// early, [`super::racing`]); `None` when their samples differ otherwise.
+pub fn shared_prefix(a: &DesignRuns, b: &DesignRuns) -> Option<usize> {
+    let n = a.sample_ids.len().min(b.sample_ids.len());
+    (a.sample_ids[..n] == b.sample_ids[..n]).then_some(n)
+}
+
+/// Why two designs' runs cannot be paired: their samples are not the same,
+/// nor the first of one another's.
 pub fn pairing_refusal(a: &DesignRuns, b: &DesignRuns) -> Option<String> {
-    (a.sample_ids != b.sample_ids).then(|| {
+    shared_prefix(a, b).is_none().then(|| {
         format!(
             "design {} has {} runs and design {} has {}, not of the same samples",
             a.design_id,
@@ -241,6 +250,15 @@ pub fn compare(
     scale: &Scale,
     seed: u64,
 ) -> Comparison {
+    // A design that left a race is compared on the samples it ran.
+    let trimmed;
+    let (a, b) = match shared_prefix(a, b) {
+        Some(n) if paired && (n < a.sample_ids.len() || n < b.sample_ids.len()) => {
+            trimmed = (a.first(n), b.first(n));
+            (&trimmed.0, &trimmed.1)
+        }
+        _ => (a, b),
+    };
     let median = |d: &DesignRuns| d.kaplan_meier().and_then(|km| km.median());
     let mut rng = stream(
         seed,
@@ -424,6 +442,31 @@ pub fn ranking(designs: &[DesignRuns], criterion: Criterion, scale: &Scale) -> V
             .then(x.cmp(&y))
     });
     order
+}
+
+/// Design ids not dominated on `measures`: no other design is at least as
+/// good on every measure and better on one (a value beyond the run or
+/// missing counts as the worst).
+pub fn pareto_set(designs: &[DesignRuns], measures: &[Criterion], scale: &Scale) -> Vec<u32> {
+    let values: Vec<Vec<Option<f64>>> = designs
+        .iter()
+        .map(|d| measures.iter().map(|m| m.value(d, scale)).collect())
+        .collect();
+    let dominates = |x: usize, y: usize| {
+        let mut strictly = false;
+        for (k, m) in measures.iter().enumerate() {
+            match m.order(values[x][k], values[y][k]) {
+                std::cmp::Ordering::Greater => return false,
+                std::cmp::Ordering::Less => strictly = true,
+                std::cmp::Ordering::Equal => {}
+            }
+        }
+        strictly
+    };
+    (0..designs.len())
+        .filter(|&y| !(0..designs.len()).any(|x| x != y && dominates(x, y)))
+        .map(|y| designs[y].design_id)
+        .collect()
 }
 
 /// Whether a design balances: it settled in at least [`MIN_SETTLED_SHARE`]

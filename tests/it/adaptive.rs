@@ -24,6 +24,7 @@ race_radius = 0.05
 drag = [10.0, 50.0]
 [sampling]
 unbalance = {{ distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }}
+racing = false
 {sampling}
 [metrics]
 t_end_revs = 400

@@ -279,6 +279,8 @@ fn planted_drag_change_of_five_percent_is_detected() {
     // The same study with every weight's drag 5 % stronger: what a change in
     // the drag law would do to the unchanged study file.
     let mut after = plan(&small_study(&tmp.path().join("after"), 21.0));
+    // Every sample, as `study check` runs them.
+    after.file.sampling.racing = false;
     for seed in [11, 12] {
         after.file.seed = seed;
         // Both seeds write the same folder: the second replaces the first.
@@ -423,6 +425,8 @@ fn cli_exit_codes_are_pass_regression_and_bad_input() {
     let p = plan(&text);
     let mut weaker = plan(&small_study(&tmp.path().join("weaker"), 20.0 / 1.05));
     weaker.file.seed = p.file.seed;
+    // Every sample, as `study baseline` runs them.
+    weaker.file.sampling.racing = false;
     let old = run_study(&weaker, &RunOptions::default(), &NoProgress).unwrap();
     write_baseline(&baseline, &p, &old.load_runs().unwrap()).unwrap();
     let out = study_cli(&["check", s, "--baseline", b]);

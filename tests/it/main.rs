@@ -42,6 +42,7 @@ mod plane_designs;
 mod plot;
 mod plot_layout;
 mod race_eccentricity;
+mod racing;
 mod report;
 mod results_columns;
 mod results_folder;

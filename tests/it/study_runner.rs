@@ -391,7 +391,11 @@ fn provenance_is_stored_in_the_parquet_metadata() {
 fn runs_spanning_several_windows_are_the_same_however_split() {
     let extra = "[solver]\nfidelity = \"analytic\"\n";
     let whole = tempfile::tempdir().unwrap();
-    let p = plan(&small_study(whole.path(), 20_000, extra));
+    // Every run, to span the windows: no race.
+    let every = |dir: &Path| {
+        small_study(dir, 20_000, extra).replace("[sampling]\n", "[sampling]\nracing = false\n")
+    };
+    let p = plan(&every(whole.path()));
     let out = run_study(&p, &RunOptions::default(), &NoProgress).unwrap();
     assert_eq!(out.runs, 40_000);
     let reference = stable(&out.dir.join("runs.parquet"));
@@ -405,7 +409,7 @@ fn runs_spanning_several_windows_are_the_same_however_split() {
     assert!(ids.iter().copied().eq(0..40_000));
 
     let small_chunks = tempfile::tempdir().unwrap();
-    let p = plan(&small_study(small_chunks.path(), 20_000, extra));
+    let p = plan(&every(small_chunks.path()));
     let opts = RunOptions {
         chunk_runs: 97,
         threads: Some(2),
@@ -415,7 +419,7 @@ fn runs_spanning_several_windows_are_the_same_however_split() {
     assert!(reference.equals_missing(&stable(&out.dir.join("runs.parquet"))));
 
     let sharded = tempfile::tempdir().unwrap();
-    let p = plan(&small_study(sharded.path(), 20_000, extra));
+    let p = plan(&every(sharded.path()));
     let dirs: Vec<_> = (1..=3)
         .map(|k| {
             let opts = RunOptions {

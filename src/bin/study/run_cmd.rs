@@ -117,6 +117,9 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
             if let Some(adaptive) = &output.adaptive {
                 println!("{}", adaptive_line(adaptive));
             }
+            if let Some(line) = race_line(&output) {
+                println!("{line}");
+            }
         }
         None => println!(
             "shard {} done: {} runs in {} (merge the shards with `study merge`)",
@@ -155,6 +158,9 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
     if let Some(summary) = &output.summary {
         print!("{}", ranked_table(summary)?);
     }
+    if let Some(line) = race_line(&output) {
+        println!("{line}");
+    }
     eprintln!("merged {} runs into {}", output.runs, output.dir.display());
     // The shards' failed runs are never absorbed either: the study text
     // stored beside the merged files names the settings.
@@ -189,4 +195,51 @@ fn adaptive_line(adaptive: &AdaptiveOutcome) -> String {
         adaptive.samples_per_design,
         state.join(", ")
     )
+}
+
+/// What racing saved, in runs, and which designs left the race when.
+fn race_line(output: &autobal::study::run::StudyOutput) -> Option<String> {
+    let departures = output.race.as_ref()?;
+    if departures.is_empty() {
+        return Some(format!(
+            "racing: no design left the race early; all {} runs were needed",
+            group_thousands(output.runs)
+        ));
+    }
+    // Designs that left at the same look, in one group.
+    let mut groups: Vec<(u32, Vec<u32>)> = Vec::new();
+    for d in departures {
+        match groups.iter_mut().find(|(s, _)| *s == d.samples) {
+            Some((_, ids)) => ids.push(d.design_id),
+            None => groups.push((d.samples, vec![d.design_id])),
+        }
+    }
+    groups.sort_by_key(|(s, _)| *s);
+    let when: Vec<String> = groups
+        .iter()
+        .map(|(samples, ids)| {
+            let ids: Vec<String> = ids.iter().map(u32::to_string).collect();
+            format!("after {samples} samples: {}", ids.join(", "))
+        })
+        .collect();
+    Some(format!(
+        "racing: decided after {} of {} runs; {} designs left the race once #1 was significantly better and no other reported measure favoured them ({}); `[sampling] racing = false` runs every sample",
+        group_thousands(output.runs),
+        group_thousands(output.runs_planned),
+        departures.len(),
+        when.join("; ")
+    ))
+}
+
+/// 10000 as "10 000", as the tool prints counts.
+fn group_thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
 }

@@ -206,6 +206,12 @@ pub struct Sampling {
     /// Samples per design in each batch of adaptive sampling.
     #[serde(default = "default_batch")]
     pub batch: u32,
+    /// Race the designs (docs/statistics.md, "Racing"): samples run in
+    /// batches, and a design significantly worse than the leader, and
+    /// dominated on every reported measure, leaves the race and keeps its
+    /// runs. `false` runs every sample (baselines and checks always do).
+    #[serde(default = "yes")]
+    pub racing: bool,
     /// Manufacturing tolerances of the weights, sampled per run (off unless given).
     #[serde(default)]
     pub tolerances: Option<super::tolerance::Tolerances>,

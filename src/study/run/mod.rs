@@ -12,6 +12,7 @@ use super::config::StudyPlan;
 use super::design::Design;
 use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet, write_text};
 use super::lock::{FolderLock, LockError};
+use super::racing::{Departure, Race, only_running, races};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
 use super::sample::{Sample, draw_sample, draw_weights};
@@ -111,6 +112,8 @@ pub trait Progress: Sync {
     fn begin(&self, _total: u64, _done: u64) {}
     /// One more run finished.
     fn advance(&self, _record: &RunRecord) {}
+    /// `runs` runs of the total will not run: their designs left the race.
+    fn skip(&self, _runs: u64) {}
     /// Everything is written.
     fn end(&self) {}
 }
@@ -133,6 +136,11 @@ pub struct StudyOutput {
     pub executed: u64,
     /// Where adaptive sampling stopped (studies with `stop_when`).
     pub adaptive: Option<AdaptiveOutcome>,
+    /// The designs that left the race, in design order (`None`: the study
+    /// did not race).
+    pub race: Option<Vec<Departure>>,
+    /// Runs the study would make without racing or a precision to stop at.
+    pub runs_planned: u64,
 }
 
 /// Where adaptive sampling stopped, and why.
@@ -417,11 +425,19 @@ fn run_in_folder(
     let mut executed = 0;
     let mut adaptive = None;
     let batches = batches(plan);
+    // A shard cannot judge a race (it lacks the other shards' runs): it
+    // runs every sample, and `merge` replays the race on the merged runs.
+    let mut race = (races(plan) && options.shard.is_none()).then(|| Race::new(plan, &batches));
+    let samples = u64::from(plan.file.sampling.samples);
     for (k, range) in batches.iter().enumerate() {
         let pending: Vec<u64> = batch_ids(plan, range)
             .into_iter()
             .filter(in_slice)
             .filter(|&id| !done[id as usize])
+            .filter(|&id| {
+                race.as_ref()
+                    .is_none_or(|r| r.running((id / samples) as usize))
+            })
             .collect();
         let saved = execute(plan, &pending, options, pool.as_ref(), &chunks, progress)?;
         if options
@@ -436,13 +452,37 @@ fn run_in_folder(
             });
         }
         executed += pending.len() as u64;
+        let last = k + 1 == batches.len();
+        // Nothing to judge: a shard of a raced study runs every batch.
+        if stop_when.is_none() && (race.is_none() || last) {
+            continue;
+        }
+        // Judge the batches so far on their own runs only.
+        let mut pieces = earlier_table_pieces(&runs_path)?;
+        pieces.extend(chunk_pieces(&chunks)?);
+        let so_far = read_pieces_summary_columns(&pieces)?;
+        let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
+        let judged = so_far.filter(&mask)?;
+        if let Some(race) = race.as_mut().filter(|_| !last) {
+            let left = match &pool {
+                Some(p) => p.install(|| race.look(plan, k, range.end, &judged))?,
+                None => race.look(plan, k, range.end, &judged)?,
+            };
+            if !left.is_empty() {
+                let remaining = (k + 1..batches.len())
+                    .map(|j| u64::from(batches[j].end - batches[j].start))
+                    .sum::<u64>();
+                progress.skip(remaining * left.len() as u64);
+            }
+            if race.decided() && stop_when.is_none() {
+                break;
+            }
+        }
         if let Some(stop) = stop_when {
-            // Judge the batches so far on their own runs only.
-            let mut pieces = earlier_table_pieces(&runs_path)?;
-            pieces.extend(chunk_pieces(&chunks)?);
-            let so_far = read_pieces_summary_columns(&pieces)?;
-            let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
-            let judged = so_far.filter(&mask)?;
+            let judged = match &race {
+                Some(race) => only_running(&judged, race)?,
+                None => judged,
+            };
             let reached = match &pool {
                 Some(p) => p.install(|| precision(plan, stop, &judged))?,
                 None => precision(plan, stop, &judged)?,
@@ -484,5 +524,7 @@ fn run_in_folder(
         summary,
         executed,
         adaptive,
+        race: race.map(|r| r.departures()),
+        runs_planned: total_ids,
     })
 }
