@@ -2,8 +2,11 @@
 //! over the designs still in the race, every design the same samples
 //! (common random numbers), and after each batch a design leaves when the
 //! leader is significantly better on the declared criterion and the design
-//! can no longer matter on any other reported measure. A design that left
-//! keeps its runs; its statistics are computed on them.
+//! can no longer change what the study reports: its verdict against
+//! whichever design ends first, the Pareto set, or a finding that it beats
+//! #1 on another measure ([`leaves`]). A design that left keeps its runs;
+//! its statistics are computed on them, and its comparisons pair on the
+//! samples it ran.
 //!
 //! Error control across the looks: look k tests at the level the
 //! Pocock-type spending function spends there ([`Spending`]), Holm across
@@ -39,7 +42,7 @@ pub const SPENDING: Spending = Spending::Pocock;
 
 /// How many standard errors ahead the leader must be on every other
 /// reported measure before a design may leave ([`leaves`]).
-pub const MARGIN_Z: f64 = 1.0;
+pub const MARGIN_Z: f64 = 2.0;
 
 /// The standard normal quantile of a two-sided 95 % interval.
 const Z_95: f64 = 1.959_963_984_540_054;
@@ -202,7 +205,9 @@ impl Race {
 /// The designs of `running` (the race's designs, on the same samples) that
 /// leave at a look spending `level`, as (design, leader, Holm p): the
 /// leader (the first by the plan's criterion, and one that balances) is
-/// better on the criterion at Holm-adjusted p ≤ `level` ([`favoured`]), the
+/// better on the criterion at Holm-adjusted p ≤ `level` ([`favoured`]); the
+/// leader and every design it does not beat yet beat it at the study's α
+/// even under the end's largest Holm factor; the
 /// design is outside the Pareto set of the running designs, and the leader
 /// is at least as good on every reported measure, so that no "other
 /// measures disagree" finding can be lost with the design.
@@ -223,7 +228,33 @@ pub fn leaves(
         return Vec::new();
     }
     let worse = significantly_worse(plan, running, leader, level, look);
+    // Whichever design ends first, the verdict on a design that left is
+    // made at the end on the runs it has now: it leaves only when the
+    // leader and every design that may still end first beat it at the
+    // study's α with the largest Holm factor the end can apply (Bonferroni
+    // over every other design).
+    let alpha = plan.file.statistics.alpha;
     let paired = plan.file.sampling.common_random_numbers;
+    let factor = plan.designs.len().saturating_sub(1).max(1) as f64;
+    let beats_at_the_end = |c: &DesignRuns, d: &DesignRuns| {
+        let mut rng = stream(
+            plan.file.seed,
+            Some(c.design_id),
+            ((look as u64) << 32) | (1 << 31) | u64::from(d.design_id),
+            Purpose::Racing,
+        );
+        criterion
+            .compare(c, d, paired, &scale, LEVEL, &mut rng)
+            .is_some_and(|x| {
+                favoured(criterion, &x, (x.p_value * factor).min(1.0), alpha) == Some(Favours::A)
+            })
+    };
+    // A design the leader beats by that test will not end first.
+    let contenders: Vec<&DesignRuns> = running
+        .iter()
+        .filter(|c| c.design_id == leader.design_id || !beats_at_the_end(leader, c))
+        .collect();
+    let beaten_by_all = |d: &DesignRuns| contenders.iter().all(|c| beats_at_the_end(c, d));
     let pareto = pareto_set(running, &plan.file.summary.pareto, &scale);
     let mut measures: Vec<Criterion> = Criterion::REPORTED.to_vec();
     measures.extend(plan.file.summary.pareto.iter().copied());
@@ -257,7 +288,7 @@ pub fn leaves(
         .into_iter()
         .filter(|&(id, _)| {
             let d = running.iter().find(|d| d.design_id == id);
-            !pareto.contains(&id) && d.is_some_and(at_least_as_good)
+            !pareto.contains(&id) && d.is_some_and(|d| beaten_by_all(d) && at_least_as_good(d))
         })
         .map(|(id, p_holm)| (id, leader.design_id, p_holm))
         .collect()
