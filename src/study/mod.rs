@@ -47,6 +47,7 @@ pub mod optimize_spec;
 pub mod plane_designs;
 pub mod plane_summary;
 pub mod record;
+pub mod results_table;
 pub mod run;
 pub mod runs_file;
 pub mod sample;

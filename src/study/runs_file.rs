@@ -229,6 +229,12 @@ fn summary_projection(path: &Path) -> PolarsResult<Vec<&'static str>> {
         })
     };
     let schema = read().map_err(|e| about(path, e))?;
+    let names: Vec<&str> = schema.iter_names().map(|n| n.as_str()).collect();
+    super::results_table::check_columns(
+        path,
+        super::results_table::TableKind::Runs,
+        names.iter().copied(),
+    )?;
     let mut columns = SUMMARY_COLUMNS.to_vec();
     columns.extend(PLANE_SUMMARY_COLUMNS.iter().filter(|c| schema.contains(c)));
     Ok(columns)

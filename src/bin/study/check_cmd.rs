@@ -86,6 +86,9 @@ fn exit_code(e: CheckError, internal: u8) -> UserError {
 
 /// Run `study baseline`.
 pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
+    if let Some(out) = &args.out {
+        autobal::output_file::prepare_folder("--out", out)?;
+    }
     let plan = load(&args.study)?;
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&plan));
     let run = RunOptions {
@@ -108,6 +111,9 @@ pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
 
 /// Run `study check`.
 pub fn check(args: &CheckArgs) -> Result<(), UserError> {
+    if let Some(out) = &args.out {
+        autobal::output_file::prepare_folder("--out", out)?;
+    }
     let plan = load(&args.study)?;
     let dir = args.baseline.clone().unwrap_or_else(|| default_dir(&plan));
     let options = CheckOptions {
