@@ -169,6 +169,18 @@ pub fn prepare(flag: &str, path: &Path, when: WhenExists) -> Result<(), OutputFi
 /// that folder can be written. Nothing is created here.
 pub fn prepare_folder(flag: &str, dir: &Path) -> Result<(), OutputFileError> {
     let shown = dir.display().to_string();
+    // "new/." cannot be created ("." inside a folder that does not exist).
+    if !dir.exists() && dir.as_os_str().to_string_lossy().ends_with("/.") {
+        return Err(OutputFileError::NoFolder {
+            flag: flag.into(),
+            path: shown.clone(),
+            parent: shown.trim_end_matches('.').into(),
+            reason: format!(
+                "folder {} does not exist; give it without the trailing /. to have it made",
+                shown.trim_end_matches("/.")
+            ),
+        });
+    }
     let mut existing = dir.to_path_buf();
     while !existing.as_os_str().is_empty() && std::fs::symlink_metadata(&existing).is_err() {
         existing = existing

@@ -122,6 +122,8 @@ impl Piece {
 }
 
 fn read_ids(path: &Path) -> PolarsResult<Vec<u64>> {
+    // A table of another kind is named with what it lacks, not "run_id".
+    summary_projection(path)?;
     let df = read_file(path, Some(&["run_id"]))?;
     Ok(df.column("run_id")?.u64()?.into_no_null_iter().collect())
 }

@@ -126,8 +126,16 @@ pub fn check(args: &CheckArgs) -> Result<(), UserError> {
             ..RunOptions::default()
         },
     };
-    let outcome = check_study(&plan, &dir, &options, &NoProgress)
-        .map_err(|e| exit_code(e, CHECK_INTERNAL))?;
+    let outcome = check_study(&plan, &dir, &options, &NoProgress).map_err(|e| {
+        // A given baseline or runs file is named by the flag it came with.
+        let flag = match &e {
+            CheckError::Baseline(_) if args.baseline.is_some() => "--baseline ",
+            CheckError::BadRuns { .. } if args.runs.is_some() => "--runs ",
+            _ => "",
+        };
+        let UserError(message, code) = exit_code(e, CHECK_INTERNAL);
+        UserError(format!("{flag}{message}"), code)
+    })?;
     let report = &outcome.report;
     if args.json {
         println!("{}", serde_json::to_string_pretty(report)?);
