@@ -519,6 +519,8 @@ fn a_results_table_of_the_wrong_kind_is_refused_naming_the_file_and_the_missing_
     assert!(study_cmd(&["baseline", p]).status.success());
     let summary = folder.join("summary.parquet");
     let s = summary.to_str().unwrap();
+    let summary_keep = tmp.path().join("summary.keep");
+    std::fs::copy(&summary, &summary_keep).unwrap();
     // The summary given where the runs are asked for.
     let out = study_cmd(&["check", p, "--runs", s]);
     let err = stderr(&out);
@@ -557,4 +559,28 @@ fn a_results_table_of_the_wrong_kind_is_refused_naming_the_file_and_the_missing_
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains(s) && err.contains("\"rank_by\""), "{err}");
     assert!(!figs.exists());
+    // A shard whose runs are a summary: merge names it.
+    for k in ["1/2", "2/2"] {
+        assert!(
+            study_cmd(&["run", p, "--quiet", "--shard", k])
+                .status
+                .success()
+        );
+    }
+    let shard = folder.join("shard-1-of-2");
+    std::fs::copy(&summary_keep, shard.join("runs.parquet")).unwrap();
+    let merged = tmp.path().join("merged");
+    let out = study_cmd(&[
+        "merge",
+        shard.to_str().unwrap(),
+        folder.join("shard-2-of-2").to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(shard.join("runs.parquet").to_str().unwrap()) && err.contains("\"outcome\""),
+        "{err}"
+    );
 }

@@ -103,20 +103,24 @@ fn a_damaged_folder_is_refused_naming_the_file_and_what_is_missing() {
     let summary_path = folder.join("summary.parquet");
     let summary = autobal::study::io::read_parquet(&summary_path).unwrap();
     let stored = std::fs::read_to_string(folder.join("study.toml")).unwrap();
-    let mut damaged = summary.drop("rank_by").unwrap();
-    autobal::study::io::write_parquet(
-        &summary_path,
-        &mut damaged,
-        &autobal::study::io::Provenance::new(&stored, 5, "all"),
-    )
-    .unwrap();
-    let (code, err, page) = report(dir, "results/corpus", "r.html");
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("results/corpus/summary.parquet") && err.contains("\"rank_by\""),
-        "{err}"
-    );
-    assert!(page.is_none());
+    // A column every summary has, and one only the ranking reads.
+    for column in ["rank_by", "vs_best_verdict"] {
+        let mut damaged = summary.drop(column).unwrap();
+        autobal::study::io::write_parquet(
+            &summary_path,
+            &mut damaged,
+            &autobal::study::io::Provenance::new(&stored, 5, "all"),
+        )
+        .unwrap();
+        let (code, err, page) = report(dir, "results/corpus", "r.html");
+        assert_eq!(code, Some(2), "{err}");
+        assert!(
+            err.contains("results/corpus/summary.parquet")
+                && err.contains(&format!("\"{column}\"")),
+            "{err}"
+        );
+        assert!(page.is_none());
+    }
     // A summary in place of the runs: both named, with what the file is.
     std::fs::copy(folder.join("runs.parquet"), dir.join("runs.keep")).unwrap();
     let mut summary = summary;

@@ -98,11 +98,14 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
         read_table(&summary_path, TableKind::Summary).map_err(|e| UserError(e.to_string(), 2))?;
     let runs_path = args.dir.join("runs.parquet");
     same_study_files(&runs_path, &summary_path)?;
-    let parts = ranking(&summary)?;
+    // A column the ranking needs beyond those checked above: still the file's fault.
+    let in_summary =
+        |message: String| UserError(format!("{}: {message}", summary_path.display()), 2);
+    let parts = ranking(&summary).map_err(|UserError(m, _)| in_summary(m))?;
     let study_text = autobal::input_file::read_text(&args.dir.join("study.toml"))
         .map_err(|e| UserError(format!("{}/study.toml: {e}", args.dir.display()), 2))?;
     // The leading designs' ids, in rank order, from the typed decision.
-    let decision = StudyDecision::from_summary(&summary)?;
+    let decision = StudyDecision::from_summary(&summary).map_err(|e| in_summary(e.to_string()))?;
     let leading = decision.leading(args.leading as usize);
     let figures = study_figures(&args.dir, &leading).map_err(plot_error)?;
     let meta = read_metadata(&runs_path).unwrap_or_default();
