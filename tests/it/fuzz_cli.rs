@@ -3,7 +3,9 @@
 //! without editing this file. Whatever the values, `study` answers with
 //! exit code 0, 1 or 2 — never a panic, a signal or a hang — and a refusal
 //! (exit 2) leaves the working folder exactly as it was, with no temporary
-//! file anywhere. Seeded, so a failure reproduces.
+//! file anywhere. Seeded, so a failure reproduces. Every path flag, read
+//! from the command definition, also meets the paths a hostile user gives
+//! (issue 46): a refusal names the flag.
 
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
