@@ -37,7 +37,7 @@ MODEL_LAYERS = [
 STUDY_LAYERS = [
     # Plain data and helpers: streams, distributions, a resolved design, a
     # design's measured runs, files.
-    {"stream", "truncated", "distribution", "design", "measured_runs", "io", "lock", "runs_file", "summary_columns"},
+    {"stream", "truncated", "distribution", "design", "measured_runs", "io", "lock", "runs_file", "summary_columns", "results_table"},
     # The parts of the study file that check, draw or measure on their own.
     {"couple", "tolerance", "plane_designs", "criterion", "optimize_spec"},
     # The study file and its resolved plan.

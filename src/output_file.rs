@@ -36,8 +36,8 @@ pub enum OutputFileError {
         /// The path.
         path: String,
     },
-    /// The folder the file would go in does not exist.
-    #[error("{flag} {path}: folder {parent} does not exist")]
+    /// The folder the file would go in does not exist (or is a file).
+    #[error("{flag} {path}: {reason}")]
     NoFolder {
         /// The flag.
         flag: String,
@@ -45,6 +45,30 @@ pub enum OutputFileError {
         path: String,
         /// Its parent folder.
         parent: String,
+        /// "folder … does not exist", or "… is a file, not a folder".
+        reason: String,
+    },
+    /// The path is a symbolic link and the user did not ask to replace it.
+    #[error(
+        "{flag} {path}: is a symbolic link (to {target}); add --overwrite to replace the link with the file"
+    )]
+    Link {
+        /// The flag.
+        flag: String,
+        /// The path.
+        path: String,
+        /// Where the link points.
+        target: String,
+    },
+    /// A folder was asked for, and the path (or a folder on its way) is a file.
+    #[error("{flag} {path}: {file} is a file, not a folder; give a folder")]
+    NotAFolder {
+        /// The flag.
+        flag: String,
+        /// The path.
+        path: String,
+        /// The file in the way.
+        file: String,
     },
     /// The file exists and the user did not ask to replace it.
     #[error("{flag} {path}: exists; add --overwrite to replace it")]
@@ -68,29 +92,41 @@ pub enum OutputFileError {
     },
 }
 
-/// Check that `path` can take a new file, before any work: it is not a
-/// folder, its folder exists and can be written, and an existing file is
-/// replaced only under [`WhenExists::Replace`]. Temporary files left beside
-/// it by a killed writer are removed.
+/// Check that `path` can take a new file, before any work: it does not
+/// name a folder (an existing one, or a path ending in `/`, `/.` or `/..`),
+/// its folder exists and can be written, and an existing file or symbolic
+/// link is replaced only under [`WhenExists::Replace`]. Temporary files left
+/// beside it by a killed writer are removed.
 pub fn prepare(flag: &str, path: &Path, when: WhenExists) -> Result<(), OutputFileError> {
     let shown = path.display().to_string();
     let parent = parent_of(path);
-    // "out.svg/" names a folder even when none exists.
-    let names_folder = path
-        .as_os_str()
-        .to_string_lossy()
-        .ends_with(std::path::MAIN_SEPARATOR);
-    if path.is_dir() || names_folder {
+    if path.is_dir() || names_folder(path) {
         return Err(OutputFileError::Folder {
             flag: flag.into(),
             path: shown,
         });
     }
     if !parent.is_dir() {
+        let reason = if parent.exists() {
+            format!("{} is a file, not a folder", parent.display())
+        } else {
+            format!("folder {} does not exist", parent.display())
+        };
         return Err(OutputFileError::NoFolder {
             flag: flag.into(),
             path: shown,
             parent: parent.display().to_string(),
+            reason,
+        });
+    }
+    let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if when == WhenExists::Refuse && link {
+        let target =
+            std::fs::read_link(path).map_or_else(|_| "?".into(), |t| t.display().to_string());
+        return Err(OutputFileError::Link {
+            flag: flag.into(),
+            path: shown,
+            target,
         });
     }
     if when == WhenExists::Refuse && path.exists() {
@@ -105,6 +141,14 @@ pub fn prepare(flag: &str, path: &Path, when: WhenExists) -> Result<(), OutputFi
         parent: parent.display().to_string(),
         source,
     };
+    // A folder without write permission is refused even for root, whom the
+    // probe below would let through: the answer must not depend on who asks.
+    if std::fs::metadata(&parent).is_ok_and(|m| m.permissions().readonly()) {
+        return Err(not_writable(std::io::Error::new(
+            std::io::ErrorKind::PermissionDenied,
+            "the folder is read-only",
+        )));
+    }
     probe_writable(&parent).map_err(not_writable)?;
     if path.exists() {
         // An existing file that is read-only would fail only at the end.
@@ -118,6 +162,66 @@ pub fn prepare(flag: &str, path: &Path, when: WhenExists) -> Result<(), OutputFi
     }
     remove_stale_temps(&parent, path.file_name().and_then(|n| n.to_str()));
     Ok(())
+}
+
+/// Check that `dir` can take (or become) an output folder, before any work:
+/// it is a folder or can be created in the nearest folder that exists, and
+/// that folder can be written. Nothing is created here.
+pub fn prepare_folder(flag: &str, dir: &Path) -> Result<(), OutputFileError> {
+    let shown = dir.display().to_string();
+    // "new/." cannot be created ("." inside a folder that does not exist).
+    if !dir.exists() && dir.as_os_str().to_string_lossy().ends_with("/.") {
+        return Err(OutputFileError::NoFolder {
+            flag: flag.into(),
+            path: shown.clone(),
+            parent: shown.trim_end_matches('.').into(),
+            reason: format!(
+                "folder {} does not exist; give it without the trailing /. to have it made",
+                shown.trim_end_matches("/.")
+            ),
+        });
+    }
+    let mut existing = dir.to_path_buf();
+    while !existing.as_os_str().is_empty() && std::fs::symlink_metadata(&existing).is_err() {
+        existing = existing
+            .parent()
+            .map_or_else(PathBuf::new, Path::to_path_buf);
+    }
+    if existing.as_os_str().is_empty() {
+        existing = PathBuf::from(".");
+    }
+    if !existing.is_dir() {
+        return Err(OutputFileError::NotAFolder {
+            flag: flag.into(),
+            path: shown,
+            file: existing.display().to_string(),
+        });
+    }
+    let not_writable = |source| OutputFileError::NotWritable {
+        flag: flag.into(),
+        path: shown.clone(),
+        parent: existing.display().to_string(),
+        source,
+    };
+    if std::fs::metadata(&existing).is_ok_and(|m| m.permissions().readonly()) {
+        return Err(not_writable(std::io::Error::new(
+            std::io::ErrorKind::PermissionDenied,
+            "the folder is read-only",
+        )));
+    }
+    probe_writable(&existing).map_err(not_writable)
+}
+
+/// Whether the path, as typed, names a folder whatever exists: it ends in a
+/// separator, `.` or `..` (`Path` drops a trailing `.`, so that "out.html/."
+/// would otherwise pass for the file "out.html" and fail after the work).
+pub fn names_folder(path: &Path) -> bool {
+    let text = path.as_os_str().to_string_lossy();
+    let last = text
+        .rsplit(['/', std::path::MAIN_SEPARATOR])
+        .next()
+        .unwrap_or("");
+    matches!(last, "" | "." | "..")
 }
 
 /// The folder a file path lives in ("." for a bare name).

@@ -9,15 +9,27 @@ use crate::plot::PlotError;
 use crate::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use crate::plot::study::{StudyData, StudyFigure, plot_study};
 use crate::study::compare_designs::Side;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A figure of the page.
 #[derive(Debug, Clone)]
 pub struct Figure {
-    /// What the figure shows, one sentence.
+    /// What the figure shows, one sentence (or, when `svg` is empty, why
+    /// it could not be drawn).
     pub caption: String,
-    /// The SVG document, without its XML prologue.
+    /// The SVG document, without its XML prologue; empty for a figure the
+    /// study's runs cannot give (nothing settled, say).
     pub svg: String,
+}
+
+impl Figure {
+    /// A figure that could not be drawn: a sentence in its place.
+    pub fn not_drawn(what: &str, why: &str) -> Self {
+        Figure {
+            caption: format!("{what}: not drawn, because {why}."),
+            svg: String::new(),
+        }
+    }
 }
 
 /// Everything the page shows, already in words and numbers.
@@ -92,6 +104,13 @@ impl Report {
         }
         out.push_str("</section>\n<section id=\"figures\">\n<h2>Figures</h2>\n");
         for (i, figure) in self.figures.iter().enumerate() {
+            if figure.svg.is_empty() {
+                out.push_str(&format!(
+                    "<figure id=\"figure-{i}\" class=\"not-drawn\">\n<p>{}</p>\n</figure>\n",
+                    escape(&figure.caption)
+                ));
+                continue;
+            }
             out.push_str(&format!(
                 "<figure id=\"figure-{i}\">\n{}\n<figcaption>{}</figcaption>\n</figure>\n",
                 figure.svg,
@@ -164,6 +183,8 @@ pub fn inline_svg(svg: &str, label: &str) -> String {
 /// The comment at the top of a study file, as paragraphs: its question in
 /// its author's words (the `#:schema` line is for editors, not readers).
 pub fn question(study_text: &str) -> Vec<String> {
+    // A byte-order mark would hide the first comment line from the test below.
+    let study_text = study_text.strip_prefix('\u{feff}').unwrap_or(study_text);
     let mut paragraphs = vec![String::new()];
     for line in study_text
         .lines()
@@ -205,12 +226,16 @@ fn draw_figures(dir: &Path, leading: &[u32], scratch: &Path) -> Result<Vec<Figur
     if data.runs.iter().any(|r| r.stall_torque.is_some()) {
         which.push(StudyFigure::Passage);
     }
+    // A figure the runs cannot give (nothing settled: no settling time to
+    // draw) leaves a sentence in its place; the verdict is still worth sharing.
     let mut figures = Vec::new();
-    let mut paths: Vec<(String, PathBuf)> = plot_study(&data, scratch, Format::Svg, &which)?
-        .into_iter()
-        .zip(&which)
-        .map(|(path, figure)| (caption(*figure), path))
-        .collect();
+    for figure in which {
+        let name = figure.file_stem().replace('_', " ");
+        figures.push(match plot_study(&data, scratch, Format::Svg, &[figure]) {
+            Ok(drawn) => inline_figure(caption(figure), &drawn[0])?,
+            Err(e) => Figure::not_drawn(&name, &undrawable(e)?),
+        });
+    }
     if !leading.is_empty() {
         let sides = leading
             .iter()
@@ -227,7 +252,7 @@ fn draw_figures(dir: &Path, leading: &[u32], scratch: &Path) -> Result<Vec<Figur
             })
             .collect();
         let path = scratch.join("kaplan_meier.svg");
-        plot_kaplan_meier(
+        let drawn = plot_kaplan_meier(
             &curves,
             "Fraction of runs settled by t: the leading designs",
             Some(SecondsAxis::for_clock(
@@ -235,23 +260,41 @@ fn draw_figures(dir: &Path, leading: &[u32], scratch: &Path) -> Result<Vec<Figur
                 sides[0].scale.rev_seconds,
             )),
             &path,
-        )?;
-        paths.push((
-            format!(
-                "Kaplan–Meier curves of the {} leading designs: the share of runs settled by each time, with 95 % bands.",
-                leading.len()
+        );
+        figures.push(match drawn {
+            Ok(()) => inline_figure(
+                format!(
+                    "Kaplan–Meier curves of the {} leading designs: the share of runs settled by each time, with 95 % bands.",
+                    leading.len()
+                ),
+                &path,
+            )?,
+            Err(e) => Figure::not_drawn(
+                "Kaplan–Meier curves of the leading designs",
+                &undrawable(e)?,
             ),
-            path,
-        ));
-    }
-    for (caption, path) in paths {
-        let svg = std::fs::read_to_string(&path)?;
-        figures.push(Figure {
-            svg: inline_svg(&svg, &caption),
-            caption,
         });
     }
     Ok(figures)
+}
+
+/// The SVG file at `path` as a figure of the page.
+fn inline_figure(caption: String, path: &Path) -> Result<Figure, PlotError> {
+    let svg = std::fs::read_to_string(path)?;
+    Ok(Figure {
+        svg: inline_svg(&svg, &caption),
+        caption,
+    })
+}
+
+/// Why a figure cannot be drawn from the study's data, in words; an error
+/// that is not about the data (a full disk, a font) is passed on.
+fn undrawable(e: PlotError) -> Result<String, PlotError> {
+    match e {
+        PlotError::NoData(why) => Ok(format!("there is nothing to plot ({why})")),
+        PlotError::Invalid { what, reason } => Ok(format!("{what}: {reason}")),
+        other => Err(other),
+    }
 }
 
 /// One sentence on what a study figure shows.

@@ -12,7 +12,7 @@
 use super::samples::{DesignSample, columns_of, design_samples};
 use crate::study::aggregate::summarize;
 use crate::study::config::StudyPlan;
-use crate::study::io::{Provenance, read_metadata, read_parquet, write_parquet, write_text};
+use crate::study::io::{Provenance, read_metadata, write_parquet, write_text};
 use crate::study::record::{RunRecord, to_dataframe};
 use polars::prelude::PolarsError;
 use serde::{Deserialize, Serialize};
@@ -196,7 +196,10 @@ pub fn read_baseline(dir: &Path) -> Result<Baseline, BaselineError> {
             "runs.parquet comes from another study than the manifest names".into(),
         ));
     }
-    let df = read_parquet(&runs_path)?;
+    let df = crate::study::results_table::read_table(
+        &runs_path,
+        crate::study::results_table::TableKind::Runs,
+    )?;
     if df.height() as u64 != manifest.runs {
         return Err(inconsistent(format!(
             "runs.parquet holds {} runs, the manifest says {}",
@@ -213,8 +216,8 @@ pub fn read_baseline(dir: &Path) -> Result<Baseline, BaselineError> {
 
 /// Refuse a baseline written from another study text than `plan`'s.
 pub fn check_same_study(baseline: &Baseline, plan: &StudyPlan) -> Result<(), BaselineError> {
-    let study = crate::study::io::sha256_hex(&plan.text);
-    if baseline.manifest.study_sha256 != study {
+    let study = crate::study::io::study_sha256(&plan.text);
+    if !crate::study::io::same_study(&baseline.manifest.study_sha256, &plan.text) {
         return Err(BaselineError::DifferentStudy {
             dir: baseline.dir.display().to_string(),
             baseline: baseline.manifest.study_sha256.clone(),

@@ -14,7 +14,8 @@ use super::baseline::{BaselineError, Manifest, check_same_study, read_baseline, 
 use super::compare::{CheckReport, CompareError, compare};
 use super::samples::design_samples;
 use crate::study::config::StudyPlan;
-use crate::study::io::{read_metadata, read_parquet, sha256_hex};
+use crate::study::io::{read_metadata, read_parquet};
+use crate::study::results_table::{TableKind, read_table};
 use crate::study::run::{Progress, RunError, RunOptions, run_study};
 use polars::prelude::PolarsError;
 use std::path::{Path, PathBuf};
@@ -143,7 +144,7 @@ impl CheckError {
                 true
             }
             CheckError::Run(e) => e.is_user_error(),
-            CheckError::Polars(_) => false,
+            CheckError::Polars(e) => crate::study::io::is_not_parquet(e),
         }
     }
 }
@@ -212,7 +213,21 @@ pub fn check_study(
     let (samples, seed, runs_file) = match &options.runs {
         Some(path) => {
             let seed = runs_file_seed(path, plan)?;
-            (design_samples(&read_parquet(path)?)?, seed, path.clone())
+            (
+                design_samples(&read_table(path, TableKind::Runs).map_err(|e| {
+                    let shown = path.display().to_string();
+                    let text = e.to_string();
+                    CheckError::BadRuns {
+                        message: text
+                            .strip_prefix(&format!("{shown}: "))
+                            .unwrap_or(&text)
+                            .to_string(),
+                        path: shown,
+                    }
+                })?)?,
+                seed,
+                path.clone(),
+            )
         }
         None => {
             let mut fresh = plan.clone();
@@ -257,7 +272,7 @@ fn runs_file_seed(path: &Path, plan: &StudyPlan) -> Result<u64, CheckError> {
             .find(|(key, _)| key == k)
             .map(|(_, v)| v.as_str())
     };
-    if get("study_sha256") != Some(sha256_hex(&plan.text).as_str()) {
+    if !get("study_sha256").is_some_and(|sha| crate::study::io::same_study(sha, &plan.text)) {
         return Err(bad(
             "was not written by this study file (its provenance names another study)",
         ));

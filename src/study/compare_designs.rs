@@ -4,7 +4,6 @@
 
 use super::config::{StudyFile, StudyPlan};
 use super::criterion::Criterion;
-use super::io::read_parquet;
 use super::measured_runs::{DesignRuns, Scale};
 use super::verdict::{
     Comparison, Favours, SettlingClock, compare, design_runs, favoured, measure_scale,
@@ -97,7 +96,8 @@ impl Side {
                 available: format!("0..={}", plan.designs.len().saturating_sub(1)),
             });
         };
-        let df = read_parquet(&runs_path)?;
+        let df =
+            super::results_table::read_table(&runs_path, super::results_table::TableKind::Runs)?;
         let mine = df.filter(&df.column("design_id")?.u32()?.equal(id))?;
         let mine = mine.sort(["sample_id"], SortMultipleOptions::default())?;
         let scale = measure_scale(&plan);

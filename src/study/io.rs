@@ -17,7 +17,8 @@ pub struct Provenance {
     /// Git commit autobal was built from ("+dirty" with uncommitted
     /// changes, "unknown" outside a git checkout): [`crate::build_info`].
     pub git_commit: String,
-    /// SHA-256 of the study file's text (the text is the folder's `study.toml`).
+    /// SHA-256 of the study text as the folder's `study.toml` holds it
+    /// ([`study_sha256`]): `sha256sum study.toml` there gives this value.
     pub study_sha256: String,
     /// The master seed.
     pub seed: u64,
@@ -31,7 +32,7 @@ impl Provenance {
         Provenance {
             version: env!("CARGO_PKG_VERSION").to_string(),
             git_commit: crate::build_info::commit_label(),
-            study_sha256: sha256_hex(study_text),
+            study_sha256: study_sha256(study_text),
             seed,
             shard: shard.to_string(),
         }
@@ -72,10 +73,15 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
 /// is called in messages.
 const NOT_PARQUET: &str = "not a readable Parquet file";
 
-/// Whether `e` (from [`about`]) says a file is not readable Parquet: the
-/// user's file is damaged, an input error rather than a fault of the tool.
+/// What a Parquet file of the wrong kind, or missing a column, is called in
+/// messages (`super::results_table` says which).
+pub(crate) const WRONG_TABLE: &str = "is not the results table needed";
+
+/// Whether `e` (from [`about`], or `super::results_table`) says a file is
+/// not readable Parquet or not the table needed: the user's file is damaged
+/// or the wrong one, an input error rather than a fault of the tool.
 pub fn is_not_parquet(e: &PolarsError) -> bool {
-    matches!(e, PolarsError::ComputeError(m) if m.contains(NOT_PARQUET))
+    matches!(e, PolarsError::ComputeError(m) if m.contains(NOT_PARQUET) || m.contains(WRONG_TABLE))
 }
 
 /// `e` (met while reading or writing `path`) with the path in front of its
@@ -165,6 +171,19 @@ pub fn folder_copy(study_text: &str) -> String {
         None if study_text.trim_start().starts_with("#:schema") => String::new(),
         _ => study_text.to_string(),
     }
+}
+
+/// SHA-256 of a study text as its results folder keeps it ([`folder_copy`]),
+/// so that the recorded hash is that of the stored `study.toml`, byte for byte.
+pub fn study_sha256(study_text: &str) -> String {
+    sha256_hex(&folder_copy(study_text))
+}
+
+/// Whether `recorded` is the hash of `study_text`: as [`study_sha256`] gives
+/// it, or of the whole file (its `#:schema` line included), as it was
+/// recorded before the two were made to agree: older baselines stay valid.
+pub fn same_study(recorded: &str, study_text: &str) -> bool {
+    recorded == study_sha256(study_text) || recorded == sha256_hex(study_text)
 }
 
 /// Write a text file atomically.

@@ -128,8 +128,8 @@ pub fn merge(
         .into());
     }
     let mut provenance = Provenance::new(&plan.text, plan.file.seed, "all");
-    // The shards' folders keep the study text without its `#:schema` line:
-    // the hash of the study file itself is the one the shards recorded.
+    // The hash the shards recorded (older shards hashed the study file
+    // with its `#:schema` line, which their folders' copies leave out).
     if let Some(sha) = super::io::read_metadata(&dirs[0].join("runs.parquet"))
         .ok()
         .and_then(|m| m.into_iter().find(|(k, _)| k == "study_sha256"))

@@ -48,6 +48,7 @@ pub mod plane_designs;
 pub mod plane_summary;
 pub mod racing;
 pub mod record;
+pub mod results_table;
 pub mod run;
 pub mod runs_file;
 pub mod sample;

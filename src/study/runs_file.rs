@@ -122,6 +122,8 @@ impl Piece {
 }
 
 fn read_ids(path: &Path) -> PolarsResult<Vec<u64>> {
+    // A table of another kind is named with what it lacks, not "run_id".
+    summary_projection(path)?;
     let df = read_file(path, Some(&["run_id"]))?;
     Ok(df.column("run_id")?.u64()?.into_no_null_iter().collect())
 }
@@ -229,6 +231,12 @@ fn summary_projection(path: &Path) -> PolarsResult<Vec<&'static str>> {
         })
     };
     let schema = read().map_err(|e| about(path, e))?;
+    let names: Vec<&str> = schema.iter_names().map(|n| n.as_str()).collect();
+    super::results_table::check_columns(
+        path,
+        super::results_table::TableKind::Runs,
+        names.iter().copied(),
+    )?;
     let mut columns = SUMMARY_COLUMNS.to_vec();
     columns.extend(PLANE_SUMMARY_COLUMNS.iter().filter(|c| schema.contains(c)));
     Ok(columns)

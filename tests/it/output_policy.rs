@@ -413,3 +413,174 @@ fn claims_rewrites_only_the_variant_folders_it_marked() {
     // Its own folders are recomputed.
     autobal::claims::run_claims(&plan, &autobal::study::run::NoProgress).unwrap();
 }
+
+#[cfg(unix)]
+#[test]
+fn a_trailing_dot_a_link_a_read_only_folder_or_a_file_as_folder_is_refused_before_any_work() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("scene.toml"), scene()).unwrap();
+    std::fs::write(dir.join("corpus.toml"), study(Path::new("results"))).unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", "corpus.toml", "--quiet"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", stderr(&run));
+    std::fs::write(dir.join("kept.txt"), b"keep").unwrap();
+    std::os::unix::fs::symlink("kept.txt", dir.join("link.out")).unwrap();
+    std::fs::create_dir(dir.join("ro")).unwrap();
+    std::fs::set_permissions(dir.join("ro"), std::fs::Permissions::from_mode(0o555)).unwrap();
+    let base: &[(&str, &[&str])] = &[
+        (
+            "--out",
+            &["sweep", "scene.toml", "--omega", "1..4", "--points", "2"],
+        ),
+        (
+            "--out",
+            &[
+                "map",
+                "scene.toml",
+                "--omega",
+                "1..4",
+                "--unbalance",
+                "0.001..0.002",
+                "--points",
+                "2x2",
+            ],
+        ),
+        ("--series", &["simulate", "scene.toml"]),
+        ("--report", &["claims", "corpus.toml"]),
+        ("--out", &["report", "results/corpus"]),
+        ("--out", &["plot", "design"]),
+        ("--plot", &["compare", "results/corpus", "--designs", "0,0"]),
+    ];
+    for (flag, verb) in base {
+        let figure = verb[0] == "plot" || *flag == "--plot";
+        let ext = if figure { "svg" } else { "out" };
+        let mut cases = vec![
+            (format!("r.{ext}/."), "names a folder"),
+            (format!("ro/r.{ext}"), "read-only"),
+            (format!("kept.txt/r.{ext}"), "is a file, not a folder"),
+        ];
+        // A figure is redrawn in place; results are replaced only when asked.
+        if !figure {
+            cases.push(("link.out".into(), "symbolic link"));
+        }
+        for (value, reason) in cases {
+            let mut args: Vec<String> = verb.iter().map(|s| s.to_string()).collect();
+            args.extend([flag.to_string(), value.clone()]);
+            let before = listing(dir);
+            let out = Command::new(env!("CARGO_BIN_EXE_study"))
+                .args(&args)
+                .current_dir(dir)
+                .output()
+                .unwrap();
+            let err = stderr(&out);
+            assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+            assert!(
+                err.contains(&format!("{flag} {value}")) && err.contains(reason),
+                "{args:?}: expected {flag} {value} and {reason:?} in: {err}"
+            );
+            assert_eq!(listing(dir), before, "{args:?} changed the folder");
+        }
+    }
+    assert_eq!(std::fs::read(dir.join("kept.txt")).unwrap(), b"keep");
+    // Folders asked for (plot study's --out) get the same care.
+    for (value, reason) in [
+        ("kept.txt", "is a file"),
+        ("ro/figs", "read-only"),
+        ("new/.", "does not exist"),
+    ] {
+        let before = listing(dir);
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["plot", "study", "results/corpus", "--out", value])
+            .current_dir(dir)
+            .output()
+            .unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{value}: {err}");
+        assert!(
+            err.contains(&format!("--out {value}")) && err.contains(reason),
+            "{err}"
+        );
+        assert_eq!(listing(dir), before);
+    }
+    std::fs::set_permissions(dir.join("ro"), std::fs::Permissions::from_mode(0o755)).unwrap();
+}
+
+#[test]
+fn a_results_table_of_the_wrong_kind_is_refused_naming_the_file_and_the_missing_columns() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (path, folder) = corpus_study(tmp.path(), "");
+    let p = path.to_str().unwrap();
+    assert!(study_cmd(&["run", p, "--quiet"]).status.success());
+    assert!(study_cmd(&["baseline", p]).status.success());
+    let summary = folder.join("summary.parquet");
+    let s = summary.to_str().unwrap();
+    let summary_keep = tmp.path().join("summary.keep");
+    std::fs::copy(&summary, &summary_keep).unwrap();
+    // The summary given where the runs are asked for.
+    let out = study_cmd(&["check", p, "--runs", s]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!("--runs {s}"))
+            && err.contains("\"outcome\"")
+            && err.contains("summary.parquet"),
+        "{err}"
+    );
+    assert_eq!(err.matches(s).count(), 1, "{err}");
+    // The summary in the runs' place, and the runs in the summary's.
+    let runs = folder.join("runs.parquet");
+    let keep = tmp.path().join("runs.keep");
+    std::fs::copy(&runs, &keep).unwrap();
+    std::fs::copy(&summary, &runs).unwrap();
+    let f = folder.to_str().unwrap();
+    let figs = tmp.path().join("figs");
+    for args in [
+        vec!["compare", f, "--designs", "0,0"],
+        vec!["plot", "study", f, "--out", figs.to_str().unwrap()],
+        vec!["run", p, "--quiet", "--resume"],
+    ] {
+        let out = study_cmd(&args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(runs.to_str().unwrap()) && err.contains("\"outcome\""),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::copy(&keep, &summary).unwrap();
+    std::fs::copy(&keep, &runs).unwrap();
+    let out = study_cmd(&["plot", "study", f, "--out", figs.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(s) && err.contains("\"rank_by\""), "{err}");
+    assert!(!figs.exists());
+    // A shard whose runs are a summary: merge names it.
+    for k in ["1/2", "2/2"] {
+        assert!(
+            study_cmd(&["run", p, "--quiet", "--shard", k])
+                .status
+                .success()
+        );
+    }
+    let shard = folder.join("shard-1-of-2");
+    std::fs::copy(&summary_keep, shard.join("runs.parquet")).unwrap();
+    let merged = tmp.path().join("merged");
+    let out = study_cmd(&[
+        "merge",
+        shard.to_str().unwrap(),
+        folder.join("shard-2-of-2").to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(shard.join("runs.parquet").to_str().unwrap()) && err.contains("\"outcome\""),
+        "{err}"
+    );
+}

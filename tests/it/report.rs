@@ -68,3 +68,159 @@ fn the_report_holds_question_ranking_verdicts_figures_curves_and_provenance_and_
     assert_eq!(not_a_study.status.code(), Some(2));
     assert!(!dir.join("x.html").exists());
 }
+
+/// A finished study of the bad-input corpus in `dir` (name "corpus"),
+/// with `edit` applied to its text and `extra` given to `study run`.
+fn finished(dir: &Path, edit: &dyn Fn(String) -> String, extra: &[&str]) {
+    let text = edit(crate::bad_input::study(Path::new("results")));
+    std::fs::write(dir.join("s.toml"), text).unwrap();
+    let mut args = vec!["run", "s.toml", "--quiet"];
+    args.extend(extra);
+    let run = study(dir, &args);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+/// `study report` of `folder` into `out`: (exit code, stderr, the page if written).
+fn report(dir: &Path, folder: &str, out: &str) -> (Option<i32>, String, Option<String>) {
+    let made = study(dir, &["report", folder, "--out", out]);
+    (
+        made.status.code(),
+        String::from_utf8_lossy(&made.stderr).to_string(),
+        std::fs::read_to_string(dir.join(out)).ok(),
+    )
+}
+
+#[test]
+fn a_damaged_folder_is_refused_naming_the_file_and_what_is_missing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    finished(dir, &|t| t, &[]);
+    let folder = dir.join("results/corpus");
+    let summary_path = folder.join("summary.parquet");
+    let summary = autobal::study::io::read_parquet(&summary_path).unwrap();
+    let stored = std::fs::read_to_string(folder.join("study.toml")).unwrap();
+    // A column every summary has, and one only the ranking reads.
+    for column in ["rank_by", "vs_best_verdict"] {
+        let mut damaged = summary.drop(column).unwrap();
+        autobal::study::io::write_parquet(
+            &summary_path,
+            &mut damaged,
+            &autobal::study::io::Provenance::new(&stored, 5, "all"),
+        )
+        .unwrap();
+        let (code, err, page) = report(dir, "results/corpus", "r.html");
+        assert_eq!(code, Some(2), "{err}");
+        assert!(
+            err.contains("results/corpus/summary.parquet")
+                && err.contains(&format!("\"{column}\"")),
+            "{err}"
+        );
+        assert!(page.is_none());
+    }
+    // A summary in place of the runs: both named, with what the file is.
+    std::fs::copy(folder.join("runs.parquet"), dir.join("runs.keep")).unwrap();
+    let mut summary = summary;
+    autobal::study::io::write_parquet(
+        &summary_path,
+        &mut summary,
+        &autobal::study::io::Provenance::new(&stored, 5, "all"),
+    )
+    .unwrap();
+    std::fs::copy(&summary_path, folder.join("runs.parquet")).unwrap();
+    let (code, err, page) = report(dir, "results/corpus", "r.html");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("results/corpus/runs.parquet")
+            && err.contains("\"outcome\"")
+            && err.contains("summary.parquet"),
+        "{err}"
+    );
+    assert!(page.is_none());
+    // No runs at all.
+    std::fs::remove_file(folder.join("runs.parquet")).unwrap();
+    let (code, err, _) = report(dir, "results/corpus", "r.html");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("results/corpus/runs.parquet"), "{err}");
+}
+
+#[test]
+fn another_studys_summary_beside_these_runs_is_refused_naming_both_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    finished(dir, &|t| t, &[]);
+    let other = tempfile::tempdir().unwrap();
+    finished(other.path(), &|t| t.replace("seed = 5", "seed = 6"), &[]);
+    std::fs::copy(
+        other.path().join("results/corpus/summary.parquet"),
+        dir.join("results/corpus/summary.parquet"),
+    )
+    .unwrap();
+    let (code, err, page) = report(dir, "results/corpus", "r.html");
+    assert_eq!(code, Some(2), "{err}");
+    for needle in [
+        "results/corpus/summary.parquet",
+        "results/corpus/runs.parquet",
+        "hashes differ",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    assert!(page.is_none());
+}
+
+#[test]
+fn a_study_where_nothing_settled_is_reported_with_a_sentence_for_each_figure_it_cannot_give() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // The hold window (50 rev) fills the run but for 2 rev: nothing settles.
+    finished(
+        dir,
+        &|t| t.replace("t_end_revs = 100", "t_end_revs = 52"),
+        &[],
+    );
+    let summary =
+        autobal::study::io::read_parquet(&dir.join("results/corpus/summary.parquet")).unwrap();
+    let settled: u64 = summary
+        .column("settled")
+        .unwrap()
+        .u64()
+        .unwrap()
+        .iter()
+        .flatten()
+        .sum();
+    assert_eq!(settled, 0, "a run settled");
+    let (code, err, page) = report(dir, "results/corpus", "r.html");
+    assert_eq!(code, Some(0), "{err}");
+    let page = page.unwrap();
+    assert!(page.contains("<table id=\"ranking-table\">"));
+    assert!(page.contains("<section id=\"verdicts\">"));
+    assert!(
+        page.contains("settling time: not drawn, because there is nothing to plot"),
+        "no sentence in place of the figure"
+    );
+}
+
+#[test]
+fn a_bom_keeps_the_question_and_the_reproducing_command_keeps_the_ranking() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    finished(
+        dir,
+        &|t| format!("\u{feff}# Which drag settles soonest?\n{t}"),
+        &["--rank-by", "median"],
+    );
+    let (code, err, page) = report(dir, "results/corpus", "r.html");
+    assert_eq!(code, Some(0), "{err}");
+    let page = page.unwrap();
+    assert!(
+        page.contains("<p>Which drag settles soonest?</p>"),
+        "the question is lost"
+    );
+    assert!(
+        page.contains("study run results/corpus/study.toml --overwrite --rank-by median"),
+        "the command reproduces another ranking"
+    );
+}

@@ -163,7 +163,65 @@ fn the_folders_copy_of_the_study_leaves_out_the_schema_line_and_still_resumes_an
             .1
     };
     let whole = sha(&folder.join("runs.parquet"));
-    assert_eq!(whole, autobal::study::io::sha256_hex(&text));
+    // The recorded hash is that of the stored study.toml, byte for byte:
+    // `sha256sum results/folder/study.toml` finds it.
+    let stored = std::fs::read(folder.join("study.toml")).unwrap();
+    assert_eq!(whole, hex_sha256(&stored));
+    assert_eq!(sha(&folder.join("summary.parquet")), whole);
     assert_eq!(sha(&merged_dir.join("runs.parquet")), whole);
     assert_eq!(sha(&merged_dir.join("summary.parquet")), whole);
+}
+
+/// SHA-256 of bytes as `sha256sum` prints it.
+fn hex_sha256(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+#[test]
+fn resume_after_the_study_changed_advises_overwrite_and_that_advice_works() {
+    let (_tmp, path, folder) = setup();
+    assert!(study(&path, &[]).status.success());
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text.replace("samples = 2", "samples = 3")).unwrap();
+    let before = std::fs::read(folder.join("runs.parquet")).unwrap();
+    let resumed = study(&path, &["--resume"]);
+    let err = stderr(&resumed);
+    assert_eq!(resumed.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--overwrite") && err.contains("replace the earlier runs"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("without --resume"),
+        "the circle is back: {err}"
+    );
+    assert_eq!(std::fs::read(folder.join("runs.parquet")).unwrap(), before);
+    // Following the advice runs the changed study.
+    let replaced = study(&path, &["--overwrite"]);
+    assert!(replaced.status.success(), "{}", stderr(&replaced));
+    let runs = autobal::study::io::read_parquet(&folder.join("runs.parquet")).unwrap();
+    assert_eq!(runs.height(), 3);
+}
+
+#[test]
+fn resume_of_a_complete_study_says_so_and_prints_its_ranking_without_a_rate() {
+    let (_tmp, path, _folder) = setup();
+    assert!(study(&path, &[]).status.success());
+    let again = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", path.to_str().unwrap(), "--resume"])
+        .args(["--progress-every", "1000"])
+        .output()
+        .unwrap();
+    let err = stderr(&again);
+    assert!(again.status.success(), "{err}");
+    assert!(err.contains("already complete"), "{err}");
+    for meaningless in ["0 runs", "runs/s", "s/run", "settled 0.0 %"] {
+        assert!(!err.contains(meaningless), "{meaningless}: {err}");
+    }
+    let out = String::from_utf8_lossy(&again.stdout);
+    assert!(out.contains("recommendation"), "no ranking: {out}");
 }

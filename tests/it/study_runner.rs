@@ -196,11 +196,13 @@ fn ctrl_c_saves_the_finished_runs_leaves_no_temporary_file_and_resume_completes(
     let study = stopped.path().join("small.toml");
     std::fs::write(&study, &text).unwrap();
     let out = stopped.path().join("small");
+    // Not quiet: the batch log's closing line must not claim "finished".
     let child = Command::new(env!("CARGO_BIN_EXE_study"))
         .args([
             "run",
             study.to_str().unwrap(),
-            "--quiet",
+            "--progress-every",
+            "1000",
             "--chunk-runs",
             "5",
             "--threads",
@@ -220,7 +222,18 @@ fn ctrl_c_saves_the_finished_runs_leaves_no_temporary_file_and_resume_completes(
     let err = String::from_utf8_lossy(&ended.stderr);
     assert_eq!(ended.status.code(), Some(130), "{err}");
     assert!(
-        err.contains("interrupted") && err.contains("--resume"),
+        err.contains("interrupted after ")
+            && err.contains(" of 300 runs")
+            && err.contains("--resume"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("finished"),
+        "an interrupted study said finished: {err}"
+    );
+    assert_eq!(
+        err.lines().filter(|l| l.contains("interrupted")).count(),
+        1,
         "{err}"
     );
     assert!(!out.join("runs.parquet").exists());

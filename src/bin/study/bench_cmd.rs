@@ -177,7 +177,7 @@ fn write_lean_inputs(
 ) -> Result<(), UserError> {
     let plan = match study {
         Some(file) => bench::lean_inputs::lean_plan_of(file, samples)
-            .map_err(|e| UserError(format!("{}: {e}", file.display()), 2))?,
+            .map_err(|e| UserError(format!("--lean-study {}: {e}", file.display()), 2))?,
         None => bench::lean_inputs::lean_plan(samples),
     };
     let rows = bench::lean_inputs::lean_rows(&plan).map_err(UserError::internal)?;

@@ -86,6 +86,9 @@ fn exit_code(e: CheckError, internal: u8) -> UserError {
 
 /// Run `study baseline`.
 pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
+    if let Some(out) = &args.out {
+        autobal::output_file::prepare_folder("--out", out)?;
+    }
     let plan = load(&args.study)?;
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&plan));
     let run = RunOptions {
@@ -108,6 +111,9 @@ pub fn baseline(args: &BaselineArgs) -> Result<(), UserError> {
 
 /// Run `study check`.
 pub fn check(args: &CheckArgs) -> Result<(), UserError> {
+    if let Some(out) = &args.out {
+        autobal::output_file::prepare_folder("--out", out)?;
+    }
     let plan = load(&args.study)?;
     let dir = args.baseline.clone().unwrap_or_else(|| default_dir(&plan));
     let options = CheckOptions {
@@ -120,8 +126,16 @@ pub fn check(args: &CheckArgs) -> Result<(), UserError> {
             ..RunOptions::default()
         },
     };
-    let outcome = check_study(&plan, &dir, &options, &NoProgress)
-        .map_err(|e| exit_code(e, CHECK_INTERNAL))?;
+    let outcome = check_study(&plan, &dir, &options, &NoProgress).map_err(|e| {
+        // A given baseline or runs file is named by the flag it came with.
+        let flag = match &e {
+            CheckError::Baseline(_) if args.baseline.is_some() => "--baseline ",
+            CheckError::BadRuns { .. } if args.runs.is_some() => "--runs ",
+            _ => "",
+        };
+        let UserError(message, code) = exit_code(e, CHECK_INTERNAL);
+        UserError(format!("{flag}{message}"), code)
+    })?;
     let report = &outcome.report;
     if args.json {
         println!("{}", serde_json::to_string_pretty(report)?);

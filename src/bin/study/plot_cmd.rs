@@ -147,20 +147,20 @@ pub fn run(args: &PlotArgs) -> Result<(), UserError> {
                 Some(k) => vec![k.into()],
                 None => Shape::ALL.to_vec(),
             };
-            plot_design(&shapes, &a.n.0, &a.out).map_err(plot_error)?;
+            plot_design(&shapes, &a.n.0, &a.out).map_err(write_error("--out", &a.out))?;
             vec![a.out.clone()]
         }
         Figure::Map(a) => {
             check_out(&a.out)?;
             let points = autobal::plot::map::read_map(&a.table).map_err(plot_error)?;
             autobal::plot::map::plot_stability_map(&points, &a.title, &a.out)
-                .map_err(plot_error)?;
+                .map_err(write_error("--out", &a.out))?;
             vec![a.out.clone()]
         }
         Figure::Tradeoff(a) => {
             check_out(&a.out)?;
             let points = read_tradeoff(&a.table).map_err(plot_error)?;
-            plot_work_precision(&points, &a.title, &a.out).map_err(plot_error)?;
+            plot_work_precision(&points, &a.title, &a.out).map_err(write_error("--out", &a.out))?;
             vec![a.out.clone()]
         }
     };
@@ -183,7 +183,7 @@ fn plot_one_run(a: &RunArgs) -> Result<Vec<PathBuf>, UserError> {
         format!("{name}: one run ({})", result.metrics.outcome.name())
     });
     let figure = RunFigure::new(&simulation, &result, &title).map_err(plot_error)?;
-    plot_run(&figure, &a.out).map_err(plot_error)?;
+    plot_run(&figure, &a.out).map_err(write_error("--out", &a.out))?;
     Ok(vec![a.out.clone()])
 }
 
@@ -197,6 +197,7 @@ fn plot_one_study(a: &StudyArgs) -> Result<Vec<PathBuf>, UserError> {
             2,
         ));
     }
+    autobal::output_file::prepare_folder("--out", &a.out)?;
     let data = StudyData::read(&a.dir).map_err(plot_error)?;
     let format = match a.format {
         FormatArg::Svg => Format::Svg,
@@ -212,7 +213,7 @@ fn plot_one_study(a: &StudyArgs) -> Result<Vec<PathBuf>, UserError> {
         }
         None => StudyFigure::ALL.to_vec(),
     };
-    plot_study(&data, &a.out, format, &figures).map_err(plot_error)
+    plot_study(&data, &a.out, format, &figures).map_err(write_error("--out", &a.out))
 }
 
 /// Reject a bad --out before any work: wrong extension or missing folder.
@@ -227,6 +228,18 @@ pub(crate) fn check_figure_path(flag: &str, out: &Path) -> Result<(), UserError>
     Format::from_path(out).map_err(|e| UserError(format!("{flag} {e}"), 2))?;
     autobal::output_file::prepare(flag, out, autobal::output_file::WhenExists::Replace)?;
     Ok(())
+}
+
+/// [`plot_error`] for drawing into `out`: a failure to write the file
+/// names the flag and the path (the folder went away, a disk filled up).
+pub(crate) fn write_error(flag: &'static str, out: &Path) -> impl Fn(PlotError) -> UserError {
+    let shown = out.display().to_string();
+    move |e| match e {
+        PlotError::Io(_) | PlotError::NoFolder(_) => {
+            UserError(format!("{flag} {shown}: cannot write the figure: {e}"), 2)
+        }
+        other => plot_error(other),
+    }
 }
 
 /// Drawing and font failures are ours (exit 1); everything else is the input's (exit 2).

@@ -56,7 +56,7 @@ impl RunProgress {
                 .with_key(
                     "rate",
                     |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
-                        let _ = write!(w, "{:.0} runs/s", state.per_sec());
+                        let _ = write!(w, "{}", rate_text(state.per_sec()));
                     },
                 ),
             );
@@ -98,11 +98,24 @@ impl RunProgress {
             "–".into()
         };
         format!(
-            "progress: {finished}/{total} runs ({:.1} %), {rate:.0} runs/s, elapsed {}, ETA {eta}, settled {settled_share} so far, failures {}",
+            "progress: {finished}/{total} runs ({:.1} %), {}, elapsed {}, ETA {eta}, settled {settled_share} so far, failures {}",
             100.0 * finished as f64 / total.max(1) as f64,
+            rate_text(rate),
             hms(elapsed.as_secs_f64()),
             self.failures.load(Ordering::Relaxed)
         )
+    }
+}
+
+/// A rate of runs as people read it: "581 runs/s", or below one run a
+/// second "12.3 s/run" (a slow study would otherwise show "0 runs/s").
+pub fn rate_text(runs_per_second: f64) -> String {
+    if runs_per_second >= 0.95 {
+        format!("{runs_per_second:.0} runs/s")
+    } else if runs_per_second > 0.0 && runs_per_second.is_finite() {
+        format!("{:.1} s/run", 1.0 / runs_per_second)
+    } else {
+        "– s/run".into()
     }
 }
 
@@ -158,6 +171,14 @@ impl Progress for RunProgress {
         }
     }
 
+    fn interrupted(&self, _finished: u64, _total: u64) {
+        // The error that follows is the one line that says so: no
+        // "finished" line may come before it.
+        if let Reporter::Bar(bar) = &self.reporter {
+            bar.finish_and_clear();
+        }
+    }
+
     fn end(&self) {
         let start = match &self.reporter {
             Reporter::Quiet => return,
@@ -180,17 +201,38 @@ impl Progress for RunProgress {
         } else {
             String::new()
         };
-        let line = format!(
-            "finished: {} runs in {} ({:.0} runs/s), settled {:.1} %{early}, failures {}",
-            done,
-            hms(elapsed.as_secs_f64()),
-            done as f64 / elapsed.as_secs_f64().max(1e-9),
-            100.0 * settled as f64 / done.max(1) as f64,
-            self.failures.load(Ordering::Relaxed)
-        );
+        let earlier = self.earlier.load(Ordering::Relaxed);
+        let line = if done == 0 {
+            // A resumed study that was already complete: no rate to give.
+            format!(
+                "already complete: all {earlier} runs were finished earlier; nothing left to run"
+            )
+        } else {
+            format!(
+                "finished: {} runs in {} ({}), settled {:.1} %{early}, failures {}",
+                done,
+                hms(elapsed.as_secs_f64()),
+                rate_text(done as f64 / elapsed.as_secs_f64().max(1e-9)),
+                100.0 * settled as f64 / done.max(1) as f64,
+                self.failures.load(Ordering::Relaxed)
+            )
+        };
         eprint!(
             "{}",
             crate::output::wrap(&line, crate::output::text_width())
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rate_text;
+
+    #[test]
+    fn a_rate_below_one_run_a_second_is_given_in_seconds_per_run() {
+        assert_eq!(rate_text(581.6), "582 runs/s");
+        assert_eq!(rate_text(1.0), "1 runs/s");
+        assert_eq!(rate_text(1.0 / 12.3), "12.3 s/run");
+        assert_eq!(rate_text(0.0), "– s/run");
     }
 }

@@ -8,9 +8,10 @@ use crate::ranking::ranking;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::report::{Report, question, study_figures};
 use autobal::study::decision::StudyDecision;
-use autobal::study::io::{read_metadata, read_parquet, write_text};
+use autobal::study::io::{read_metadata, write_text};
+use autobal::study::results_table::{TableKind, read_table};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Examples shown under `study report --help`.
 pub const EXAMPLES: &str = "Examples:
@@ -29,8 +30,51 @@ pub struct ReportArgs {
     #[arg(long)]
     overwrite: bool,
     /// How many leading designs get a Kaplan–Meier curve.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=8))]
+    #[arg(long, default_value_t = DEFAULT_LEADING, value_parser = clap::value_parser!(u32).range(0..=8))]
     leading: u32,
+}
+
+/// Leading designs drawn when `--leading` is not given.
+const DEFAULT_LEADING: u32 = 3;
+
+/// Refuse a folder whose runs and summary come from different studies:
+/// the page would put one study's verdict beside another's runs.
+fn same_study_files(runs: &Path, summary: &Path) -> Result<(), UserError> {
+    let hash = |path: &Path| -> Result<Option<String>, UserError> {
+        if !path.is_file() {
+            return Err(UserError(
+                format!(
+                    "{}: not found (give the output folder of a finished `study run` or `study merge`)",
+                    path.display()
+                ),
+                2,
+            ));
+        }
+        let meta = read_metadata(path).map_err(|e| UserError(e.to_string(), 2))?;
+        Ok(meta
+            .into_iter()
+            .find(|(k, _)| k == "study_sha256")
+            .map(|(_, v)| v))
+    };
+    let (of_runs, of_summary) = (hash(runs)?, hash(summary)?);
+    if of_runs != of_summary {
+        let short = |h: &Option<String>| {
+            h.as_deref().map_or("none recorded".to_string(), |h| {
+                h[..h.len().min(12)].to_string()
+            })
+        };
+        return Err(UserError(
+            format!(
+                "{} and {} come from different studies: their study hashes differ ({} and {}); rerun the study, or give a folder whose files belong together",
+                summary.display(),
+                runs.display(),
+                short(&of_summary),
+                short(&of_runs)
+            ),
+            2,
+        ));
+    }
+    Ok(())
 }
 
 /// Run `study report`.
@@ -50,14 +94,21 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
             2,
         ));
     }
-    let summary = read_parquet(&summary_path).map_err(|e| UserError(e.to_string(), 2))?;
-    let parts = ranking(&summary)?;
+    let summary =
+        read_table(&summary_path, TableKind::Summary).map_err(|e| UserError(e.to_string(), 2))?;
+    let runs_path = args.dir.join("runs.parquet");
+    same_study_files(&runs_path, &summary_path)?;
+    // A column the ranking needs beyond those checked above: still the file's fault.
+    let in_summary =
+        |message: String| UserError(format!("{}: {message}", summary_path.display()), 2);
+    let parts = ranking(&summary).map_err(|UserError(m, _)| in_summary(m))?;
     let study_text = autobal::input_file::read_text(&args.dir.join("study.toml"))
         .map_err(|e| UserError(format!("{}/study.toml: {e}", args.dir.display()), 2))?;
     // The leading designs' ids, in rank order, from the typed decision.
-    let leading = StudyDecision::from_summary(&summary)?.leading(args.leading as usize);
+    let decision = StudyDecision::from_summary(&summary).map_err(|e| in_summary(e.to_string()))?;
+    let leading = decision.leading(args.leading as usize);
     let figures = study_figures(&args.dir, &leading).map_err(plot_error)?;
-    let meta = read_metadata(&args.dir.join("runs.parquet")).unwrap_or_default();
+    let meta = read_metadata(&runs_path).unwrap_or_default();
     let value = |key: &str| {
         meta.iter()
             .find(|(k, _)| k == key)
@@ -90,11 +141,19 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
             ("shard".into(), value("shard")),
             (
                 "reproduce".into(),
+                // Every flag that changes what the page shows: the ranking
+                // the summary was made with (the study file's, or --rank-by).
                 format!(
-                    "study run {}/study.toml --overwrite && study report {} --out {} --overwrite",
+                    "study run {}/study.toml --overwrite --rank-by {} && study report {} --out {} --overwrite{}",
                     args.dir.display(),
+                    decision.criterion,
                     args.dir.display(),
-                    args.out.display()
+                    args.out.display(),
+                    if args.leading == DEFAULT_LEADING {
+                        String::new()
+                    } else {
+                        format!(" --leading {}", args.leading)
+                    }
                 ),
             ),
         ],

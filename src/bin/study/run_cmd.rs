@@ -154,6 +154,9 @@ fn fail_on_unfinished_runs(
 
 /// Run `study merge`.
 pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
+    if let Some(out) = &args.out {
+        autobal::output_file::prepare_folder("--out", out)?;
+    }
     let output = merge(&args.dirs, args.out.as_deref(), args.overwrite)?;
     if let Some(summary) = &output.summary {
         print!("{}", ranked_table(summary)?);

@@ -17,8 +17,8 @@ pub use settling_vs_unbalance::plot_settling_vs_unbalance;
 
 use super::{Format, PlotError};
 use crate::stats::survival::Observation;
-use crate::study::io::read_parquet;
 use crate::study::record::{RunRecord, from_dataframe};
+use crate::study::results_table::{TableKind, read_table};
 use polars::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -162,7 +162,7 @@ pub struct StudyData {
 impl StudyData {
     /// Read `runs.parquet` and `summary.parquet` from a study's output folder.
     pub fn read(dir: &Path) -> Result<Self, PlotError> {
-        let open = |file: &str| {
+        let open = |file: &str, kind: TableKind| {
             let path = dir.join(file);
             if !path.is_file() {
                 return Err(PlotError::invalid(
@@ -170,10 +170,10 @@ impl StudyData {
                     "not found: give the output folder of `study run`",
                 ));
             }
-            read_parquet(&path).map_err(|e| PlotError::unreadable(&path, e))
+            read_table(&path, kind).map_err(|e| PlotError::unreadable(&path, e))
         };
-        let runs = from_dataframe(&open("runs.parquet")?)?;
-        let designs = design_stats(&open("summary.parquet")?)?;
+        let runs = from_dataframe(&open("runs.parquet", TableKind::Runs)?)?;
+        let designs = design_stats(&open("summary.parquet", TableKind::Summary)?)?;
         let name = dir
             .canonicalize()
             .unwrap_or_else(|_| dir.to_path_buf())

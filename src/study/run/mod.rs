@@ -116,6 +116,10 @@ pub trait Progress: Sync {
     fn skip(&self, _runs: u64) {}
     /// Everything is written.
     fn end(&self) {}
+    /// The run stopped on request ([`RunOptions::cancel`]): `finished` of
+    /// `total` runs are saved, and [`RunError::Interrupted`] follows; `end`
+    /// is not called, since the study did not finish.
+    fn interrupted(&self, _finished: u64, _total: u64) {}
 }
 
 /// A progress sink that ignores everything.
@@ -175,7 +179,7 @@ pub enum RunError {
     },
     /// `--resume` on a folder whose run began from a different study file.
     #[error(
-        "cannot resume in {path}: the study file changed since the run began (delete the folder or run without --resume)"
+        "cannot resume in {path}: the study file changed since the run began; run it with --overwrite instead of --resume to replace the earlier runs with runs of the changed file (or restore the file, or give the study another `name`)"
     )]
     StudyChanged {
         /// The folder.
@@ -229,13 +233,17 @@ pub enum RunError {
     AdaptiveSharded,
     /// Stopped on request; what finished is saved.
     #[error(
-        "interrupted: {saved} runs of this invocation are saved in {path}; continue with --resume"
+        "interrupted after {finished} of {total} runs ({saved} of them in this invocation), saved in {path}; continue with --resume"
     )]
     Interrupted {
         /// The folder.
         path: String,
         /// Runs finished and saved in this invocation.
         saved: u64,
+        /// Runs finished in all, earlier invocations included.
+        finished: u64,
+        /// Runs of the study (of the shard, with `--shard`).
+        total: u64,
     },
     /// Reading or writing Parquet failed.
     #[error("{0}")]
@@ -445,10 +453,13 @@ fn run_in_folder(
             .as_ref()
             .is_some_and(|c| c.load(Ordering::Relaxed))
         {
-            progress.end();
+            let finished = already + executed + saved;
+            progress.interrupted(finished, total);
             return Err(RunError::Interrupted {
                 path: dir.display().to_string(),
-                saved,
+                saved: executed + saved,
+                finished,
+                total,
             });
         }
         executed += pending.len() as u64;
