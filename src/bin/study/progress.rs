@@ -171,6 +171,16 @@ impl Progress for RunProgress {
         }
     }
 
+    fn skip(&self, runs: u64) {
+        // Designs that left the race: their later runs will not come, so
+        // the bar, the rate line and the ETA count to what is left.
+        let total = self.total.load(Ordering::Relaxed).saturating_sub(runs);
+        self.total.store(total, Ordering::Relaxed);
+        if let Reporter::Bar(bar) = &self.reporter {
+            bar.set_length(total);
+        }
+    }
+
     fn interrupted(&self, _finished: u64, _total: u64) {
         // The error that follows is the one line that says so: no
         // "finished" line may come before it.
