@@ -147,3 +147,44 @@ fn the_man_page_is_short_with_examples_and_no_repeated_entries() {
         assert!(examples.contains(example), "no example {example:?}");
     }
 }
+
+#[test]
+fn completions_offer_the_values_of_rank_by_and_no_file_names_for_designs() {
+    for shell in ["bash", "zsh", "fish"] {
+        let out = study(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        let script = String::from_utf8(out.stdout).unwrap();
+        for criterion in [
+            "median",
+            "p90",
+            "settled_fraction",
+            "residual_p95",
+            "settled_by:",
+            "p_residual_below:",
+        ] {
+            // zsh escapes the colon of a stem.
+            let written = if shell == "zsh" {
+                criterion.replace(':', "\\:")
+            } else {
+                criterion.to_string()
+            };
+            assert!(script.contains(&written), "{shell}: no {criterion}");
+        }
+    }
+    // bash: the value list follows --rank-by, and --designs completes to
+    // what was typed rather than to file names.
+    let bash = String::from_utf8(study(&["completions", "bash"]).stdout).unwrap();
+    let after = |flag: &str| {
+        let at = bash
+            .find(&format!("{flag})"))
+            .unwrap_or_else(|| panic!("no {flag} case"));
+        bash[at..].lines().take(3).collect::<Vec<_>>().join("\n")
+    };
+    let rank_by = after("--rank-by");
+    assert!(
+        rank_by.contains("compgen -W") && rank_by.contains("mean median p90"),
+        "{rank_by}"
+    );
+    let designs = after("--designs");
+    assert!(!designs.contains("compgen -f"), "{designs}");
+}
