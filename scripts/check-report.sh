@@ -1,13 +1,21 @@
 #!/usr/bin/env bash
-# Open a `study report` page in a real headless browser and check that it
-# renders: no script error and no console error, every figure has a
-# non-empty box, the ranking table has rows, and nothing is fetched from
-# elsewhere. Usage: scripts/check-report.sh REPORT.html
+# Open a `study report` page in a real headless browser, 1280 px wide, and
+# check that it renders: no script error and no console error, every figure
+# has a non-empty box, the ranking table has rows, nothing is wider than its
+# box (the page, a paragraph, a figure; the table may scroll inside its
+# own), and nothing is fetched from elsewhere. Then it takes a screenshot of
+# the whole page, as tall as the page is (so the last figure and the
+# provenance are on it), into SCREENSHOT.png if given.
+# Usage: scripts/check-report.sh REPORT.html [SCREENSHOT.png]
 # Exit 0: rendered and checked (or no browser here: said plainly, skipped);
 # 1: a check failed; 2: usage.
-# Needs Chromium (Debian: apt-get install chromium) and python3.
+# Needs Chromium (Debian: apt-get install chromium) and python3. The same
+# layout rules are checked without a browser on the generated HTML by
+# `cargo test --test it report`.
 set -euo pipefail
-report=${1:?usage: scripts/check-report.sh REPORT.html}
+report=${1:?usage: scripts/check-report.sh REPORT.html [SCREENSHOT.png]}
+screenshot=${2:-}
+width=1280
 [ -f "$report" ] || { echo "check-report: $report: no such file" >&2; exit 2; }
 
 browser=""
@@ -40,17 +48,27 @@ probe = """<script>window.addEventListener('load',function(){
 var figs=[].slice.call(document.querySelectorAll('figure'));
 var boxes=figs.map(function(f){var s=f.querySelector('svg');if(!s)return [f.id,0,0];var r=s.getBoundingClientRect();return [f.id,r.width,r.height]});
 var rows=document.querySelectorAll('#ranking-table tbody tr').length;
+var root=document.documentElement, overflow=[];
+if(root.scrollWidth>root.clientWidth+1)overflow.push('the page is '+root.scrollWidth+' px wide in a '+root.clientWidth+' px window');
+var main=document.querySelector('main'), right=main.getBoundingClientRect().right+1;
+[].slice.call(main.querySelectorAll('section, p, figure, figcaption, svg, dl, dd, div, pre, table, h1, h2')).forEach(function(el){
+  if(el.closest('.scroll, pre')&&!el.matches('.scroll, pre'))return;
+  var r=el.getBoundingClientRect(), what=el.tagName.toLowerCase()+(el.id?'#'+el.id:'')+(el.className&&typeof el.className==='string'?'.'+el.className:'');
+  if(r.right>right)overflow.push(what+' reaches '+Math.round(r.right)+' px, past the column at '+Math.round(right));
+  var ox=getComputedStyle(el).overflowX;
+  if(ox==='visible'&&el.scrollWidth>el.clientWidth+1&&el.clientWidth>0)overflow.push(what+' holds '+el.scrollWidth+' px in '+el.clientWidth);
+});
 var out=document.createElement('pre');out.id='__check';
-out.textContent=JSON.stringify({errors:window.__errors,boxes:boxes,rows:rows});document.body.appendChild(out)});</script>"""
+out.textContent=JSON.stringify({errors:window.__errors,boxes:boxes,rows:rows,overflow:overflow,height:Math.ceil(root.scrollHeight)});document.body.appendChild(out)});</script>"""
 html = html.replace("<head>", "<head>" + catch, 1).replace("</body>", probe + "</body>", 1)
 open(dst, "w", encoding="utf-8").write(html)
 EOF
 
-"$browser" --headless --no-sandbox --disable-gpu --window-size=1200,3000 \
+"$browser" --headless --no-sandbox --disable-gpu --window-size=$width,3000 \
     --virtual-time-budget=10000 --enable-logging=stderr --v=0 \
     --dump-dom "file://$work/page.html" >"$work/dom.html" 2>"$work/browser.log" || true
 
-python3 - "$work/dom.html" "$work/browser.log" "$report" <<'EOF'
+python3 - "$work/dom.html" "$work/browser.log" "$report" "$work/height" <<'EOF'
 import html as h, json, re, sys
 dom, log = (open(p, encoding="utf-8", errors="replace").read() for p in sys.argv[1:3])
 report = sys.argv[3]
@@ -68,9 +86,33 @@ if not result["boxes"]:
 problems += [f"figure {i} has an empty box ({w:.0f} x {hgt:.0f})" for i, w, hgt in result["boxes"] if w < 10 or hgt < 10]
 if result["rows"] < 1:
     problems.append("the ranking table has no row")
+problems += ["overflow: " + o for o in result["overflow"]]
+open(sys.argv[4], "w").write(str(result["height"]))
 if problems:
     print(f"check-report: {report}: " + "; ".join(problems), file=sys.stderr)
     sys.exit(1)
-print(f"check-report: {report}: rendered in Chromium: {len(result['boxes'])} figures with non-empty boxes, "
-      f"ranking table with {result['rows']} rows, no script or console error, nothing fetched")
+print(f"check-report: {report}: rendered in Chromium at 1280 px: {len(result['boxes'])} figures with non-empty boxes, "
+      f"ranking table with {result['rows']} rows, nothing wider than its box, no script or console error, nothing fetched")
+EOF
+
+# The screenshot is as tall as the page (a fixed window height cut off the
+# last figure and the provenance).
+height=$(cat "$work/height")
+shot=${screenshot:-$work/page.png}
+"$browser" --headless --no-sandbox --disable-gpu --hide-scrollbars \
+    --window-size=$width,"$height" --virtual-time-budget=10000 \
+    --screenshot="$shot" "file://$work/page.html" >/dev/null 2>>"$work/browser.log" || true
+python3 - "$shot" "$height" <<'EOF'
+import struct, sys
+shot, height = sys.argv[1], int(sys.argv[2])
+try:
+    head = open(shot, "rb").read(24)
+except OSError:
+    print(f"check-report: no screenshot was taken ({shot})", file=sys.stderr)
+    sys.exit(1)
+w, h = struct.unpack(">II", head[16:24])
+if h < height:
+    print(f"check-report: the screenshot is {h} px tall, the page {height} px", file=sys.stderr)
+    sys.exit(1)
+print(f"check-report: screenshot of the whole page, {w} x {h} px: {shot}")
 EOF
