@@ -7,16 +7,37 @@
 # the whole page, as tall as the page is (so the last figure and the
 # provenance are on it), into SCREENSHOT.png if given.
 # Usage: scripts/check-report.sh REPORT.html [SCREENSHOT.png]
-# Exit 0: rendered and checked (or no browser here: said plainly, skipped);
-# 1: a check failed; 2: usage.
-# Needs Chromium (Debian: apt-get install chromium) and python3. The same
-# layout rules are checked without a browser on the generated HTML by
-# `cargo test --test it report`.
+# First, everywhere, the HTML's own rules: every table inside a scrolling
+# box, figures and images at most the column's width, no Markdown backtick
+# in a caption or cell (also `cargo test --test it report`).
+# Exit 0: checked (with no browser here the browser part is said plainly to
+# be skipped); 1: a check failed; 2: usage.
+# Needs python3, and Chromium for the browser part (Debian: apt-get install
+# chromium).
 set -euo pipefail
 report=${1:?usage: scripts/check-report.sh REPORT.html [SCREENSHOT.png]}
 screenshot=${2:-}
 width=1280
 [ -f "$report" ] || { echo "check-report: $report: no such file" >&2; exit 2; }
+
+# Without a browser too: the HTML itself keeps everything inside its box
+# (the rules of `cargo test --test it report`, here on any report).
+python3 - "$report" <<'EOF'
+import re, sys
+page = open(sys.argv[1], encoding="utf-8").read()
+style = (re.search(r"<style>(.*?)</style>", page, re.S) or [None, ""])[1]
+rules = {sel.strip(): body.replace(" ", "") for sels, body in re.findall(r"([^{}]+)\{([^}]*)\}", style) for sel in sels.split(",")}
+problems = [f"no rule `{sel} {{ {need} }}`" for sel, need in
+            [(".scroll", "overflow-x:auto"), ("figure svg", "max-width:100%"), ("img", "max-width:100%"), ("pre", "overflow-x:auto")]
+            if need not in rules.get(sel, "")]
+problems += ["a table outside a scrolling box" for m in re.finditer(r"<table", page) if not page[:m.start()].endswith('<div class="scroll">')]
+problems += [f"a literal backtick in <{tag}>: {text[:60]}" for tag in ("figcaption", "p", "td", "th", "dd")
+             for text in re.findall(rf"<{tag}(?:\s[^>]*)?>(.*?)</{tag}>", page, re.S) if "`" in text]
+if problems:
+    print(f"check-report: {sys.argv[1]}: " + "; ".join(problems), file=sys.stderr)
+    sys.exit(1)
+print(f"check-report: {sys.argv[1]}: the HTML keeps tables, figures and code inside their boxes")
+EOF
 
 browser=""
 for b in chromium chromium-browser google-chrome google-chrome-stable; do
