@@ -74,7 +74,7 @@ impl Report {
         if !self.question.is_empty() {
             out.push_str("<section id=\"question\">\n<h2>The question</h2>\n");
             for line in &self.question {
-                out.push_str(&format!("<p>{}</p>\n", escape(line)));
+                out.push_str(&format!("<p>{}</p>\n", prose(line)));
             }
             out.push_str("</section>\n");
         }
@@ -87,17 +87,17 @@ impl Report {
         for row in &self.rows {
             out.push_str("<tr>");
             for cell in row {
-                out.push_str(&format!("<td>{}</td>", escape(cell)));
+                out.push_str(&format!("<td>{}</td>", cell_html(cell)));
             }
             out.push_str("</tr>\n");
         }
         out.push_str("</tbody>\n</table></div>\n");
         for line in &self.legend {
-            out.push_str(&format!("<p class=\"legend\">{}</p>\n", escape(line)));
+            out.push_str(&format!("<p class=\"legend\">{}</p>\n", prose(line)));
         }
         out.push_str("</section>\n<section id=\"verdicts\">\n<h2>Verdicts</h2>\n");
         for line in &self.findings {
-            out.push_str(&format!("<p>{}</p>\n", escape(line)));
+            out.push_str(&format!("<p>{}</p>\n", prose(line)));
         }
         if !self.preformatted.trim().is_empty() {
             out.push_str(&format!("<pre>{}</pre>\n", escape(&self.preformatted)));
@@ -114,7 +114,7 @@ impl Report {
             out.push_str(&format!(
                 "<figure id=\"figure-{i}\">\n{}\n<figcaption>{}</figcaption>\n</figure>\n",
                 figure.svg,
-                escape(&figure.caption)
+                prose(&figure.caption)
             ));
         }
         out.push_str("</section>\n<section id=\"provenance\">\n<h2>Provenance</h2>\n<dl>\n");
@@ -130,21 +130,27 @@ impl Report {
     }
 }
 
-/// The page's own style: plain, printable, no external font.
+/// The page's own style: plain, printable, no external font. Nothing may
+/// be wider than its box: the table scrolls inside its own (an interval
+/// first drops under its value), figures shrink to the column, long words
+/// and code break.
 const STYLE: &str = "<style>
+*, *::before, *::after { box-sizing: border-box; }
 body { font-family: system-ui, sans-serif; margin: 0; color: #1a1a1a; background: #fff; }
-main { max-width: 1100px; margin: 0 auto; padding: 1rem 1.5rem 3rem; }
+main { max-width: 1240px; margin: 0 auto; padding: 1rem 1.5rem 3rem; overflow-wrap: anywhere; }
 h1 { font-size: 1.6rem; } h2 { font-size: 1.25rem; border-bottom: 1px solid #ccc; padding-bottom: .2rem; }
-.scroll { overflow-x: auto; }
-table { border-collapse: collapse; font-variant-numeric: tabular-nums; font-size: .9rem; }
-th, td { padding: .2rem .5rem; text-align: right; border-bottom: 1px solid #e4e4e4; white-space: nowrap; }
+.scroll { overflow-x: auto; max-width: 100%; }
+table { border-collapse: collapse; font-variant-numeric: tabular-nums; font-size: .9rem; overflow-wrap: normal; }
+th, td { padding: .2rem .5rem; text-align: right; border-bottom: 1px solid #e4e4e4; }
+td span { white-space: nowrap; }
 th { background: #f4f4f4; vertical-align: bottom; }
+code { font-size: .95em; background: #f4f4f4; padding: 0 .15em; }
 tbody tr:first-child { background: #eef6ee; }
 p.legend { font-size: .85rem; color: #444; }
 figure { margin: 1.5rem 0; }
-figure svg { max-width: 100%; height: auto; display: block; }
+figure svg, img { max-width: 100%; height: auto; display: block; }
 figcaption { font-size: .9rem; color: #444; }
-pre { background: #f7f7f7; padding: .5rem; overflow-x: auto; }
+pre { background: #f7f7f7; padding: .5rem; overflow-x: auto; max-width: 100%; }
 dt { font-weight: bold; margin-top: .4rem; } dd { margin-left: 1rem; }
 </style>
 ";
@@ -155,6 +161,41 @@ pub fn escape(text: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// A line of prose safe inside HTML, its `code` spans (Markdown's
+/// backticks, as the CLI prints them) set as code rather than shown as
+/// backticks; an unpaired backtick stays as it is.
+pub fn prose(text: &str) -> String {
+    let parts: Vec<&str> = text.split('`').collect();
+    if parts.len().is_multiple_of(2) {
+        return escape(text);
+    }
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, part)| {
+            if i % 2 == 1 {
+                format!("<code>{}</code>", escape(part))
+            } else {
+                escape(part)
+            }
+        })
+        .collect()
+}
+
+/// A ranking cell: a value with its interval ("+12.4 [+7.6, +17.2]") as
+/// two unbreakable pieces, so that a narrow table wraps the interval under
+/// its value instead of cutting it.
+fn cell_html(cell: &str) -> String {
+    match cell.split_once(" [") {
+        Some((value, interval)) => format!(
+            "<span>{}</span> <span>[{}</span>",
+            escape(value),
+            escape(interval)
+        ),
+        None => format!("<span>{}</span>", escape(cell)),
+    }
 }
 
 /// An SVG file's text ready to sit inside HTML: without its XML prologue,
@@ -331,10 +372,25 @@ mod tests {
             ..Report::default()
         }
         .html();
-        assert!(page.contains("<th>a<br>b</th>") && page.contains("<td>&lt;x&gt;</td>"));
+        assert!(
+            page.contains("<th>a<br>b</th>") && page.contains("<td><span>&lt;x&gt;</span></td>")
+        );
         for external in ["http://", "https://", "src=", "<script", "<link"] {
             assert!(!page.contains(external), "{external}");
         }
+    }
+
+    #[test]
+    fn backticks_become_code_and_intervals_stay_whole() {
+        assert_eq!(
+            prose("as `study plot study` draws <it>"),
+            "as <code>study plot study</code> draws &lt;it&gt;"
+        );
+        assert_eq!(prose("an odd ` stays"), "an odd ` stays");
+        assert_eq!(
+            cell_html("+12.4 [+7.6, +17.2]"),
+            "<span>+12.4</span> <span>[+7.6, +17.2]</span>"
+        );
     }
 
     #[test]

@@ -620,4 +620,25 @@ fn the_ranking_speaks_in_an_engineers_terms() {
     assert!(!stderr.contains("certified hold"), "{stderr}");
     assert!(!stderr.contains("failures 0wrote"), "{stderr}");
     assert!(stderr.lines().any(|l| l.starts_with("wrote ")), "{stderr}");
+    // --wide keeps the exact terms; the default (80 columns) says them in
+    // words (the finished study reprints its ranking on --resume).
+    assert!(
+        stdout.contains("horizon τ = ")
+            && stdout.contains("t_end − hold")
+            && stdout.contains("(2α)"),
+        "{stdout}"
+    );
+    let again = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", path.to_str().unwrap(), "--resume"])
+        .output()
+        .unwrap();
+    assert_eq!(again.status.code(), Some(0));
+    let default = String::from_utf8_lossy(&again.stdout).replace("\n  ", " ");
+    assert!(
+        default.contains("the run's length less its hold window (τ)"),
+        "{default}"
+    );
+    for jargon in ["t_end − hold", "(2α)"] {
+        assert!(!default.contains(jargon), "{jargon}: {default}");
+    }
 }

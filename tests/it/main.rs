@@ -62,3 +62,4 @@ mod tilt_inertia;
 mod tolerances;
 mod toy_effect;
 mod tradeoff;
+mod user_docs;

@@ -25,7 +25,7 @@ pub struct ClaimsArgs {
     overwrite: bool,
     /// The measure the verdicts rest on (default: the study's `[summary] rank_by`):
     /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
-    #[arg(long, value_parser = crate::run_cmd::parse_criterion, value_name = "CRITERION")]
+    #[arg(long, value_parser = crate::completion_values::CriterionParser, hide_possible_values = true, value_name = "CRITERION")]
     rank_by: Option<autobal::study::criterion::Criterion>,
 }
 

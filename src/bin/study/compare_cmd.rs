@@ -29,7 +29,9 @@ pub struct CompareArgs {
     #[arg(required = true, num_args = 1..=2)]
     folders: Vec<PathBuf>,
     /// Design ids A,B (with one folder: required; with two: when a folder holds several designs).
-    #[arg(long, value_delimiter = ',')]
+    // No file names: a shell offers none and shows "A,B" (the ids are the
+    // ranking's id column).
+    #[arg(long, value_delimiter = ',', value_name = "A,B", value_hint = clap::ValueHint::Other)]
     designs: Option<Vec<u32>>,
     /// Significance level of the verdict.
     #[arg(long, default_value_t = 0.05, value_parser = crate::limits::significance)]
@@ -39,7 +41,7 @@ pub struct CompareArgs {
     plot: Option<PathBuf>,
     /// The measure the verdict rests on (default: the first study's `[summary] rank_by`):
     /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
-    #[arg(long, value_parser = crate::run_cmd::parse_criterion, value_name = "CRITERION")]
+    #[arg(long, value_parser = crate::completion_values::CriterionParser, hide_possible_values = true, value_name = "CRITERION")]
     rank_by: Option<Criterion>,
 }
 

@@ -7,6 +7,7 @@ mod bench_cmd;
 mod check_cmd;
 mod claims_cmd;
 mod compare_cmd;
+mod completion_values;
 mod criterion_cmd;
 mod design_cmd;
 mod limits;

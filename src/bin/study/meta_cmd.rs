@@ -94,7 +94,8 @@ pub fn man(command: clap::Command) -> Result<(), UserError> {
 /// The roff of the whole page: title, name, synopsis, description and
 /// options of `study`, then a COMMANDS section with each verb's synopsis,
 /// description and options (a verb's own verbs, as `plot run`, below it),
-/// then the exit codes and the full version.
+/// an EXAMPLES section from the verbs' `--help` examples, then the exit
+/// codes and the full version.
 fn man_page(mut command: clap::Command, out: &mut Vec<u8>) -> std::io::Result<()> {
     command.build();
     // The footer's fields hold a short version (clap_mangen's default put the
@@ -111,35 +112,95 @@ fn man_page(mut command: clap::Command, out: &mut Vec<u8>) -> std::io::Result<()
     man.render_description_section(out)?;
     man.render_options_section(out)?;
     out.extend_from_slice(b".SH COMMANDS\n");
-    for verb in command.get_subcommands().filter(|c| !c.is_hide_set()) {
+    for verb in verbs(&command) {
         verb_section(verb, "study", out)?;
+    }
+    out.extend_from_slice(b".SH EXAMPLES\n");
+    for verb in verbs(&command) {
+        examples_section(verb, "study", out)?;
     }
     man.render_extra_section(out)?;
     man.render_version_section(out)?;
     Ok(())
 }
 
+/// The verbs of `command` a reader looks up: the visible ones but `help`,
+/// whose entries ("study help run", …) would repeat every verb's page.
+fn verbs(command: &clap::Command) -> impl Iterator<Item = &clap::Command> {
+    command
+        .get_subcommands()
+        .filter(|c| !c.is_hide_set() && c.get_name() != "help")
+}
+
+/// A verb's examples (its `--help` text after the options, from
+/// "Examples:" on) as a subsection set line for line; its own verbs follow.
+fn examples_section(verb: &clap::Command, parent: &str, out: &mut Vec<u8>) -> std::io::Result<()> {
+    let name = format!("{parent} {}", verb.get_name());
+    if let Some(help) = verb.get_after_help() {
+        let help = help.to_string();
+        let body = help.strip_prefix("Examples:").unwrap_or(&help);
+        writeln!(out, ".SS \"{name}\"\n.nf")?;
+        for line in body.trim_matches('\n').lines() {
+            writeln!(out, "{}", roff_text(line))?;
+        }
+        out.extend_from_slice(b".fi\n");
+    }
+    for sub in verbs(verb) {
+        examples_section(sub, &name, out)?;
+    }
+    Ok(())
+}
+
+/// `line` as roff text: backslashes escaped, a leading control character
+/// made literal, hyphens as minus signs (so that flags copy as typed).
+fn roff_text(line: &str) -> String {
+    let escaped = line.replace('\\', "\\e").replace('-', "\\-");
+    if escaped.starts_with(['.', '\'']) {
+        format!("\\&{escaped}")
+    } else {
+        escaped
+    }
+}
+
 /// One verb as a subsection: `.SS study <verb>`, its synopsis, what it
 /// does and its options; its own verbs follow.
 fn verb_section(verb: &clap::Command, parent: &str, out: &mut Vec<u8>) -> std::io::Result<()> {
     let name = format!("{parent} {}", verb.get_name());
-    let command = verb.clone().bin_name(&name);
+    // -h and the global flags (--wide) are under the tool's own options
+    // once; on every verb they would repeat.
+    let repeated: Vec<clap::Id> = verb
+        .get_arguments()
+        .filter(|a| a.is_global_set() || a.get_id() == "help")
+        .map(|a| a.get_id().clone())
+        .collect();
+    let command = repeated.iter().fold(verb.clone().bin_name(&name), |c, id| {
+        c.mut_arg(id.clone(), |a| a.hide(true))
+    });
     let man = clap_mangen::Man::new(command);
     writeln!(out, ".SS \"{name}\"")?;
     let mut part = Vec::new();
     man.render_synopsis_section(&mut part)?;
     man.render_description_section(&mut part)?;
     man.render_options_section(&mut part)?;
-    // The parts' own .SH headings would end the COMMANDS section.
+    // The parts' own .SH headings would end the COMMANDS section; the
+    // string each part defines for an apostrophe (Aq) is defined once in
+    // the page's head already.
     let text = String::from_utf8_lossy(&part);
+    let mut last = "";
     for line in text.lines() {
-        if line.starts_with(".SH ") {
-            out.extend_from_slice(b".PP\n");
+        let line = if line.starts_with(".SH ") {
+            ".PP"
         } else {
+            line
+        };
+        let defines_aq = line.starts_with(".ie \\n(.g .ds Aq") || line.starts_with(".el .ds Aq");
+        let repeated_paragraph = line == ".PP" && last == ".PP";
+        if !(defines_aq || repeated_paragraph) {
             writeln!(out, "{line}")?;
+            last = line;
         }
     }
-    for sub in verb.get_subcommands().filter(|c| !c.is_hide_set()) {
+    for sub in verbs(verb) {
         verb_section(sub, &name, out)?;
     }
     Ok(())

@@ -11,10 +11,16 @@ pub fn set_wide(wide: bool) {
     let _ = WIDE.set(wide);
 }
 
+/// Whether `--wide` was given: notes then keep the exact terms and symbols
+/// (τ, 2α) that the default output says in words.
+pub fn wide() -> bool {
+    WIDE.get().copied().unwrap_or(false)
+}
+
 /// Columns text output may fill: `None` (no limit) with `--wide`, else the
 /// terminal's width on a terminal, else `$COLUMNS`, else 80.
 pub fn text_width() -> Option<usize> {
-    if WIDE.get().copied().unwrap_or(false) {
+    if wide() {
         return None;
     }
     Some(terminal_columns())

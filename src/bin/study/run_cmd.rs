@@ -54,7 +54,7 @@ pub struct RunArgs {
     chunk_runs: usize,
     /// Rank designs by this criterion instead of the study's `[summary] rank_by`:
     /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
-    #[arg(long, value_parser = parse_criterion, value_name = "CRITERION")]
+    #[arg(long, value_parser = crate::completion_values::CriterionParser, hide_possible_values = true, value_name = "CRITERION")]
     rank_by: Option<Criterion>,
 }
 

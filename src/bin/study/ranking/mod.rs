@@ -333,17 +333,17 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .next()
         .unwrap_or_else(|| "from t = 0".into());
     let legend = format!(
-        "(ranked by the {}, designs that balance first; ρ = r/R, the weight's radius over the race's; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: the restricted mean, each run counted up to the horizon τ = {} rev, t_end − hold; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window, in µm and relative to A_ref (the whirl the same unbalance causes without a balancer); failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
+        "(ranked by the {}, designs that balance first; ρ = r/R, the weight's radius over the race's; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: the restricted mean, each run counted up to {}; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window, in µm and relative to A_ref (the whirl the same unbalance causes without a balancer); failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
         criterion.label(),
         if run_up {
             " (but the column “median from t = 0”)"
         } else {
             ""
         },
-        num(
+        horizon_text(num(
             sum.f("settling_horizon_revs")?.first().copied().flatten(),
             0
-        )
+        ))
     );
     // Revolutions of the operating speed are a clock: say what they are in
     // seconds (under a run-up, seconds after the rotor reached that speed).
@@ -428,6 +428,16 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         findings,
         passage: passage_table(summary)?,
     })
+}
+
+/// How far the restricted mean counts a run: in words by default (the
+/// verdict's test names τ), with the symbol and its formula under `--wide`.
+fn horizon_text(revs: String) -> String {
+    if crate::output::wide() {
+        format!("the horizon τ = {revs} rev, t_end − hold")
+    } else {
+        format!("{revs} rev, the run's length less its hold window (τ)")
+    }
 }
 
 /// Which columns give way first when the ranking is wider than the

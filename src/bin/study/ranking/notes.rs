@@ -67,8 +67,9 @@ pub(super) fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
         .reduce(f64::max);
     let closest = deepest.map_or(String::new(), |f| {
         format!(
-            "; deepest overlap {:.2} % of the angle at which two weights touch (2α)",
-            100.0 * f
+            "; deepest overlap {:.2} % of the angle at which two weights touch{}",
+            100.0 * f,
+            if crate::output::wide() { " (2α)" } else { "" }
         )
     });
     let off = contact.iter().filter(|c| *c == Some(false)).count();
