@@ -61,6 +61,8 @@ pub struct RankedDesign {
     pub balances: bool,
     /// Not dominated on the study's Pareto measures.
     pub pareto: bool,
+    /// It left the race before the study's end (fewer runs than the others).
+    pub left_race: bool,
 }
 
 /// What the verdict line says of #1.
@@ -190,6 +192,11 @@ impl StudyDecision {
         let verdicts = c.s("vs_best_verdict")?;
         let balances = c.b("balances")?;
         let pareto = c.b("pareto")?;
+        // Summaries written before racing lack the column: nobody left.
+        let left_race: Vec<bool> = match summary.column("left_race_after") {
+            Ok(col) => col.u32()?.iter().map(|v| v.is_some()).collect(),
+            Err(_) => vec![false; summary.height()],
+        };
         let ranked: Vec<RankedDesign> = order
             .iter()
             .map(|&i| RankedDesign {
@@ -198,6 +205,7 @@ impl StudyDecision {
                 verdict: verdicts[i].as_deref().and_then(StoredVerdict::parse),
                 balances: balances[i],
                 pareto: pareto[i],
+                left_race: left_race[i],
             })
             .collect();
         let alpha = c

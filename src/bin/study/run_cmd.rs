@@ -1,6 +1,7 @@
 //! `study run` and `study merge`: the Monte Carlo study runner.
 
 use crate::UserError;
+use crate::output::{text_width, wrap};
 use crate::progress::RunProgress;
 use crate::ranking::ranked_table;
 use autobal::study::config::load;
@@ -118,7 +119,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
                 println!("{}", adaptive_line(adaptive));
             }
             if let Some(line) = race_line(&output) {
-                println!("{line}");
+                print!("{}", wrap(&(line + "\n"), text_width()));
             }
         }
         None => println!(
@@ -162,7 +163,7 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
         print!("{}", ranked_table(summary)?);
     }
     if let Some(line) = race_line(&output) {
-        println!("{line}");
+        print!("{}", wrap(&(line + "\n"), text_width()));
     }
     eprintln!("merged {} runs into {}", output.runs, output.dir.display());
     // The shards' failed runs are never absorbed either: the study text
@@ -226,10 +227,15 @@ fn race_line(output: &autobal::study::run::StudyOutput) -> Option<String> {
         })
         .collect();
     Some(format!(
-        "racing: decided after {} of {} runs; {} designs left the race once #1 was significantly better and no other reported measure favoured them ({}); `[sampling] racing = false` runs every sample",
+        "racing: decided after {} of {} runs; {} left the race once #1 was significantly better and no other reported measure favoured {} ({}); `[sampling] racing = false` runs every sample",
         group_thousands(output.runs),
         group_thousands(output.runs_planned),
-        departures.len(),
+        if departures.len() == 1 {
+            "1 design".to_string()
+        } else {
+            format!("{} designs", departures.len())
+        },
+        if departures.len() == 1 { "it" } else { "them" },
         when.join("; ")
     ))
 }

@@ -40,7 +40,7 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
                 ids.iter().map(|&id| who_id(decision, id)).collect()
             };
             let mut line = format!(
-                "verdict on the {}: {} is better than {} of the other {} designs ({}{}, Holm-adjusted at α = {}, {} runs per design)",
+                "verdict on the {}: {} is better than {} of the other {} designs ({}{}, Holm-adjusted at α = {}, {} runs per design{})",
                 criterion.label(),
                 who_id(decision, *best),
                 better_than.len(),
@@ -53,6 +53,11 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
                 },
                 decision.alpha,
                 decision.runs_per_design,
+                if decision.ranked.iter().any(|d| d.left_race) {
+                    "; fewer for the designs that left the race, each compared on the samples it ran"
+                } else {
+                    ""
+                },
             );
             if !not_distinguishable.is_empty() {
                 line += &format!(

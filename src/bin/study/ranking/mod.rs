@@ -326,6 +326,33 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     } else {
         (header, rows)
     };
+    // A raced study: designs that left the race have fewer runs, and say so.
+    let runs: Vec<Option<u64>> = summary.column("runs")?.u64()?.iter().collect();
+    let raced = runs.iter().flatten().min() != runs.iter().flatten().max();
+    let (header, rows) = if raced {
+        let at = header
+            .iter()
+            .position(|h| h.starts_with("settled"))
+            .map_or(header.len(), |p| p + 1);
+        let mut header = header;
+        header.insert(at, "runs".into());
+        let rows = rows
+            .into_iter()
+            .zip(&order)
+            .map(|(mut row, &i)| {
+                row.insert(at, runs[i].map_or("–".into(), |r| r.to_string()));
+                row
+            })
+            .collect();
+        (header, rows)
+    } else {
+        (header, rows)
+    };
+    let runs_note = if raced {
+        "(runs: a design with fewer runs than the others left the race after that many samples, once #1 was significantly better and no other measure favoured it; its statistics and its comparison with #1 use the runs it has, docs/statistics.md, \"Racing\")\n"
+    } else {
+        ""
+    };
     let from = sum
         .s("settling_from")?
         .into_iter()
@@ -424,7 +451,12 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         header,
         rows,
         priority,
-        legend: legend + &estimate_note(&sum)? + &seconds_note + &rho_note + &plane_note,
+        legend: legend
+            + runs_note
+            + &estimate_note(&sum)?
+            + &seconds_note
+            + &rho_note
+            + &plane_note,
         findings,
         passage: passage_table(summary)?,
     })
@@ -450,6 +482,7 @@ fn column_priority(header: &str, criterion: Criterion, any_failed: bool) -> u8 {
         "#" | "id" => 0,
         "kind" | "n" | "ρ" => 1,
         h if h.starts_with("β\n") || h.starts_with("M_s\n") || h.starts_with("settled") => 1,
+        "runs" => 2,
         h if h.contains("[95% CI]") && !h.starts_with('Δ') => 1,
         h if h == criterion.to_string() => 1,
         "failed" if any_failed => 2,
