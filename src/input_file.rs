@@ -23,6 +23,54 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     std::fs::read_to_string(path)
 }
 
+/// A TOML parse error of `text` in a user's words, led by the dotted key
+/// of the line it points at (`optimize.rho_bounds: …`) when the parser's
+/// own message does not name it: the parser shows the line, not the
+/// table the line sits in.
+pub fn toml_message(text: &str, error: &toml::de::Error) -> String {
+    let words = in_user_words(&error.to_string());
+    match error
+        .span()
+        .and_then(|span| dotted_key_at(text, span.start))
+    {
+        Some(key) if !error.message().contains(&key) => format!("{key}: {words}"),
+        _ => words,
+    }
+}
+
+/// The dotted key of the `key = value` line holding byte `offset` of a
+/// TOML text: the last table header above it, then the line's key.
+/// `None` on a header line or a line without `=` (a continued array).
+fn dotted_key_at(text: &str, offset: usize) -> Option<String> {
+    let offset = offset.min(text.len());
+    let start = text.get(..offset)?.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next()?.trim_start();
+    if line.starts_with('[') || line.starts_with('#') {
+        return None;
+    }
+    let key = line.split_once('=')?.0.trim().trim_matches('"');
+    if key.is_empty() {
+        return None;
+    }
+    let table = text[..start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('['))
+        .map(|h| {
+            h.trim_start_matches('[')
+                .split(']')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_string()
+        });
+    Some(match table {
+        Some(t) if !t.is_empty() => format!("{t}.{key}"),
+        _ => key.to_string(),
+    })
+}
+
 /// A TOML parser's message with serde's words for types put in a user's:
 /// "expected struct UnbalanceSpec" names a Rust type the user never wrote.
 pub fn in_user_words(message: &str) -> String {
@@ -101,5 +149,29 @@ mod tests {
         let file = dir.path().join("ok.toml");
         std::fs::write(&file, "a = 1").unwrap();
         assert_eq!(read_text(&file).unwrap(), "a = 1");
+    }
+
+    #[test]
+    fn a_parse_error_is_led_by_the_dotted_key_of_its_line() {
+        let text = "name = \"x\"\n[optimize]\nrho_bounds = \"wide\"\n";
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct O {
+            rho_bounds: [f64; 2],
+        }
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct F {
+            name: String,
+            optimize: O,
+        }
+        let e = toml::from_str::<F>(text).unwrap_err();
+        assert!(
+            toml_message(text, &e).starts_with("optimize.rho_bounds: "),
+            "{}",
+            toml_message(text, &e)
+        );
+        assert_eq!(dotted_key_at(text, 3), Some("name".into()));
+        assert_eq!(dotted_key_at(text, 15), None);
     }
 }

@@ -8,7 +8,8 @@ use super::rotor::RotorModel;
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
 use super::validate::{
-    DENSITY_RANGE, RACE_RADIUS_RANGE, invalid, non_negative, positive, spin_rate, within,
+    DENSITY_RANGE, MAX_TOTAL_WEIGHTS, RACE_RADIUS_RANGE, invalid, non_negative, positive,
+    spin_rate, within,
 };
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
@@ -206,6 +207,16 @@ impl Scene {
                 });
             }
             (false, true) => {
+                let weights: u64 = designs.iter().map(|(_, d)| u64::from(d.n)).sum();
+                if weights > MAX_TOTAL_WEIGHTS as u64 {
+                    return Err(SceneError::Invalid {
+                        field: designs[0].0.clone() + ".n",
+                        value: format!("{weights} weights in all"),
+                        reason: format!(
+                            "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
+                        ),
+                    });
+                }
                 for (key, d) in designs {
                     if d.n == 0 {
                         return Err(invalid(
@@ -231,6 +242,15 @@ impl Scene {
                 }
             }
             (true, false) => {
+                if self.cargo.len() > MAX_TOTAL_WEIGHTS {
+                    return Err(SceneError::Invalid {
+                        field: "cargo".into(),
+                        value: format!("{} cargoes", self.cargo.len()),
+                        reason: format!(
+                            "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
+                        ),
+                    });
+                }
                 for (j, c) in self.cargo.iter().enumerate() {
                     positive(&format!("cargo[{j}].mass"), c.mass)?;
                     positive(&format!("cargo[{j}].track_radius"), c.track_radius)?;

@@ -3,6 +3,7 @@
 mod adaptive;
 mod auto_method;
 mod bad_input;
+mod bad_input_two;
 mod bench;
 mod certified_hold;
 mod check;

@@ -354,6 +354,16 @@ impl RotorParams for TwoSupportRotor {
                 reason: "give the axial position of at least one balancer plane".into(),
             });
         }
+        if self.planes.len() > crate::model::validate::MAX_PLANES {
+            return Err(SceneError::Invalid {
+                field: "rotor.planes".into(),
+                value: format!("{} planes", self.planes.len()),
+                reason: format!(
+                    "at most {} balancer planes: each plane adds a balancer's equations, and no machine carries more",
+                    crate::model::validate::MAX_PLANES
+                ),
+            });
+        }
         for (p, &z) in self.planes.iter().enumerate() {
             finite(&format!("rotor.planes[{p}]"), z)?;
         }
