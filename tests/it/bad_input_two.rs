@@ -271,3 +271,64 @@ fn a_scene_with_planes_or_weights_beyond_the_limits_is_refused() {
         assert!(err.contains(needle), "{needle}: {err}");
     }
 }
+
+/// A speed in rpm runs as its rad/s twin and `simulate` echoes both units;
+/// both keys for one speed, or neither, are refused naming them.
+#[test]
+fn a_speed_is_given_once_in_rad_per_second_or_in_rpm() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/two_support_long.toml"
+    ))
+    .unwrap();
+    assert!(text.contains("\nomega = 6.32\n"));
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("scene.toml");
+    let simulate = |body: String| {
+        std::fs::write(&path, body).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["simulate", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).to_string(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (code, out, err) = simulate(text.replacen("\nomega = 6.32\n", "\nrpm = 60\n", 1));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        out.lines()
+            .next()
+            .unwrap()
+            .contains("ω = 6.283 rad/s (60 rpm)"),
+        "{out}"
+    );
+    for (to, needles) in [
+        (
+            "\nomega = 6.32\nrpm = 60\n",
+            &["speed.omega", "speed.rpm"][..],
+        ),
+        ("\n", &["omega", "rpm"][..]),
+        ("\nrpm = 1e300\n", &["speed.rpm = 1e300"][..]),
+        ("\nrpm = nan\n", &["speed.rpm"][..]),
+    ] {
+        let (code, _, err) = simulate(text.replacen("\nomega = 6.32\n", to, 1));
+        assert_eq!(code, Some(2), "{to:?}: {err}");
+        assert!(needles.iter().all(|n| err.contains(n)), "{to:?}: {err}");
+    }
+    // A motor's synchronous speed has its rpm twin too.
+    let motor = text.replacen(
+        "mode = \"constant\"\nomega = 6.32",
+        "mode = \"motor\"\nstall_torque = 1.0\nrpm_sync = 60\nomega_sync = 6.3",
+        1,
+    );
+    assert_ne!(motor, text);
+    let (code, _, err) = simulate(motor);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("speed.omega_sync") && err.contains("speed.rpm_sync"),
+        "{err}"
+    );
+}
