@@ -38,6 +38,43 @@ pub fn toml_message(text: &str, error: &toml::de::Error) -> String {
     }
 }
 
+/// `T` read from a TOML table by way of its text: serde reads an internally
+/// tagged or flattened table from a buffer that has lost each value's
+/// place, so its errors name no key ("invalid type: sequence, expected a
+/// number"); read again as text, the error points at the key's line, and
+/// the message is led by that key (`max: invalid type: …`).
+pub fn from_table<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, String> {
+    let text = table.to_string();
+    toml::from_str(&text).map_err(|e| {
+        let message = in_user_words(e.message());
+        // A tagged or flattened table's error has no place: find the key by
+        // the value it describes, when one key alone holds such a value.
+        let by_value = || {
+            let (_, what) = e.message().split_once("invalid type: ")?;
+            let mut keys = table.iter().filter(|(_, v)| {
+                let said = match v {
+                    toml::Value::Array(_) => "sequence".to_string(),
+                    toml::Value::Table(_) => "map".to_string(),
+                    toml::Value::Boolean(b) => format!("boolean `{b}`"),
+                    toml::Value::String(s) => format!("string {s:?}"),
+                    toml::Value::Integer(i) => format!("integer `{i}`"),
+                    toml::Value::Float(f) => format!("floating point `{f}`"),
+                    toml::Value::Datetime(d) => format!("{d}"),
+                };
+                what.starts_with(&said)
+            });
+            match (keys.next(), keys.next()) {
+                (Some((k, _)), None) => Some(k.clone()),
+                _ => None,
+            }
+        };
+        match by_value().or_else(|| e.span().and_then(|span| dotted_key_at(&text, span.start))) {
+            Some(key) if !message.contains(&format!("`{key}`")) => format!("{key}: {message}"),
+            _ => message,
+        }
+    })
+}
+
 /// The dotted key of the `key = value` line holding byte `offset` of a
 /// TOML text: the last table header above it, then the line's key.
 /// `None` on a header line or a line without `=` (a continued array).

@@ -257,6 +257,15 @@ impl Scene {
                     non_negative(&format!("cargo[{j}].drag"), c.drag)?;
                     non_negative(&format!("cargo[{j}].rolling_coupling"), c.rolling_coupling)?;
                     non_negative(&format!("cargo[{j}].rolling_inertia"), c.rolling_inertia)?;
+                    // As a race's radius: beyond it the weight's size is no
+                    // size (1e308 made every start a clash).
+                    if !(0.0..=RACE_RADIUS_RANGE.1).contains(&c.radius) {
+                        return Err(invalid(
+                            &format!("cargo[{j}].radius"),
+                            c.radius,
+                            &format!("must be in [0, {}] m (0: no contact)", RACE_RADIUS_RANGE.1),
+                        ));
+                    }
                     if !(c.kappa.is_finite() && c.kappa >= 1.0) {
                         return Err(invalid(
                             &format!("cargo[{j}].kappa"),

@@ -7,8 +7,8 @@ use serde::{Deserialize, Serialize};
 ///
 /// Files give each speed in rad/s (`omega…`) or in rpm (`rpm…`), one of the
 /// two ([`SpeedLawText`]); the law itself holds rad/s.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "mode", rename_all = "snake_case", try_from = "SpeedLawText")]
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+#[serde(tag = "mode", rename_all = "snake_case")]
 #[schemars(with = "SpeedLawText")]
 pub enum SpeedLaw {
     /// φ = ω t (seed 004, eqs 19–20).
@@ -148,6 +148,16 @@ fn one_speed(
         (None, None, None) => Err(format!(
             "missing field `{omega_key}`: give the speed in rad/s (`{omega_key}`) or in rpm (`{rpm_key}`)"
         )),
+    }
+}
+
+impl<'de> Deserialize<'de> for SpeedLaw {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        // Through the table's text, so that a bad value's error names its key.
+        let table = toml::Table::deserialize(deserializer)?;
+        let text: SpeedLawText = crate::input_file::from_table(&table).map_err(D::Error::custom)?;
+        SpeedLaw::try_from(text).map_err(D::Error::custom)
     }
 }
 

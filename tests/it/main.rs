@@ -26,6 +26,7 @@ mod extremes;
 mod fixtures;
 mod fuzz_cli;
 mod fuzz_input;
+mod fuzz_schema;
 mod golden;
 mod integrate;
 mod model_conservation;

@@ -335,8 +335,8 @@ impl RotorParams for TwoSupportRotor {
         for (name, v) in [
             ("rotor.l1", self.l1),
             ("rotor.l2", self.l2),
-            ("rotor.static_angle", self.static_angle),
-            ("rotor.moment_angle", self.moment_angle),
+            ("rotor.static_angle_deg", self.static_angle),
+            ("rotor.moment_angle_deg", self.moment_angle),
         ] {
             finite(name, v)?;
         }
@@ -370,7 +370,7 @@ impl RotorParams for TwoSupportRotor {
         for (j, u) in self.unbalances.iter().enumerate() {
             non_negative(&format!("rotor.unbalances[{j}].s"), u.s)?;
             finite(&format!("rotor.unbalances[{j}].z"), u.z)?;
-            finite(&format!("rotor.unbalances[{j}].angle"), u.angle)?;
+            finite(&format!("rotor.unbalances[{j}].angle_deg"), u.angle)?;
         }
         Ok(())
     }
