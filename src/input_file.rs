@@ -114,7 +114,11 @@ pub fn in_user_words(message: &str) -> String {
     let mut out = message
         .replace("expected f64", "expected a number")
         .replace("expected f32", "expected a number")
-        .replace("expected variant identifier", "expected a name in quotes");
+        .replace("expected variant identifier", "expected a name in quotes")
+        .replace(
+            "expected a map",
+            "expected a table of keys (`{ key = value }` or a [section])",
+        );
     for integer in ["u8", "u16", "u32", "u64", "usize", "i32", "i64"] {
         out = out.replace(
             &format!("expected {integer}"),

@@ -80,11 +80,6 @@ const CASES: &[(&str, &str, &str)] = &[
         "planes = [-1.0, 1.0, -0.5, -0.4, -0.3, -0.2, -0.1, 0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]",
         "scene.rotor.planes",
     ),
-    (
-        "planes = [-1.0, 1.0]\n[scene.speed]\nmode = \"constant\"\nomega = 6.3\n[designs]\nkind = \"ball\"\nn = 2",
-        "planes = [-1.0, 0.0, 1.0]\n[scene.speed]\nmode = \"constant\"\nomega = 6.3\n[designs]\nkind = \"ball\"\nn = 200",
-        "scene.rotor.planes",
-    ),
     // Names that become folders and labels.
     ("name = \"two\"", "name = \"   \"", "name"),
     ("name = \"two\"", "name = \"\"", "name"),
@@ -331,4 +326,29 @@ fn a_speed_is_given_once_in_rad_per_second_or_in_rpm() {
         err.contains("speed.omega_sync") && err.contains("speed.rpm_sync"),
         "{err}"
     );
+}
+
+/// Three planes of 200 weights: each balancer within its own limit, 600
+/// weights in all beyond the 512 any scene may hold.
+#[test]
+fn planes_times_weights_beyond_the_limit_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = study(&tmp.path().join("results"))
+        .replacen("planes = [-1.0, 1.0]", "planes = [-1.0, 0.0, 1.0]", 1)
+        .replacen("n = 2", "n = 200", 1)
+        .replacen("rho = 0.1", "rho = 0.01", 1)
+        .replacen(
+            "follows_static = 0.5",
+            "follows_static = 0.5\nat = [-1.0, 1.0]",
+            1,
+        );
+    let path = tmp.path().join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    let (code, err) = run(&["run", path.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("scene.rotor.planes") && err.contains("3 planes × 200"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("results").exists());
 }

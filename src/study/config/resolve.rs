@@ -98,28 +98,6 @@ impl StudyFile {
                 ),
             ));
         }
-        let most_weights = self
-            .designs
-            .n
-            .values()
-            .into_iter()
-            .chain(
-                self.designs
-                    .per_plane
-                    .iter()
-                    .flat_map(|a| a.n.as_ref().map(|n| n.values()).unwrap_or_default()),
-            )
-            .max()
-            .unwrap_or(0);
-        if planes as u64 * u64::from(most_weights) > MAX_TOTAL_WEIGHTS as u64 {
-            return Err(invalid(
-                "scene.rotor.planes",
-                format!("{planes} planes × {most_weights} weights"),
-                &format!(
-                    "at most {MAX_TOTAL_WEIGHTS} weights over every plane (planes × designs.n): the state and the implicit method's Jacobian grow with their number"
-                ),
-            ));
-        }
         let alpha = self.statistics.alpha;
         if !(alpha > 0.0 && alpha <= 0.5) {
             return Err(invalid(
@@ -254,6 +232,28 @@ impl StudyFile {
                  reason: r,
              }| invalid(&k, v, &r),
         )?;
+        let most_weights = self
+            .designs
+            .n
+            .values()
+            .into_iter()
+            .chain(
+                self.designs
+                    .per_plane
+                    .iter()
+                    .flat_map(|a| a.n.as_ref().map(|n| n.values()).unwrap_or_default()),
+            )
+            .max()
+            .unwrap_or(0);
+        if planes as u64 * u64::from(most_weights) > MAX_TOTAL_WEIGHTS as u64 {
+            return Err(invalid(
+                "scene.rotor.planes",
+                format!("{planes} planes × {most_weights} weights"),
+                &format!(
+                    "at most {MAX_TOTAL_WEIGHTS} weights over every plane (planes × designs.n): the state and the implicit method's Jacobian grow with their number"
+                ),
+            ));
+        }
         let planes = self.scene.rotor.as_rotor().planes();
         if !self.designs.per_plane.is_empty() && self.optimize.is_some() && planes != 2 {
             // The optimiser searches plane 0's and plane 1's radius ratios.
