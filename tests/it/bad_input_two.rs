@@ -55,17 +55,17 @@ const CASES: &[(&str, &str, &str)] = &[
     ),
     (
         "[metrics]",
-        "[optimize]\nrho_bounds = [0.05, 0.2, 0.3]\n[metrics]",
+        "[optimize]\nobjective = \"capacity\"\nrho_bounds = [0.05, 0.2, 0.3]\n[metrics]",
         "optimize.rho_bounds",
     ),
     (
         "[metrics]",
-        "[optimize]\nfree = [\"rho\", \"drag\"]\ndrag_bounds = [0.01, 0.1, 1.0]\n[metrics]",
+        "[optimize]\nobjective = \"settling_mean\"\nfree = [\"rho\", \"drag\"]\ndrag_bounds = [0.01, 0.1, 1.0]\n[metrics]",
         "optimize.drag_bounds",
     ),
     (
         "[metrics]",
-        "[optimize]\nrho_bounds = []\n[metrics]",
+        "[optimize]\nobjective = \"capacity\"\nrho_bounds = []\n[metrics]",
         "optimize.rho_bounds",
     ),
     // Coincident planes: the couple has no moment, as with `at = [z, z]`.
