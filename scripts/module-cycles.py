@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parent.parent / "src"
 
 # Layers, lowest first: a module may import its own layer and the ones below.
 CRATE_LAYERS = [
-    {"stats", "design", "integrate", "build_info", "input_file", "invalid_key", "output_file", "number_text"},
+    {"stats", "design", "integrate", "build_info", "input_file", "invalid_key", "output_file", "number_text", "pair"},
     {"model"},
     {"metrics"},
     {"simulation", "scene_file"},

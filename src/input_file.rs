@@ -23,13 +23,102 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     std::fs::read_to_string(path)
 }
 
+/// A TOML parse error of `text` in a user's words, led by the dotted key
+/// of the line it points at (`optimize.rho_bounds: …`) when the parser's
+/// own message does not name it: the parser shows the line, not the
+/// table the line sits in.
+pub fn toml_message(text: &str, error: &toml::de::Error) -> String {
+    let words = in_user_words(&error.to_string());
+    match error
+        .span()
+        .and_then(|span| dotted_key_at(text, span.start))
+    {
+        Some(key) if !error.message().contains(&key) => format!("{key}: {words}"),
+        _ => words,
+    }
+}
+
+/// `T` read from a TOML table by way of its text: serde reads an internally
+/// tagged or flattened table from a buffer that has lost each value's
+/// place, so its errors name no key ("invalid type: sequence, expected a
+/// number"); read again as text, the error points at the key's line, and
+/// the message is led by that key (`max: invalid type: …`).
+pub fn from_table<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, String> {
+    let text = table.to_string();
+    toml::from_str(&text).map_err(|e| {
+        let message = in_user_words(e.message());
+        // A tagged or flattened table's error has no place: find the key by
+        // the value it describes, when one key alone holds such a value.
+        let by_value = || {
+            let (_, what) = e.message().split_once("invalid type: ")?;
+            let mut keys = table.iter().filter(|(_, v)| {
+                let said = match v {
+                    toml::Value::Array(_) => "sequence".to_string(),
+                    toml::Value::Table(_) => "map".to_string(),
+                    toml::Value::Boolean(b) => format!("boolean `{b}`"),
+                    toml::Value::String(s) => format!("string {s:?}"),
+                    toml::Value::Integer(i) => format!("integer `{i}`"),
+                    toml::Value::Float(f) => format!("floating point `{f}`"),
+                    toml::Value::Datetime(d) => format!("{d}"),
+                };
+                what.starts_with(&said)
+            });
+            match (keys.next(), keys.next()) {
+                (Some((k, _)), None) => Some(k.clone()),
+                _ => None,
+            }
+        };
+        match by_value().or_else(|| e.span().and_then(|span| dotted_key_at(&text, span.start))) {
+            Some(key) if !message.contains(&format!("`{key}`")) => format!("{key}: {message}"),
+            _ => message,
+        }
+    })
+}
+
+/// The dotted key of the `key = value` line holding byte `offset` of a
+/// TOML text: the last table header above it, then the line's key.
+/// `None` on a header line or a line without `=` (a continued array).
+fn dotted_key_at(text: &str, offset: usize) -> Option<String> {
+    let offset = offset.min(text.len());
+    let start = text.get(..offset)?.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next()?.trim_start();
+    if line.starts_with('[') || line.starts_with('#') {
+        return None;
+    }
+    let key = line.split_once('=')?.0.trim().trim_matches('"');
+    if key.is_empty() {
+        return None;
+    }
+    let table = text[..start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('['))
+        .map(|h| {
+            h.trim_start_matches('[')
+                .split(']')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_string()
+        });
+    Some(match table {
+        Some(t) if !t.is_empty() => format!("{t}.{key}"),
+        _ => key.to_string(),
+    })
+}
+
 /// A TOML parser's message with serde's words for types put in a user's:
 /// "expected struct UnbalanceSpec" names a Rust type the user never wrote.
 pub fn in_user_words(message: &str) -> String {
     let mut out = message
         .replace("expected f64", "expected a number")
         .replace("expected f32", "expected a number")
-        .replace("expected variant identifier", "expected a name in quotes");
+        .replace("expected variant identifier", "expected a name in quotes")
+        .replace(
+            "expected a map",
+            "expected a table of keys (`{ key = value }` or a [section])",
+        );
     for integer in ["u8", "u16", "u32", "u64", "usize", "i32", "i64"] {
         out = out.replace(
             &format!("expected {integer}"),
@@ -101,5 +190,29 @@ mod tests {
         let file = dir.path().join("ok.toml");
         std::fs::write(&file, "a = 1").unwrap();
         assert_eq!(read_text(&file).unwrap(), "a = 1");
+    }
+
+    #[test]
+    fn a_parse_error_is_led_by_the_dotted_key_of_its_line() {
+        let text = "name = \"x\"\n[optimize]\nrho_bounds = \"wide\"\n";
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct O {
+            rho_bounds: [f64; 2],
+        }
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct F {
+            name: String,
+            optimize: O,
+        }
+        let e = toml::from_str::<F>(text).unwrap_err();
+        assert!(
+            toml_message(text, &e).starts_with("optimize.rho_bounds: "),
+            "{}",
+            toml_message(text, &e)
+        );
+        assert_eq!(dotted_key_at(text, 3), Some("name".into()));
+        assert_eq!(dotted_key_at(text, 15), None);
     }
 }

@@ -40,6 +40,7 @@ pub mod model;
 pub mod number_text;
 pub mod optimize;
 pub mod output_file;
+pub mod pair;
 pub mod plot;
 pub mod report;
 pub mod scene_file;

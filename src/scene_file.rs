@@ -90,7 +90,7 @@ impl SceneFile {
     pub fn parse(text: &str, path: &str) -> Result<Self, SceneFileError> {
         toml::from_str(text).map_err(|e| SceneFileError::Parse {
             path: path.to_string(),
-            message: crate::input_file::in_user_words(&e.to_string()),
+            message: crate::input_file::toml_message(text, &e),
         })
     }
 

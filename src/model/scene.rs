@@ -8,7 +8,8 @@ use super::rotor::RotorModel;
 use super::speed::SpeedLaw;
 use super::system::RotorSystem;
 use super::validate::{
-    DENSITY_RANGE, RACE_RADIUS_RANGE, invalid, non_negative, positive, spin_rate, within,
+    DENSITY_RANGE, MAX_TOTAL_WEIGHTS, RACE_RADIUS_RANGE, invalid, non_negative, positive,
+    spin_rate, within,
 };
 use crate::design::optimum::optimal_rho;
 use crate::design::{DesignError, geometry::rho_half_race};
@@ -206,6 +207,16 @@ impl Scene {
                 });
             }
             (false, true) => {
+                let weights: u64 = designs.iter().map(|(_, d)| u64::from(d.n)).sum();
+                if weights > MAX_TOTAL_WEIGHTS as u64 {
+                    return Err(SceneError::Invalid {
+                        field: designs[0].0.clone() + ".n",
+                        value: format!("{weights} weights in all"),
+                        reason: format!(
+                            "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
+                        ),
+                    });
+                }
                 for (key, d) in designs {
                     if d.n == 0 {
                         return Err(invalid(
@@ -231,12 +242,30 @@ impl Scene {
                 }
             }
             (true, false) => {
+                if self.cargo.len() > MAX_TOTAL_WEIGHTS {
+                    return Err(SceneError::Invalid {
+                        field: "cargo".into(),
+                        value: format!("{} cargoes", self.cargo.len()),
+                        reason: format!(
+                            "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
+                        ),
+                    });
+                }
                 for (j, c) in self.cargo.iter().enumerate() {
                     positive(&format!("cargo[{j}].mass"), c.mass)?;
                     positive(&format!("cargo[{j}].track_radius"), c.track_radius)?;
                     non_negative(&format!("cargo[{j}].drag"), c.drag)?;
                     non_negative(&format!("cargo[{j}].rolling_coupling"), c.rolling_coupling)?;
                     non_negative(&format!("cargo[{j}].rolling_inertia"), c.rolling_inertia)?;
+                    // As a race's radius: beyond it the weight's size is no
+                    // size (1e308 made every start a clash).
+                    if !(0.0..=RACE_RADIUS_RANGE.1).contains(&c.radius) {
+                        return Err(invalid(
+                            &format!("cargo[{j}].radius"),
+                            c.radius,
+                            &format!("must be in [0, {}] m (0: no contact)", RACE_RADIUS_RANGE.1),
+                        ));
+                    }
                     if !(c.kappa.is_finite() && c.kappa >= 1.0) {
                         return Err(invalid(
                             &format!("cargo[{j}].kappa"),

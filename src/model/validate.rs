@@ -51,6 +51,15 @@ pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     }
 }
 
+/// Most balancer planes a rotor may carry: machines carry one or two, a
+/// long shaft a few; each plane adds a balancer's equations, and a
+/// 120 000-plane array once ran for ever instead of being refused.
+pub const MAX_PLANES: usize = 16;
+/// Most weights over every balancer of a scene: the state and the
+/// implicit method's Jacobian grow with their number (its square), and
+/// two full balancers of 256 weights each stay within it.
+pub const MAX_TOTAL_WEIGHTS: usize = 512;
+
 /// Slowest spin rate a scene may name (rad/s): a revolution of over an hour
 /// and three quarters; below it no run reaches a revolution boundary.
 pub const MIN_SPIN_RATE: f64 = 1e-3;

@@ -95,7 +95,7 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             "must contain \"rho\" (and optionally \"drag\")",
         ));
     }
-    if let Some([lo, hi]) = spec.rho_bounds
+    if let Some(crate::pair::Pair([lo, hi])) = spec.rho_bounds
         && !(lo > 0.0 && hi > lo && hi < 1.0)
     {
         return Err(bad(
@@ -104,7 +104,7 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             "need 0 < lo < hi < 1",
         ));
     }
-    if let Some([lo, hi]) = spec.drag_bounds
+    if let Some(crate::pair::Pair([lo, hi])) = spec.drag_bounds
         && !(lo > 0.0 && hi > lo && hi.is_finite())
     {
         return Err(bad(

@@ -186,7 +186,7 @@ pub struct SearchResult {
 /// The ρ interval to search for n weights: the bounds, the fit limit and the housing limit.
 pub fn rho_interval(evaluator: &Evaluator<'_>, n: u32) -> (f64, f64) {
     let spec = evaluator.spec;
-    let [lo, hi] = spec.rho_bounds.unwrap_or([0.02, 1.0]);
+    let [lo, hi] = spec.rho_bounds.map_or([0.02, 1.0], |p| p.0);
     let mut hi = hi.min(rho_max(n).unwrap_or(1.0) * (1.0 - 1e-9)).min(0.999);
     if let Some(h) = spec.housing_rho_max {
         hi = hi.min(h);
@@ -282,12 +282,14 @@ pub fn search_slot(evaluator: &Evaluator<'_>, base: Candidate, slot: Slot) -> Se
         return nelder_mead(&cost, lo, hi, budget);
     }
     // A coarse scan brackets the best ρ (Brent only finds a local minimum) …
-    const SCAN: usize = 5;
-    let grid: Vec<f64> = (0..SCAN)
-        .map(|i| lo + (hi - lo) * i as f64 / (SCAN - 1) as f64)
+    // five points, or four when that is the whole budget: the scan never
+    // spends more than `max_evaluations`.
+    let scan = (budget as usize).min(5);
+    let grid: Vec<f64> = (0..scan)
+        .map(|i| lo + (hi - lo) * i as f64 / (scan - 1) as f64)
         .collect();
     let costs: Vec<f64> = grid.iter().map(|&r| cost.eval(r, drag)).collect();
-    let best = (0..SCAN)
+    let best = (0..scan)
         .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
         .unwrap_or(0);
     if costs[best] >= INFEASIBLE || hi - lo < 1e-9 {
@@ -306,13 +308,15 @@ pub fn search_slot(evaluator: &Evaluator<'_>, base: Candidate, slot: Slot) -> Se
         log: Mutex::new(cost.take_log()),
         ..cost
     };
-    let mut bracket = (grid[best.saturating_sub(1)], grid[(best + 1).min(SCAN - 1)]);
-    let h = (hi - lo) / (8.0 * (SCAN - 1) as f64);
+    let mut bracket = (grid[best.saturating_sub(1)], grid[(best + 1).min(scan - 1)]);
+    let h = (hi - lo) / (8.0 * 4.0);
     let mut stop = "budget";
     let mut how = String::new();
     for _ in 0..MAX_PASSES {
         let used = brent_cost.log.lock().expect("log lock").len() as u64;
-        if used >= budget {
+        // Brent evaluates once to start and once per iteration: with fewer
+        // than two evaluations left it cannot take a step within the budget.
+        if used + 2 > budget {
             break;
         }
         let solver = NoiseAwareBrent {
@@ -320,7 +324,7 @@ pub fn search_slot(evaluator: &Evaluator<'_>, base: Candidate, slot: Slot) -> Se
             converged: false,
         };
         let result = Executor::new(RhoCost(&brent_cost), solver)
-            .configure(|s| s.max_iters(budget - used))
+            .configure(|s| s.max_iters(budget - used - 1))
             .run();
         let reason = match result {
             Ok(r) => r
@@ -551,7 +555,7 @@ fn nelder_mead(cost: &CandidateCost<'_>, lo: f64, hi: f64, budget: u64) -> Searc
     let spec = cost.evaluator.spec;
     let [dlo, dhi] = spec
         .drag_bounds
-        .unwrap_or([cost.drag / 10.0, cost.drag * 10.0]);
+        .map_or([cost.drag / 10.0, cost.drag * 10.0], |p| p.0);
     let ln_drag = (dlo.ln(), dhi.ln());
     let steps = [0.25 * (hi - lo), 0.25 * (ln_drag.1 - ln_drag.0)];
     let mut objective = SimplexCost {

@@ -132,9 +132,12 @@ impl Simulation {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: self.solver.max_steps,
-            max_wall: Some(std::time::Duration::from_secs_f64(
-                self.solver.max_wall_seconds,
-            )),
+            // Validated to a year at most; saturating all the same, so
+            // that a settings value built in code cannot panic here.
+            max_wall: Some(
+                std::time::Duration::try_from_secs_f64(self.solver.max_wall_seconds)
+                    .unwrap_or(std::time::Duration::from_secs(31_536_000)),
+            ),
             reduce_second_order: !self.solver.full_newton,
             structured_newton: !self.solver.dense_newton,
             return_when_dearer: self.solver.return_when_dearer,

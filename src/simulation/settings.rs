@@ -131,11 +131,13 @@ impl SolverSettings {
         if self.max_steps == 0 {
             return Err(InvalidKey::new("solver.max_steps", "0", "must be positive"));
         }
-        if !(self.max_wall_seconds.is_finite() && self.max_wall_seconds > 0.0) {
+        // A year at most: a deadline beyond the clock's range (1e308 s)
+        // overflowed the instant it is added to.
+        if !(self.max_wall_seconds > 0.0 && self.max_wall_seconds <= 31_536_000.0) {
             return Err(InvalidKey::new(
                 "solver.max_wall_seconds",
-                self.max_wall_seconds.to_string(),
-                "must be a positive number of seconds",
+                crate::model::validate::shown(self.max_wall_seconds),
+                "must be a positive number of seconds, a year (31 536 000 s) at most",
             ));
         }
         Ok(())

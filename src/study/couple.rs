@@ -47,7 +47,21 @@ pub struct CoupleSpec {
     /// rotor may carry one balancer plane: a single balancer against a
     /// load's static and couple unbalance.
     #[serde(default)]
-    pub at: Option<[f64; 2]>,
+    pub at: Option<crate::pair::Pair>,
+}
+
+/// The balancer planes' axial positions of a rotor on two supports.
+fn rotor_planes(rotor: &RotorModel) -> &[f64] {
+    match rotor {
+        RotorModel::TwoSupport(r) => &r.planes,
+        _ => &[],
+    }
+}
+
+/// Two balancer planes in one axial position, where the couple's parts
+/// ±U_c would cancel: the same refusal as `at = [z, z]`.
+fn coincident_planes(rotor: &RotorModel) -> bool {
+    matches!(rotor_planes(rotor), [a, b] if a == b)
 }
 
 /// A couple part as drawn for one run.
@@ -89,7 +103,14 @@ pub fn validate(
                 ),
             ));
         }
-        (_, Some([a, b])) if !(a.is_finite() && b.is_finite() && a != b) => {
+        (Some(2), None) if coincident_planes(rotor) => {
+            return Err(InvalidKey::new(
+                "scene.rotor.planes",
+                format!("{:?}", rotor_planes(rotor)),
+                "a couple unbalance needs two distinct balancer planes: in one axial position the couple has no moment (or give sampling.couple.at)",
+            ));
+        }
+        (_, Some(crate::pair::Pair([a, b]))) if !(a.is_finite() && b.is_finite() && a != b) => {
             return Err(InvalidKey::new(
                 "sampling.couple.at",
                 format!("[{a}, {b}]"),

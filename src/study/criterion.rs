@@ -60,6 +60,35 @@ struct CriterionText(
     String,
 );
 
+/// Whole criteria in the given units for a value that lacks one: the
+/// number the user typed when it is one, else a typical level, so that
+/// each suggestion parses as it stands (`settled_by:30min` once suggested
+/// `30mins`, itself refused).
+fn suggest(key: &str, value: &str, units: &[&str]) -> String {
+    let typed = value.trim();
+    let digits = typed
+        .char_indices()
+        .map(|(i, c)| i + c.len_utf8())
+        .rfind(|&end| {
+            typed[..end]
+                .parse::<f64>()
+                .is_ok_and(|v| v.is_finite() && v > 0.0)
+        })
+        .map(|end| &typed[..end]);
+    units
+        .iter()
+        .map(|unit| {
+            let level = digits.unwrap_or(match *unit {
+                "m" => "2e-5",
+                "s" => "0.5",
+                _ => "30",
+            });
+            format!("{key}:{level}{unit}")
+        })
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
 /// The forms `--rank-by` and `rank_by` accept, for messages.
 pub const CRITERION_FORMS: &str = "median, mean (restricted mean up to the horizon), p90, settled_fraction, settled_by:<X>rev or settled_by:<X>s, residual_p95, p_residual_below:<X>m";
 
@@ -83,11 +112,16 @@ impl Criterion {
     /// Parse the text form (see [`CRITERION_FORMS`]).
     pub fn parse(text: &str) -> Result<Self, String> {
         let text = text.trim();
-        let number = |value: &str, unit: &str| -> Result<f64, String> {
-            let v: f64 = value
-                .trim()
-                .strip_suffix(unit)
-                .ok_or_else(|| format!("{text:?}: give the unit, e.g. {value}{unit}"))?
+        let number = |key: &str, value: &str, units: &[&str]| -> Result<f64, String> {
+            let unit = units.iter().find(|u| value.trim().ends_with(**u));
+            let v: f64 = unit
+                .and_then(|u| value.trim().strip_suffix(*u))
+                .ok_or_else(|| {
+                    format!(
+                        "{text:?}: give the unit, e.g. {}",
+                        suggest(key, value, units)
+                    )
+                })?
                 .trim()
                 .parse()
                 .map_err(|_| format!("{text:?}: {value:?} is not a number"))?;
@@ -116,12 +150,14 @@ impl Criterion {
                 }
             },
             Some(("settled_by", value)) if value.trim().ends_with("rev") => {
-                Criterion::SettledBy(Within::Revs(number(value, "rev")?))
+                Criterion::SettledBy(Within::Revs(number("settled_by", value, &["rev"])?))
             }
             Some(("settled_by", value)) => {
-                Criterion::SettledBy(Within::Seconds(number(value, "s")?))
+                Criterion::SettledBy(Within::Seconds(number("settled_by", value, &["s", "rev"])?))
             }
-            Some(("p_residual_below", value)) => Criterion::ResidualBelow(number(value, "m")?),
+            Some(("p_residual_below", value)) => {
+                Criterion::ResidualBelow(number("p_residual_below", value, &["m"])?)
+            }
             Some(_) => {
                 return Err(format!(
                     "{text:?} is not a criterion; one of: {CRITERION_FORMS}"

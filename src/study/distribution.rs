@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 /// fraction of each design's balancing capacity.
 // No deny_unknown_fields here: serde cannot combine it with `flatten`; the
 // flattened distribution rejects unknown keys itself.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[schemars(transform = close_unbalance_tables)]
 pub struct UnbalanceSpec {
     /// The distribution.
@@ -28,6 +28,28 @@ pub struct UnbalanceSpec {
     /// different unbalance under the two.
     #[serde(default)]
     pub relative_to: Option<Scale>,
+}
+
+/// [`UnbalanceSpec`]'s keys as serde reads them (the flattened
+/// distribution), read from the table's text so that errors name the key.
+#[derive(Deserialize)]
+struct UnbalanceFields {
+    #[serde(flatten)]
+    distribution: Distribution,
+    #[serde(default)]
+    relative_to: Option<Scale>,
+}
+
+impl<'de> Deserialize<'de> for UnbalanceSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let table = toml::Table::deserialize(deserializer)?;
+        let f: UnbalanceFields = crate::input_file::from_table(&table).map_err(D::Error::custom)?;
+        Ok(UnbalanceSpec {
+            distribution: f.distribution,
+            relative_to: f.relative_to,
+        })
+    }
 }
 
 impl UnbalanceSpec {

@@ -88,10 +88,10 @@ pub struct OptimizeSpec {
     pub free: Vec<Variable>,
     /// Bounds on ρ (default: (0.02, ρ_max(n))).
     #[serde(default)]
-    pub rho_bounds: Option<[f64; 2]>,
+    pub rho_bounds: Option<crate::pair::Pair>,
     /// Bounds on β (N·s/m) when drag is free.
     #[serde(default)]
-    pub drag_bounds: Option<[f64; 2]>,
+    pub drag_bounds: Option<crate::pair::Pair>,
     /// Largest ρ the housing allows (a torus-shaped race limits the weight radius).
     #[serde(default)]
     pub housing_rho_max: Option<f64>,

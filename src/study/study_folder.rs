@@ -85,8 +85,11 @@ pub fn claim(
         path: dir.display().to_string(),
         source,
     };
-    std::fs::create_dir_all(&dir).map_err(not_writable)?;
-    probe_writable(&dir).map_err(not_writable)?;
+    let made = create_dirs(&dir).map_err(not_writable)?;
+    if let Err(e) = probe_writable(&dir) {
+        remove_made(&made);
+        return Err(not_writable(e));
+    }
     let lock = FolderLock::acquire(&dir)?;
     for file in files {
         prepare(role, &dir.join(file), when)?;
@@ -96,6 +99,29 @@ pub fn claim(
         crate::study::io::write_text(&manifest, &copy).map_err(not_writable)?;
     }
     Ok(ClaimedFolder { dir, _lock: lock })
+}
+
+/// `create_dir_all`, returning the folders it made (deepest last); on
+/// failure it removes the ones it made, so that a refusal (a name too long
+/// for the file system, a read-only parent) leaves no empty folders behind.
+fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let made: Vec<PathBuf> = dir
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .map(Path::to_path_buf)
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .collect();
+    std::fs::create_dir_all(dir).inspect_err(|_| remove_made(&made))?;
+    Ok(made)
+}
+
+/// Remove the (empty) folders [`create_dirs`] made, deepest first.
+fn remove_made(made: &[PathBuf]) {
+    for d in made.iter().rev() {
+        let _ = std::fs::remove_dir(d);
+    }
 }
 
 /// What another verb made of `dir`, if anything.

@@ -3,6 +3,7 @@
 mod adaptive;
 mod auto_method;
 mod bad_input;
+mod bad_input_two;
 mod bench;
 mod certified_hold;
 mod check;
@@ -25,6 +26,7 @@ mod extremes;
 mod fixtures;
 mod fuzz_cli;
 mod fuzz_input;
+mod fuzz_schema;
 mod golden;
 mod integrate;
 mod model_conservation;

@@ -408,3 +408,31 @@ fn ties_between_counts_are_stated() {
     assert_eq!(ties.len(), 1, "{ties:?}");
     assert_ne!(ties[0], c.rows[c.overall].scope);
 }
+
+/// Issue 46: each (kind, n) search spent one evaluation over
+/// `max_evaluations` (4 gave 5, 10 gave 11): the scan, Brent's start and
+/// the simplex now stay within it.
+#[test]
+fn no_search_spends_more_than_max_evaluations() {
+    for (free, max) in [("", 4), ("", 10), ("free = [\"rho\", \"drag\"]\n", 5)] {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = plan(
+            tmp.path(),
+            "kind = \"ball\"\nn = 3\nrho = \"optimal\"\ndrag = 10.0",
+            "samples = 2\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }",
+            &format!(
+                "objective = \"settling_mean\"\n{free}max_evaluations = {max}\nconfirm_samples = 0"
+            ),
+        );
+        let out = optimize(&p).unwrap();
+        let searched = out
+            .evaluations
+            .iter()
+            .filter(|e| e.phase != "confirm")
+            .count();
+        assert!(
+            (1..=max).contains(&searched),
+            "{free}max_evaluations = {max}: {searched} evaluations"
+        );
+    }
+}

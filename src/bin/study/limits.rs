@@ -88,6 +88,43 @@ pub fn range(
     }
 }
 
+/// A speed range flag (`--omega` in rad/s, `--rpm`: `per_rad` units per
+/// rad/s) whose ends are also spin rates a scene may name: refused here
+/// naming the flag, not the scene key `speed.omega` each point becomes.
+pub fn speed_range(
+    flag: &str,
+    text: &str,
+    zero_allowed: bool,
+    example: Option<&str>,
+    per_rad: f64,
+) -> Result<(f64, f64), String> {
+    use autobal::model::validate::{MAX_SPIN_RATE, MIN_SPIN_RATE};
+    let (lo, hi) = range(flag, text, zero_allowed, example)?;
+    let inside = |v: f64| {
+        (zero_allowed && v == 0.0) || (MIN_SPIN_RATE..=MAX_SPIN_RATE).contains(&(v / per_rad))
+    };
+    if inside(lo) && inside(hi) {
+        Ok((lo, hi))
+    } else {
+        let unit = if per_rad == 1.0 { "rad/s" } else { "rpm" };
+        Err(format!(
+            "--{flag} {text}: each end must be a spin rate in [{}, {}] {unit}{} (outside it every run fails: no revolution completes, or the steps underflow)",
+            crate::limits::short(MIN_SPIN_RATE * per_rad),
+            crate::limits::short(MAX_SPIN_RATE * per_rad),
+            if zero_allowed { ", or 0" } else { "" }
+        ))
+    }
+}
+
+/// A limit in a message: few digits, an exponent when large or small.
+fn short(v: f64) -> String {
+    if (1e-2..1e5).contains(&v) {
+        format!("{}", (v * 1e4).round() / 1e4)
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
 /// `stepped --dwell`: seconds at each speed, in (0, one day].
 pub fn dwell_seconds(text: &str) -> Result<f64, String> {
     number_in(text, "seconds held at each speed; a day at most", 86_400.0)

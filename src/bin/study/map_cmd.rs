@@ -43,7 +43,8 @@ fn parse_range(name: &str, text: &str) -> Result<(f64, f64), UserError> {
 
 /// Run `study map`.
 pub fn run(args: &MapArgs) -> Result<(), UserError> {
-    let (w_lo, w_hi) = parse_range("omega", &args.omega)?;
+    let (w_lo, w_hi) = crate::limits::speed_range("omega", &args.omega, true, None, 1.0)
+        .map_err(|e| UserError(e, 2))?;
     let (u_lo, u_hi) = parse_range("unbalance", &args.unbalance)?;
     let bad = || {
         UserError(

@@ -3,6 +3,7 @@
 use crate::UserError;
 use autobal::metrics::RunMetrics;
 use autobal::model::critical_speeds::critical_speeds_in_range;
+use autobal::model::speed::{RAD_PER_RPM, SpeedLaw};
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
 use autobal::study::io::{Provenance, write_series};
@@ -59,7 +60,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
             "{}",
             crate::output::wrap(
                 &format!(
-                    "{}{}{}",
+                    "{}{}{}{}",
+                    speed_line(&simulation.scene.speed),
                     describe(&result.metrics),
                     bearing_orbits_line(&result.metrics),
                     critical_speeds_line(critical.as_deref())
@@ -69,6 +71,37 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
         );
     }
     Ok(())
+}
+
+/// The speed law in both units, so that an `omega` typed in rpm shows at
+/// once: "ω = 314.2 rad/s (3000 rpm)".
+fn speed_line(law: &SpeedLaw) -> String {
+    let sig4 = |v: f64| autobal::number_text::significant(v, 4);
+    let both = |w: f64| format!("{} rad/s ({} rpm)", sig4(w), sig4(w / RAD_PER_RPM));
+    let text = match *law {
+        SpeedLaw::Constant { omega } => format!("ω = {}, constant", both(omega)),
+        SpeedLaw::Ramp {
+            omega_start,
+            omega_end,
+            duration,
+        } => format!(
+            "ω from {} to {} over {} s",
+            both(omega_start),
+            both(omega_end),
+            sig4(duration)
+        ),
+        SpeedLaw::Motor {
+            omega_sync,
+            omega_start,
+            ..
+        } => format!(
+            "motor: ω_sync = {}, from ω = {}",
+            both(omega_sync),
+            both(omega_start)
+        ),
+        SpeedLaw::Free { omega_start } => format!("free: from ω = {}", both(omega_start)),
+    };
+    format!("speed              {text}\n")
 }
 
 /// Each bearing's orbit over the revolution after the run (rotors with

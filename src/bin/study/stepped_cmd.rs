@@ -50,7 +50,14 @@ pub struct SteppedArgs {
 const MAX_STEPS: f64 = 100_000.0;
 
 fn parse_rpm(text: &str) -> Result<(f64, f64), UserError> {
-    crate::limits::range("rpm", text, false, Some("1000..5000")).map_err(|e| UserError(e, 2))
+    crate::limits::speed_range(
+        "rpm",
+        text,
+        false,
+        Some("1000..5000"),
+        30.0 / std::f64::consts::PI,
+    )
+    .map_err(|e| UserError(e, 2))
 }
 
 /// Run `study stepped`.

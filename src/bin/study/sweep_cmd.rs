@@ -37,7 +37,8 @@ pub struct SweepArgs {
 }
 
 fn parse_range(text: &str) -> Result<(f64, f64), UserError> {
-    crate::limits::range("omega", text, false, Some("0.5..8")).map_err(|e| UserError(e, 2))
+    crate::limits::speed_range("omega", text, false, Some("0.5..8"), 1.0)
+        .map_err(|e| UserError(e, 2))
 }
 
 /// Run `study sweep`.

@@ -53,6 +53,15 @@ pub struct RaceEccentricity {
 impl EffectSpec for RaceEccentricity {
     fn validate(&self, key: &str) -> Result<(), SceneError> {
         non_negative(&format!("{key}.offset"), self.offset)?;
+        // No race is off its axis by more than the largest race's radius.
+        let most = crate::model::validate::RACE_RADIUS_RANGE.1;
+        if self.offset > most {
+            return Err(invalid(
+                &format!("{key}.offset"),
+                self.offset,
+                &format!("must be at most {most} m, the largest race radius"),
+            ));
+        }
         if !self.angle_deg.is_finite() {
             return Err(invalid(
                 &format!("{key}.angle_deg"),

@@ -184,7 +184,7 @@ impl RotorParams for FlexibleShaft {
         non_negative("rotor.c_t", self.c_t)?;
         non_negative("rotor.c_r", self.c_r)?;
         non_negative("rotor.eccentricity", self.eccentricity)?;
-        finite("rotor.unbalance_angle", self.unbalance_angle)
+        finite("rotor.unbalance_angle_deg", self.unbalance_angle)
     }
 
     fn set_unbalance(&mut self, unbalance: f64, direction: f64) {

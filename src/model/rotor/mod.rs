@@ -374,7 +374,7 @@ impl<'de> Deserialize<'de> for RotorModel {
                 .and_then(|span| text[..span.start].rsplit('\n').next())
                 .and_then(|line| line.split('=').next())
                 .map(str::trim)
-                .filter(|k| !k.is_empty());
+                .filter(|k| !k.is_empty() && !k.starts_with('['));
             match key {
                 Some(key) => D::Error::custom(format!("rotor.{key} ({model}): {}", e.message())),
                 None => D::Error::custom(format!("rotor ({model}): {}", e.message())),

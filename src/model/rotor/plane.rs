@@ -136,7 +136,7 @@ impl RotorParams for PlaneRotor {
         non_negative("rotor.by", self.by)?;
         if !self.unbalance_angle.is_finite() {
             return Err(invalid(
-                "rotor.unbalance_angle",
+                "rotor.unbalance_angle_deg",
                 self.unbalance_angle,
                 "must be finite",
             ));

@@ -335,8 +335,8 @@ impl RotorParams for TwoSupportRotor {
         for (name, v) in [
             ("rotor.l1", self.l1),
             ("rotor.l2", self.l2),
-            ("rotor.static_angle", self.static_angle),
-            ("rotor.moment_angle", self.moment_angle),
+            ("rotor.static_angle_deg", self.static_angle),
+            ("rotor.moment_angle_deg", self.moment_angle),
         ] {
             finite(name, v)?;
         }
@@ -354,13 +354,23 @@ impl RotorParams for TwoSupportRotor {
                 reason: "give the axial position of at least one balancer plane".into(),
             });
         }
+        if self.planes.len() > crate::model::validate::MAX_PLANES {
+            return Err(SceneError::Invalid {
+                field: "rotor.planes".into(),
+                value: format!("{} planes", self.planes.len()),
+                reason: format!(
+                    "at most {} balancer planes: each plane adds a balancer's equations, and no machine carries more",
+                    crate::model::validate::MAX_PLANES
+                ),
+            });
+        }
         for (p, &z) in self.planes.iter().enumerate() {
             finite(&format!("rotor.planes[{p}]"), z)?;
         }
         for (j, u) in self.unbalances.iter().enumerate() {
             non_negative(&format!("rotor.unbalances[{j}].s"), u.s)?;
             finite(&format!("rotor.unbalances[{j}].z"), u.z)?;
-            finite(&format!("rotor.unbalances[{j}].angle"), u.angle)?;
+            finite(&format!("rotor.unbalances[{j}].angle_deg"), u.angle)?;
         }
         Ok(())
     }

@@ -17,6 +17,7 @@ use crate::model::rotor::RotorModel;
 use crate::model::scene::{DesignSpec, RhoChoice, Scene, SceneError};
 use crate::model::speed::SpeedLaw;
 use crate::model::start::StartMode;
+use crate::model::validate::{MAX_PLANES, MAX_TOTAL_WEIGHTS};
 use crate::simulation::SolverSettings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

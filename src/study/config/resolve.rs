@@ -4,12 +4,15 @@
 
 use super::*;
 
+/// Longest study name in bytes (docs/limits.md): a folder name.
+pub const MAX_NAME_BYTES: usize = 128;
+
 impl StudyFile {
     /// Parse TOML text (`path` is used in messages only).
     pub fn parse(text: &str, path: &str) -> Result<Self, StudyError> {
         toml::from_str(text).map_err(|e| StudyError::Parse {
             path: path.to_string(),
-            message: crate::input_file::in_user_words(&e.to_string()),
+            message: crate::input_file::toml_message(text, &e),
         })
     }
 
@@ -35,11 +38,64 @@ impl StudyFile {
                 .unwrap_or("study")
                 .to_string(),
         };
-        if name.is_empty() || name.contains(['/', '\\']) || name == ".." || name == "." {
+        // The name becomes a folder and a label: checked here, before any
+        // folder is made, so that a refusal leaves nothing behind.
+        let bad_name = if name.trim().is_empty() {
+            Some("must not be empty or blank")
+        } else if name.chars().any(char::is_control) {
+            Some("must not hold control characters (a newline, a tab, …)")
+        } else if name.trim() != name {
+            Some("must not begin or end with a space")
+        } else if name.contains(['/', '\\']) || name == ".." || name == "." {
+            Some("must be a plain folder name")
+        } else if name.len() > MAX_NAME_BYTES {
+            Some(
+                "at most 128 bytes: it is a folder name, and file systems refuse longer ones (255 bytes, less with the files beside it)",
+            )
+        } else {
+            None
+        };
+        if let Some(reason) = bad_name {
+            let key = if self.name.is_some() {
+                "name"
+            } else {
+                "name (from the study file's name)"
+            };
+            let shown = if name.len() > 40 {
+                format!(
+                    "{:?}… ({} bytes)",
+                    name.chars().take(20).collect::<String>(),
+                    name.len()
+                )
+            } else {
+                format!("{name:?}")
+            };
+            return Err(invalid(key, shown, reason));
+        }
+        // Planes and weights first: every later check may walk the planes.
+        let planes = self.scene.rotor.as_rotor().planes();
+        if planes > MAX_PLANES {
             return Err(invalid(
-                "name",
-                format!("{name:?}"),
-                "must be a plain folder name",
+                "scene.rotor.planes",
+                format!("{planes} planes"),
+                &format!(
+                    "at most {MAX_PLANES} balancer planes: each plane adds a balancer's equations, and no machine carries more"
+                ),
+            ));
+        }
+        if let Some(n) = self
+            .designs
+            .n
+            .values()
+            .into_iter()
+            .find(|&n| n > MAX_WEIGHTS)
+        {
+            return Err(invalid(
+                "designs.n",
+                n.to_string(),
+                &format!(
+                    "at most {MAX_WEIGHTS} weights per balancer: the state and the implicit method's Jacobian grow with n (n² entries), and no race holds more weights of a useful size"
+                ),
             ));
         }
         let alpha = self.statistics.alpha;
@@ -87,7 +143,9 @@ impl StudyFile {
                     s.samples.to_string(),
                     &format!(
                         "with sequence = \"sobol\" a power of two up to {max} (e.g. {}): a Sobol sequence is even only over 2^m points",
-                        s.samples.next_power_of_two().min(max)
+                        s.samples
+                            .checked_next_power_of_two()
+                            .map_or(max, |p| p.min(max))
                     ),
                 ));
             }
@@ -97,7 +155,7 @@ impl StudyFile {
                     s.batch.to_string(),
                     &format!(
                         "with sequence = \"sobol\" a power of two (e.g. {}), so that every batch ends on an even prefix of the sequence",
-                        s.batch.next_power_of_two()
+                        s.batch.checked_next_power_of_two().unwrap_or(1024)
                     ),
                 ));
             }
@@ -163,21 +221,6 @@ impl StudyFile {
         {
             return Err(invalid(&field, value, &reason));
         }
-        if let Some(n) = self
-            .designs
-            .n
-            .values()
-            .into_iter()
-            .find(|&n| n > MAX_WEIGHTS)
-        {
-            return Err(invalid(
-                "designs.n",
-                n.to_string(),
-                &format!(
-                    "at most {MAX_WEIGHTS} weights per balancer: the state and the implicit method's Jacobian grow with n (n² entries), and no race holds more weights of a useful size"
-                ),
-            ));
-        }
         super::super::plane_designs::validate(
             &self.designs.per_plane,
             self.scene.rotor.as_rotor().planes(),
@@ -189,6 +232,28 @@ impl StudyFile {
                  reason: r,
              }| invalid(&k, v, &r),
         )?;
+        let most_weights = self
+            .designs
+            .n
+            .values()
+            .into_iter()
+            .chain(
+                self.designs
+                    .per_plane
+                    .iter()
+                    .flat_map(|a| a.n.as_ref().map(|n| n.values()).unwrap_or_default()),
+            )
+            .max()
+            .unwrap_or(0);
+        if planes as u64 * u64::from(most_weights) > MAX_TOTAL_WEIGHTS as u64 {
+            return Err(invalid(
+                "scene.rotor.planes",
+                format!("{planes} planes × {most_weights} weights"),
+                &format!(
+                    "at most {MAX_TOTAL_WEIGHTS} weights over every plane (planes × designs.n): the state and the implicit method's Jacobian grow with their number"
+                ),
+            ));
+        }
         let planes = self.scene.rotor.as_rotor().planes();
         if !self.designs.per_plane.is_empty() && self.optimize.is_some() && planes != 2 {
             // The optimiser searches plane 0's and plane 1's radius ratios.

@@ -31,7 +31,12 @@ pub fn sample_simulation(
     if let Some(couple) = &sample.couple {
         let planes =
             super::super::couple::plane_unbalances((sample.unbalance, sample.direction), couple);
-        let at = plan.file.sampling.couple.as_ref().and_then(|c| c.at);
+        let at = plan
+            .file
+            .sampling
+            .couple
+            .as_ref()
+            .and_then(|c| c.at.map(|p| p.0));
         super::super::couple::apply(&mut scene.rotor, at, &planes);
     }
     sample.weights = draw_weights(plan, design, sample_id, &mut scene);
