@@ -48,6 +48,8 @@ drag = [2.0, 5.0, 10.0, 20.0, 50.0]
 [sampling]
 samples = 50000
 unbalance = {{ distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }}
+# Every run: the runner's streaming is measured, not a race.
+racing = false
 
 [solver]
 fidelity = "analytic"
