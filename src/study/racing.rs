@@ -266,8 +266,12 @@ pub fn leaves(
     let at_least_as_good = |d: &DesignRuns| {
         measures.iter().enumerate().all(|(j, m)| {
             let (a, b) = (m.value(leader, &scale), m.value(d, &scale));
-            if m.order(a, b) == std::cmp::Ordering::Equal {
-                return true;
+            match m.order(a, b) {
+                std::cmp::Ordering::Equal => return true,
+                // Behind on the point estimate: not ahead by any margin,
+                // and no bootstrap interval is needed to say so.
+                std::cmp::Ordering::Greater => return false,
+                std::cmp::Ordering::Less => {}
             }
             let mut rng = stream(
                 plan.file.seed,
