@@ -302,52 +302,28 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         .iter()
         .flatten()
         .any(|f| f != "from t = 0");
-    let (header, rows) = if run_up {
+    let (mut header, mut rows) = (header, rows);
+    if run_up {
         let from_start = sum.f("settling_revs_median_km_from_start")?;
-        let at = header
-            .iter()
-            .position(|h| h.starts_with("median"))
-            .unwrap_or(0)
-            + 1;
-        let mut header = header;
-        header.insert(at, "median\nfrom t = 0".into());
-        let rows = rows
-            .into_iter()
-            .zip(&order)
-            .map(|(mut row, &i)| {
-                row.insert(
-                    at,
-                    from_start[i].map_or("beyond".into(), |m| format!("{m:.1}")),
-                );
-                row
-            })
-            .collect();
-        (header, rows)
-    } else {
-        (header, rows)
-    };
+        let after = header.iter().position(|h| h.starts_with("median"));
+        insert_column(
+            &mut header,
+            &mut rows,
+            after.unwrap_or(0) + 1,
+            "median\nfrom t = 0",
+            |k| from_start[order[k]].map_or("beyond".into(), |m| format!("{m:.1}")),
+        );
+    }
     // A raced study: designs that left the race have fewer runs, and say so.
     let runs: Vec<Option<u64>> = summary.column("runs")?.u64()?.iter().collect();
     let raced = runs.iter().flatten().min() != runs.iter().flatten().max();
-    let (header, rows) = if raced {
-        let at = header
-            .iter()
-            .position(|h| h.starts_with("settled"))
-            .map_or(header.len(), |p| p + 1);
-        let mut header = header;
-        header.insert(at, "runs".into());
-        let rows = rows
-            .into_iter()
-            .zip(&order)
-            .map(|(mut row, &i)| {
-                row.insert(at, runs[i].map_or("–".into(), |r| r.to_string()));
-                row
-            })
-            .collect();
-        (header, rows)
-    } else {
-        (header, rows)
-    };
+    if raced {
+        let after = header.iter().position(|h| h.starts_with("settled"));
+        let at = after.map_or(header.len(), |p| p + 1);
+        insert_column(&mut header, &mut rows, at, "runs", |k| {
+            runs[order[k]].map_or("–".into(), |r| r.to_string())
+        });
+    }
     let runs_note = if raced {
         "(runs: a design with fewer runs than the others left the race after that many samples, once #1 was significantly better and no other measure favoured it; its statistics and its comparison with #1 use the runs it has, docs/statistics.md, \"Racing\")\n"
     } else {
@@ -460,6 +436,20 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         findings,
         passage: passage_table(summary)?,
     })
+}
+
+/// Insert a column `name` at `at`, row k (in rank order) holding `cell(k)`.
+fn insert_column(
+    header: &mut Vec<String>,
+    rows: &mut [Vec<String>],
+    at: usize,
+    name: &str,
+    cell: impl Fn(usize) -> String,
+) {
+    header.insert(at, name.into());
+    for (k, row) in rows.iter_mut().enumerate() {
+        row.insert(at, cell(k));
+    }
 }
 
 /// How far the restricted mean counts a run: in words by default (the
