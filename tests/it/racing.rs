@@ -218,3 +218,47 @@ fn a_raced_study_is_identical_for_threads_and_shards() {
         one.race.as_ref().unwrap().len()
     );
 }
+
+/// Racing beside a precision to stop at: the race looks after every batch,
+/// the precision is judged on the designs still running, and the result is
+/// the same for one and two threads.
+#[test]
+fn a_race_with_a_precision_to_stop_at_is_the_same_for_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = main_job(
+        dir.path(),
+        "batch = 20\nstop_when = { median_halfwidth_rel = 0.1 }",
+    )
+    .replace("samples = 500", "samples = 200");
+    let p = plan(&text);
+    let run = |threads, out: &str| {
+        let mut p = p.clone();
+        p.file.output = dir.path().join(out).display().to_string();
+        let options = RunOptions {
+            threads: Some(threads),
+            ..RunOptions::default()
+        };
+        run_study(&p, &options, &NoProgress).unwrap()
+    };
+    let (one, two) = (run(1, "one"), run(2, "two"));
+    let adaptive = one.adaptive.clone().expect("where it stopped");
+    let departures = one.race.clone().expect("a race");
+    assert!(!departures.is_empty(), "nobody left the race");
+    // Every design that left did so at a batch's end, at the latest at the
+    // look that stopped the study (whose precision no longer counts it).
+    for d in &departures {
+        assert_eq!(d.samples % 20, 0, "{d:?}");
+        assert!(
+            d.samples <= adaptive.samples_per_design,
+            "{d:?} {adaptive:?}"
+        );
+    }
+    assert_eq!(two.adaptive, one.adaptive);
+    assert_eq!(two.race, one.race);
+    let stable = |dir: &Path| {
+        let df = read_parquet(&dir.join("runs.parquet")).unwrap();
+        let cols = deterministic_columns(&df);
+        df.select(cols).unwrap()
+    };
+    assert!(stable(&one.dir).equals_missing(&stable(&two.dir)));
+}
