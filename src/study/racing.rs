@@ -80,6 +80,9 @@ pub struct Departure {
 pub struct Race {
     levels: Vec<f64>,
     left: Vec<Option<Departure>>,
+    /// Whether the study ends when one design is left (not when it runs on
+    /// to a precision, `sampling.stop_when`).
+    ends_when_decided: bool,
     /// The samples after which one design was left: the race, and the study, ended.
     ended: Option<u32>,
 }
@@ -93,6 +96,7 @@ impl Race {
         Race {
             levels: SPENDING.look_levels(plan.file.statistics.alpha, &fractions),
             left: vec![None; plan.designs.len()],
+            ends_when_decided: plan.file.sampling.stop_when.is_none(),
             ended: None,
         }
     }
@@ -147,14 +151,14 @@ impl Race {
             }
         }
         // One design left: the decision is made, and more of its runs would
-        // change no verdict.
-        if self.running_count() < 2 {
+        // change no verdict (unless the study runs on to a precision).
+        if self.ends_when_decided && self.running_count() < 2 {
             self.ended = Some(samples);
         }
         Ok(out)
     }
 
-    /// True once a single design is left in the race: the study ends.
+    /// True once a single design is left in a race that ends then.
     pub fn decided(&self) -> bool {
         self.ended.is_some()
     }

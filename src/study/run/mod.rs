@@ -444,7 +444,7 @@ fn run_in_folder(
             .filter(|&id| !done[id as usize])
             .filter(|&id| {
                 race.as_ref()
-                    .is_none_or(|r| r.running((id / samples) as usize))
+                    .is_none_or(|r| r.runs((id / samples) as usize, (id % samples) as u32))
             })
             .collect();
         let saved = execute(plan, &pending, options, pool.as_ref(), &chunks, progress)?;
@@ -479,13 +479,14 @@ fn run_in_folder(
                 Some(p) => p.install(|| race.look(plan, k, range.end, &judged))?,
                 None => race.look(plan, k, range.end, &judged)?,
             };
-            if !left.is_empty() {
-                let remaining = (k + 1..batches.len())
-                    .map(|j| u64::from(batches[j].end - batches[j].start))
-                    .sum::<u64>();
-                progress.skip(remaining * left.len() as u64);
+            // Runs that will not come: the later samples of the designs that
+            // left, and of the one left when that ends the study.
+            let stopped = left.len() + usize::from(race.decided());
+            if stopped > 0 {
+                let remaining = u64::from(plan.file.sampling.samples - range.end);
+                progress.skip(remaining * stopped as u64);
             }
-            if race.decided() && stop_when.is_none() {
+            if race.decided() {
                 break;
             }
         }
