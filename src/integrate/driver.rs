@@ -4,7 +4,7 @@
 //! implicit method. A [`Stepper`] supplies only the method itself.
 
 use super::cost::{CostTrial, StallWindow, TRIAL_STEPS, TrialWindow};
-use super::events::{EventFlow, crossed, first_root};
+use super::events::{EventFlow, crossed, first_root, lowest, may_dip};
 use super::norm::check_step;
 use super::stepper::{Stepper, Trial};
 use super::stiffness::{StiffnessWatch, Verdict};
@@ -71,8 +71,12 @@ where
         vec![0.0; n_events],
     );
     let mut probe = vec![0.0; if n_events > 0 { y.len() } else { 0 }];
+    // Their rates at the current point and a step's end, where cheap.
+    let (mut r_now, mut r_end) = (vec![0.0; n_events], vec![0.0; n_events]);
+    let mut has_rates = false;
     if let Some(ev) = events {
         ev.values(t, &y, &mut g_now);
+        has_rates = ev.rates(t, &y, &mut r_now);
     }
 
     loop {
@@ -124,20 +128,30 @@ where
         let mut event = None;
         if let Some(ev) = events {
             ev.values(t, &y, &mut g_end);
+            if has_rates {
+                ev.rates(t, &y, &mut r_end);
+            }
             for k in 0..n_events {
-                if !crossed(g_now[k], g_end[k]) {
-                    continue;
-                }
                 let dense = stepper.dense();
-                let at = first_root(
-                    |s| {
-                        dense.eval(s, &mut probe);
-                        ev.values(s, &probe, &mut g_probe);
-                        g_probe[k]
-                    },
-                    (t_prev, g_now[k]),
-                    (t, g_end[k]),
-                );
+                let mut g_at = |s: f64| {
+                    dense.eval(s, &mut probe);
+                    ev.values(s, &probe, &mut g_probe);
+                    g_probe[k]
+                };
+                // The far end of the bracket: the step's end, or the bottom
+                // of a dip below zero inside it.
+                let far = if crossed(g_now[k], g_end[k]) {
+                    (t, g_end[k])
+                } else if has_rates
+                    && may_dip((g_now[k], g_end[k]), (r_now[k], r_end[k]), h)
+                    && let (bottom, low) = lowest(&mut g_at, t_prev, t)
+                    && low <= 0.0
+                {
+                    (bottom, low)
+                } else {
+                    continue;
+                };
+                let at = first_root(g_at, (t_prev, g_now[k]), far);
                 if event.is_none_or(|(first, _)| at < first) {
                     event = Some((at, k));
                 }
@@ -169,6 +183,9 @@ where
                 return report(Status::Stopped, t, y, stats, &window);
             }
             ev.values(t, &y, &mut g_now);
+            if has_rates {
+                ev.rates(t, &y, &mut r_now);
+            }
             h = match stepper.start(system, t, &y, h_max.min(t_end - t), &mut stats) {
                 Ok(h0) => h0.min(h_max),
                 Err(f) => return report(Status::Failed(f), t, y, stats, &window),
@@ -178,6 +195,7 @@ where
             continue;
         }
         std::mem::swap(&mut g_now, &mut g_end);
+        std::mem::swap(&mut r_now, &mut r_end);
         if last || t >= t_end {
             return report(Status::Finished, t, y, stats, &window);
         }

@@ -30,6 +30,18 @@ pub trait Events {
     /// `falling`: change `y` in place (an impulse, a new mode) and say
     /// whether the run goes on.
     fn handle(&self, t: f64, y: &mut [f64], k: usize, falling: bool) -> EventFlow;
+    /// dg_k/dt at (t, y) into `out` for the functions whose rate is cheap
+    /// (0 for the others), and return true; or return false (the default).
+    /// With rates, a function that falls and rises again within one step
+    /// is searched for a dip below zero between the step's ends, which the
+    /// test at the ends alone cannot see.
+    fn rates(&self, _t: f64, _y: &[f64], _out: &mut [f64]) -> bool {
+        false
+    }
+    /// Put the initial state (t0, y) into a mode the system can start from
+    /// (e.g. link weights that start touching), before the first step; the
+    /// default leaves it as it is.
+    fn start(&self, _t: f64, _y: &mut [f64]) {}
 }
 
 /// Whether g went from one side of zero to the other (or onto it) between
@@ -37,6 +49,44 @@ pub trait Events {
 /// has not crossed.
 pub(crate) fn crossed(before: f64, after: f64) -> bool {
     (before > 0.0 && after <= 0.0) || (before < 0.0 && after >= 0.0)
+}
+
+/// Whether g, falling at the step's start (rate `r0` < 0) and rising at its
+/// end (`r1` > 0), may have dipped below zero in between: only when its
+/// ends are within twice the step's largest rate times the step length of
+/// zero (a dip below both ends is at most about that deep).
+pub(crate) fn may_dip(g: (f64, f64), r: (f64, f64), h: f64) -> bool {
+    r.0 < 0.0 && r.1 > 0.0 && g.0 > 0.0 && g.1 > 0.0 && g.0.min(g.1) <= 2.0 * h * r.0.abs().max(r.1)
+}
+
+/// Golden-section steps of the search for a dip: the bracket shrinks to
+/// 0.618⁴⁰ ≈ 4·10⁻⁹ of the step.
+const DIP_ITERATIONS: usize = 40;
+
+/// The lowest point (t, g) of g on [a, b], found by golden-section search
+/// (g is taken as having one minimum in the step, as a function that falls
+/// and then rises does).
+pub(crate) fn lowest(mut g: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> (f64, f64) {
+    let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    let mut x1 = b - ratio * (b - a);
+    let mut x2 = a + ratio * (b - a);
+    let (mut g1, mut g2) = (g(x1), g(x2));
+    for _ in 0..DIP_ITERATIONS {
+        if g1 <= g2 {
+            b = x2;
+            x2 = x1;
+            g2 = g1;
+            x1 = b - ratio * (b - a);
+            g1 = g(x1);
+        } else {
+            a = x1;
+            x1 = x2;
+            g1 = g2;
+            x2 = a + ratio * (b - a);
+            g2 = g(x2);
+        }
+    }
+    if g1 <= g2 { (x1, g1) } else { (x2, g2) }
 }
 
 /// Iterations of the root search at most: the Illinois method gains about
@@ -107,6 +157,18 @@ mod tests {
         let root = first_root(g, (0.0, -0.5), (2.0, g(2.0)));
         assert!(within(root, 0.5f64.powf(0.2)), "{root}");
         assert!(g(root) >= 0.0, "the far side of the crossing");
+    }
+
+    #[test]
+    fn a_dip_inside_a_step_is_found() {
+        // g = (t − 0.5)² − 0.01 dips below zero between ends at +0.24.
+        let g = |t: f64| (t - 0.5) * (t - 0.5) - 0.01;
+        assert!(may_dip((g(0.0), g(1.0)), (-1.0, 1.0), 1.0));
+        let (t, low) = lowest(g, 0.0, 1.0);
+        assert!((t - 0.5).abs() < 1e-6 && low < 0.0, "{t} {low}");
+        // Far from zero for its rates: no search.
+        assert!(!may_dip((5.0, 5.0), (-1.0, 1.0), 1.0));
+        assert!(!may_dip((0.1, 0.1), (1.0, 1.0), 1.0));
     }
 
     #[test]

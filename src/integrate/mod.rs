@@ -511,6 +511,18 @@ pub fn solve<S: OdeSystem + ?Sized, O: StepObserver + ?Sized>(
     if let Err(reason) = norm::validate(system.dim(), y0, t0, t_end, options) {
         return invalid(reason, t0, y0, Stats::default());
     }
+    // A hybrid system chooses its starting mode, and may move the state
+    // onto it (a projection of rounding size).
+    let started;
+    let y0 = match system.events() {
+        Some(events) => {
+            let mut y = y0.to_vec();
+            events.start(t0, &mut y);
+            started = y;
+            &started[..]
+        }
+        None => y0,
+    };
     observer.start(t0, y0);
     let deadline = options.max_wall.map(|d| std::time::Instant::now() + d);
     let first = drive_method(

@@ -16,10 +16,11 @@
 
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
+use super::rigid_contact::{self, Clustered, RigidContact};
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
-use crate::integrate::{CouplingStructure, HeadEquation, OdeSystem};
+use crate::integrate::{CouplingStructure, EventFlow, Events, HeadEquation, OdeSystem};
 use std::cell::RefCell;
 
 /// Why a scene cannot use the rotating frame.
@@ -58,6 +59,8 @@ pub struct RotatingSystem {
     trig: RefCell<Vec<(f64, f64)>>,
     effects: Vec<Box<dyn Effect>>,
     rotor_unbalance: (f64, f64),
+    /// Rigid contact between the weights, when the scene asks for it.
+    rigid: Option<RigidContact>,
 }
 
 impl RotatingSystem {
@@ -83,6 +86,11 @@ impl RotatingSystem {
         let effects = scene
             .effects
             .build(&super::effect::BuildSetup::plane(&cargo, omega));
+        let rigid = scene
+            .effects
+            .contact
+            .as_ref()
+            .and_then(|c| c.rigid(&cargo, omega));
         Ok(RotatingSystem {
             omega,
             m_total: r.mass + cargo.iter().map(|c| c.mass).sum::<f64>(),
@@ -96,6 +104,7 @@ impl RotatingSystem {
             cargo,
             effects,
             rotor_unbalance: (me, r.unbalance_angle),
+            rigid,
         })
     }
 
@@ -136,6 +145,10 @@ impl OdeSystem for RotatingSystem {
     }
 
     fn coupling_structure(&self, _t: f64, y: &[f64], out: &mut CouplingStructure) -> bool {
+        // A cluster couples all its members: dense Newton matrices.
+        if self.rigid.is_some() {
+            return false;
+        }
         let n = self.cargo.len();
         let psi = &y[2..2 + n];
         out.head = 2;
@@ -149,7 +162,7 @@ impl OdeSystem for RotatingSystem {
     }
 
     fn head_equation(&self, _t: f64, y: &[f64], f: &[f64], out: &mut HeadEquation) -> bool {
-        if self.effects.iter().any(|e| e.rotor_forces_from_weights()) {
+        if self.rigid.is_some() || self.effects.iter().any(|e| e.rotor_forces_from_weights()) {
             return false;
         }
         let n = self.cargo.len();
@@ -178,6 +191,67 @@ impl OdeSystem for RotatingSystem {
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        if let Some(rigid) = &self.rigid
+            && rigid.mode().any_linked()
+        {
+            return self.rhs_clustered(rigid, t, y, dydt);
+        }
+        let n = self.cargo.len();
+        let nq = 2 + n;
+        let ((gr, gi), (fr, fi)) = self.head_and_weight_forces(t, y, dydt);
+        let (mut gr, mut gi) = (gr, gi);
+        let w = self.omega;
+        let (psi, psi_rate) = (&y[2..nq], &y[nq + 2..]);
+        let cargo_f = &mut dydt[nq + 2..];
+        let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
+        let mut trig = self.trig.borrow_mut();
+        // Zipped slices: no bounds checks in the loop.
+        let per_cargo = psi.iter().zip(psi_rate).zip(cargo_f.iter_mut());
+        let constants = self.mass_track.iter().zip(&self.inv_inertia);
+        for (((&p, &p_rate), f), ((&ml, &inv), tr)) in per_cargo.zip(constants.zip(trig.iter_mut()))
+        {
+            let (s, co) = super::trig::sin_cos(p);
+            *tr = (s, co);
+            let rate = w + p_rate;
+            gr += ml * rate * rate * co;
+            gi += ml * rate * rate * s;
+            // Cargo row: I ψ̈ + (−ml s, ml co)·a = Q − ml Im[(fr + i fi) e^{−iψ}].
+            let q = *f - ml * (fi * co - fr * s);
+            *f = q;
+            let (wr, wi) = (-ml * s, ml * co);
+            a11 -= wr * wr * inv;
+            a12 -= wr * wi * inv;
+            a22 -= wi * wi * inv;
+            gr -= wr * q * inv;
+            gi -= wi * q * inv;
+        }
+        let det = a11 * a22 - a12 * a12;
+        let ar = (gr * a22 - gi * a12) / det;
+        let ai = (gi * a11 - gr * a12) / det;
+        let constants = self.mass_track.iter().zip(&self.inertia);
+        for ((f, &(s, co)), (&ml, &inertia)) in cargo_f.iter_mut().zip(trig.iter()).zip(constants) {
+            *f = (*f - ml * (co * ai - s * ar)) / inertia;
+        }
+        dydt[nq] = ar;
+        dydt[nq + 1] = ai;
+    }
+
+    fn events(&self) -> Option<&dyn Events> {
+        self.rigid.as_ref().map(|_| self as &dyn Events)
+    }
+}
+
+impl RotatingSystem {
+    /// Copy q̇ into dydt's first half, fill its weight slots with the
+    /// effects' forces on the weights, and return the head's right-hand side
+    /// G before the weights' terms and the frame acceleration 2iωẇ − ω²w
+    /// (see the module docs): what both eliminations start from.
+    fn head_and_weight_forces(
+        &self,
+        t: f64,
+        y: &[f64],
+        dydt: &mut [f64],
+    ) -> ((f64, f64), (f64, f64)) {
         let n = self.cargo.len();
         let nq = 2 + n;
         let (q, qd) = y.split_at(nq);
@@ -222,22 +296,77 @@ impl OdeSystem for RotatingSystem {
             gr += rotor_f[0];
             gi += rotor_f[1];
         }
-        let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
+        ((gr, gi), (fr, fi))
+    }
+
+    /// The right-hand side with weights linked by rigid contact: each
+    /// cluster's rows summed (the contact torques cancel) and eliminated as
+    /// one weight of inertia Σ I and reaction Σ w; every member gets the
+    /// cluster's acceleration, and the links' torques are recorded for the
+    /// events.
+    fn rhs_clustered(&self, rigid: &RigidContact, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let n = self.cargo.len();
+        let nq = 2 + n;
+        let ((mut gr, mut gi), (fr, fi)) = self.head_and_weight_forces(t, y, dydt);
+        let w = self.omega;
+        let (psi, psi_rate) = (&y[2..nq], &y[nq + 2..]);
+        let mut scratch = rigid.scratch();
+        let forces = &mut scratch.forces;
+        forces.resize(n, 0.0);
         let mut trig = self.trig.borrow_mut();
-        // Zipped slices: no bounds checks in the loop.
-        let per_cargo = psi.iter().zip(psi_rate).zip(cargo_f.iter_mut());
-        let constants = self.mass_track.iter().zip(&self.inv_inertia);
-        for (((&p, &p_rate), f), ((&ml, &inv), tr)) in per_cargo.zip(constants.zip(trig.iter_mut()))
-        {
-            let (s, co) = super::trig::sin_cos(p);
-            *tr = (s, co);
-            let rate = w + p_rate;
+        for j in 0..n {
+            let (s, co) = super::trig::sin_cos(psi[j]);
+            trig[j] = (s, co);
+            let ml = self.mass_track[j];
+            let rate = w + psi_rate[j];
             gr += ml * rate * rate * co;
             gi += ml * rate * rate * s;
-            // Cargo row: I ψ̈ + (−ml s, ml co)·a = Q − ml Im[(fr + i fi) e^{−iψ}].
-            let q = *f - ml * (fi * co - fr * s);
-            *f = q;
-            let (wr, wi) = (-ml * s, ml * co);
+            forces[j] = dydt[nq + 2 + j] - ml * (fi * co - fr * s);
+        }
+        let mut mode = rigid.mode();
+        let (ar, ai) = self.solve_clusters(
+            mode.clusters(),
+            &trig,
+            forces,
+            (gr, gi),
+            &mut dydt[nq + 2..],
+        );
+        dydt[nq] = ar;
+        dydt[nq + 1] = ai;
+        let accel = &dydt[nq + 2..];
+        mode.record_torques(&self.inertia, forces, accel, |j| {
+            let (s, co) = trig[j];
+            self.mass_track[j] * (co * ai - s * ar)
+        });
+    }
+
+    /// Solve M·(ü, v̈, ψ̈) = (g, forces) with the clusters moving as one:
+    /// writes each weight's ψ̈ into `accel` and returns (ü, v̈). `trig` holds
+    /// (sin ψ, cos ψ) of each weight.
+    fn solve_clusters(
+        &self,
+        clusters: &rigid_contact::Clusters,
+        trig: &[(f64, f64)],
+        forces: &[f64],
+        (mut gr, mut gi): (f64, f64),
+        accel: &mut [f64],
+    ) -> (f64, f64) {
+        let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
+        let sums = |c: usize| {
+            let (mut inertia, mut wr, mut wi, mut q) = (0.0, 0.0, 0.0, 0.0);
+            for &j in clusters.members(c) {
+                let (s, co) = trig[j];
+                let ml = self.mass_track[j];
+                inertia += self.inertia[j];
+                wr -= ml * s;
+                wi += ml * co;
+                q += forces[j];
+            }
+            (inertia, wr, wi, q)
+        };
+        for c in 0..clusters.len() {
+            let (inertia, wr, wi, q) = sums(c);
+            let inv = 1.0 / inertia;
             a11 -= wr * wr * inv;
             a12 -= wr * wi * inv;
             a22 -= wi * wi * inv;
@@ -247,11 +376,70 @@ impl OdeSystem for RotatingSystem {
         let det = a11 * a22 - a12 * a12;
         let ar = (gr * a22 - gi * a12) / det;
         let ai = (gi * a11 - gr * a12) / det;
-        let constants = self.mass_track.iter().zip(&self.inertia);
-        for ((f, &(s, co)), (&ml, &inertia)) in cargo_f.iter_mut().zip(trig.iter()).zip(constants) {
-            *f = (*f - ml * (co * ai - s * ar)) / inertia;
+        for c in 0..clusters.len() {
+            let (inertia, wr, wi, q) = sums(c);
+            let a = (q - (wr * ar + wi * ai)) / inertia;
+            for &j in clusters.members(c) {
+                accel[j] = a;
+            }
         }
-        dydt[nq] = ar;
-        dydt[nq + 1] = ai;
+        (ar, ai)
+    }
+}
+
+impl Clustered for RotatingSystem {
+    fn rigid(&self) -> &RigidContact {
+        self.rigid
+            .as_ref()
+            .expect("asked only of a system with rigid contact")
+    }
+
+    fn first_weight(&self) -> usize {
+        2
+    }
+
+    fn coordinates(&self) -> usize {
+        2 + self.cargo.len()
+    }
+
+    fn impulse_response(&self, _t: f64, y: &[f64], impulse: &[f64], response: &mut [f64]) {
+        let n = self.cargo.len();
+        let mut trig = self.trig.borrow_mut();
+        for (tr, &p) in trig.iter_mut().zip(&y[2..2 + n]) {
+            *tr = super::trig::sin_cos(p);
+        }
+        let mode = self.rigid().mode();
+        let (ar, ai) = self.solve_clusters(
+            mode.clusters(),
+            &trig,
+            impulse,
+            (0.0, 0.0),
+            &mut response[2..],
+        );
+        response[0] = ar;
+        response[1] = ai;
+    }
+}
+
+impl Events for RotatingSystem {
+    fn count(&self) -> usize {
+        self.rigid().count()
+    }
+
+    fn values(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        rigid_contact::values(self, t, y, out);
+    }
+
+    fn handle(&self, t: f64, y: &mut [f64], k: usize, falling: bool) -> EventFlow {
+        rigid_contact::handle(self, t, y, k, falling)
+    }
+
+    fn rates(&self, _t: f64, y: &[f64], out: &mut [f64]) -> bool {
+        rigid_contact::rates(self, y, out);
+        true
+    }
+
+    fn start(&self, t: f64, y: &mut [f64]) {
+        rigid_contact::start(self, t, y);
     }
 }

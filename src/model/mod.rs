@@ -29,6 +29,7 @@ pub mod invariants;
 pub mod linear;
 pub mod quasi_static;
 pub mod race_ring;
+pub mod rigid_contact;
 pub mod rotor;
 pub mod scene;
 pub mod sommerfeld;

@@ -15,6 +15,7 @@
 use super::{BuildSetup, Effect, EffectContext, EffectSpec, Forces};
 use crate::model::cargo::Cargo;
 use crate::model::race_ring::{MAX_RING, for_each_neighbour_pair};
+use crate::model::rigid_contact::RigidContact;
 use crate::model::validate::{SceneError, invalid};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -34,6 +35,39 @@ pub struct ContactSpec {
     /// Damping ratio of a contact.
     #[serde(default = "default_damping")]
     pub damping_ratio: f64,
+    /// How contact is modelled: `penalty` (a stiff spring and damper
+    /// between overlapping weights, the default) or `rigid` (weights that
+    /// touch move as one until the force between them would pull; no
+    /// overlap and no stiffness; the rotating frame only).
+    #[serde(default)]
+    pub model: ContactModel,
+    /// Rigid contact: the ratio of parting to closing speed in an impact,
+    /// 0 (a dead impact in oil, the default) to below 1. Unused by `penalty`,
+    /// whose `damping_ratio` sets the rebound.
+    #[serde(default)]
+    pub restitution: f64,
+}
+
+/// How contact between weights is modelled.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactModel {
+    /// A stiff, damped spring between overlapping weights (never pulling).
+    #[default]
+    Penalty,
+    /// Touching weights move as one cluster; impacts and partings are
+    /// located as events ([`crate::model::rigid_contact`]).
+    Rigid,
+}
+
+impl ContactModel {
+    /// The name files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactModel::Penalty => "penalty",
+            ContactModel::Rigid => "rigid",
+        }
+    }
 }
 
 fn enabled_by_default() -> bool {
@@ -58,6 +92,8 @@ impl Default for ContactSpec {
             enabled: true,
             frequency_ratio: default_ratio(),
             damping_ratio: default_damping(),
+            model: ContactModel::Penalty,
+            restitution: 0.0,
         }
     }
 }
@@ -81,11 +117,31 @@ impl EffectSpec for ContactSpec {
                 "a damping ratio from 0 to 1000 (default 2: a dead impact)",
             ));
         }
+        if !(0.0..1.0).contains(&self.restitution) {
+            return Err(invalid(
+                &format!("{key}.restitution"),
+                self.restitution,
+                "parting over closing speed in an impact: 0 (a dead impact, the default) up to below 1",
+            ));
+        }
         Ok(())
     }
 
     fn build(&self, setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>> {
+        // Rigid contact is no force: the system holds it as constraints.
+        if self.model == ContactModel::Rigid {
+            return None;
+        }
         Contact::new(self, setup.cargo, setup.omega).map(|c| Box::new(c) as Box<dyn Effect>)
+    }
+}
+
+impl ContactSpec {
+    /// The rigid contact of these cargoes, when the file asks for it and a
+    /// weight has a size; `omega` sets the scale of its force tolerance.
+    pub fn rigid(&self, cargo: &[Cargo], omega: f64) -> Option<RigidContact> {
+        (self.enabled && self.model == ContactModel::Rigid && cargo.iter().any(|c| c.radius > 0.0))
+            .then(|| RigidContact::new(cargo, omega, self.restitution))
     }
 }
 

@@ -1,0 +1,277 @@
+//! What happens at rigid contact's events: the start's links, impacts,
+//! partings, and the loop that opens every link that would pull. The
+//! systems supply their equations through [`Clustered`]; the logic is the
+//! same in every frame.
+
+use super::{GAP_OFFSET, RigidContact, TOUCHING_AT_START};
+use crate::integrate::{EventFlow, OdeSystem};
+
+/// A system whose weights may be held in clusters by rigid contact.
+pub trait Clustered: OdeSystem {
+    /// Its rigid contact.
+    fn rigid(&self) -> &RigidContact;
+    /// Index of the first weight's angle ψ_0 in q.
+    fn first_weight(&self) -> usize;
+    /// Number of generalised coordinates (q̇ starts there in the state).
+    fn coordinates(&self) -> usize;
+    /// The velocity change of every coordinate, `response` (length
+    /// [`Clustered::coordinates`]), that the generalised impulse `impulse`
+    /// on the weights (one per weight) makes at state y: M⁻¹ times it, with
+    /// the current clusters moving as one.
+    fn impulse_response(&self, t: f64, y: &[f64], impulse: &[f64], response: &mut [f64]);
+}
+
+/// Choose the starting mode: link every pair that starts touching and not
+/// parting (a clustered start), as a dead impact, then open every link that
+/// would pull.
+pub fn start<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64]) {
+    let rc = system.rigid();
+    let (first, nq) = (system.first_weight(), system.coordinates());
+    let n = rc.half_angle.len();
+    rc.arrange(&y[first..first + n]);
+    {
+        let mut s = rc.scratch();
+        s.dydt.resize(y.len(), 0.0);
+        s.forces.resize(n, 0.0);
+        s.impulse.resize(n, 0.0);
+        s.response.resize(nq, 0.0);
+    }
+    resolve(system, t, y, TOUCHING_AT_START);
+}
+
+/// g_k(t, y) for every pair: an open pair's gap past [`GAP_OFFSET`], a
+/// linked pair's torque past −λ_tol.
+pub fn values<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64], out: &mut [f64]) {
+    let rc = system.rigid();
+    if rc.mode.borrow().any_linked() {
+        refresh_torques(system, t, y);
+    }
+    let first = system.first_weight();
+    let psi = &y[first..first + rc.half_angle.len()];
+    let mode = rc.mode.borrow();
+    for (k, g) in out.iter_mut().enumerate() {
+        *g = if mode.linked[k] {
+            mode.torque[k] + rc.pull_tolerance
+        } else {
+            rc.gap(mode.pairs[k], psi) + GAP_OFFSET
+        };
+    }
+}
+
+/// dg_k/dt for the open pairs (the closing rate, from the state alone); 0
+/// for links, whose torque's rate would cost a derivative of the forces.
+pub fn rates<S: Clustered + ?Sized>(system: &S, y: &[f64], out: &mut [f64]) {
+    let rc = system.rigid();
+    let (first, nq) = (system.first_weight(), system.coordinates());
+    let mode = rc.mode.borrow();
+    for (k, r) in out.iter_mut().enumerate() {
+        let (behind, ahead) = mode.pairs[k];
+        *r = if mode.linked[k] {
+            0.0
+        } else {
+            y[nq + first + ahead] - y[nq + first + behind]
+        };
+    }
+}
+
+/// Pair `k`'s function reached zero at (t, y): a link parts, or an open
+/// pair meets in an impact. A gap growing through its zero (a pair that
+/// touched without closing) changes nothing.
+pub fn handle<S: Clustered + ?Sized>(
+    system: &S,
+    t: f64,
+    y: &mut [f64],
+    k: usize,
+    falling: bool,
+) -> EventFlow {
+    let rc = system.rigid();
+    let linked = rc.mode.borrow().linked[k];
+    if linked && falling {
+        unlink(rc, k);
+    }
+    // A gap growing through its zero (a pair that touched without closing)
+    // changes nothing; `resolve` finds every pair that meets.
+    resolve(system, t, y, -GAP_OFFSET);
+    EventFlow::Continue
+}
+
+/// Most rounds of impacts and partings at one instant: each round makes
+/// the touching pairs stop closing and opens every pulling link; a few
+/// suffice for any cluster seen (a cascade runs along a ring once).
+const MAX_ROUNDS: usize = 64;
+
+/// Settle the mode at (t, y): every open pair within `touching` (rad) of
+/// touching and closing meets in an impact (several may meet at once, or
+/// one impact drive the next pair together), and every link that would
+/// pull opens, until neither happens.
+fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f64) {
+    let rc = system.rigid();
+    let (first, nq) = (system.first_weight(), system.coordinates());
+    let n = rc.half_angle.len();
+    for _ in 0..MAX_ROUNDS {
+        let mut changed = false;
+        let count = rc.mode.borrow().pairs.len();
+        for k in 0..count {
+            let (behind, ahead, linked) = {
+                let mode = rc.mode.borrow();
+                (mode.pairs[k].0, mode.pairs[k].1, mode.linked[k])
+            };
+            if linked || rc.gap((behind, ahead), &y[first..first + n]) > touching {
+                continue;
+            }
+            let closing = y[nq + first + ahead] - y[nq + first + behind];
+            if closing >= 0.0 {
+                continue;
+            }
+            let e = if -closing < rc.sticking_speed {
+                0.0
+            } else {
+                rc.restitution
+            };
+            impact(system, t, y, k, e);
+            changed = true;
+        }
+        changed |= open_pulling_links(system, t, y);
+        if !changed {
+            return;
+        }
+    }
+}
+
+/// Evaluate the right-hand side at (t, y) for its side effect: the mode's
+/// torques.
+fn refresh_torques<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64]) {
+    let rc = system.rigid();
+    let mut dydt = std::mem::take(&mut rc.scratch().dydt);
+    dydt.resize(y.len(), 0.0);
+    system.rhs(t, y, &mut dydt);
+    rc.scratch().dydt = dydt;
+}
+
+/// Open pair `k` (behind A, ahead B) meets: the impulse along the pair that
+/// leaves it parting at `e` times its closing speed, through the whole mass
+/// matrix (rotor and other clusters included, as momentum requires). A dead
+/// impact (e = 0) links the pair, moves B onto touching and gives the merged
+/// cluster one velocity.
+fn impact<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], k: usize, e: f64) {
+    let rc = system.rigid();
+    let (first, nq) = (system.first_weight(), system.coordinates());
+    let n = rc.half_angle.len();
+    let (behind, ahead) = rc.mode.borrow().pairs[k];
+    let mut scratch = rc.scratch();
+    let scratch = &mut *scratch;
+    scratch.impulse.iter_mut().for_each(|p| *p = 0.0);
+    scratch.impulse[ahead] = 1.0;
+    scratch.impulse[behind] = -1.0;
+    system.impulse_response(t, y, &scratch.impulse, &mut scratch.response);
+    let (qd, rate_of) = (nq, |y: &[f64], j: usize| y[nq + first + j]);
+    let closing = rate_of(y, ahead) - rate_of(y, behind);
+    let per_unit = scratch.response[first + ahead] - scratch.response[first + behind];
+    if closing < 0.0 && per_unit > 0.0 {
+        let size = -(1.0 + e) * closing / per_unit;
+        for (v, dv) in y[qd..qd + nq].iter_mut().zip(&scratch.response) {
+            *v += size * dv;
+        }
+    }
+    let mut mode = rc.mode.borrow_mut();
+    let mode = &mut *mode;
+    // B's members move forward by the overlap onto touching (a rebound
+    // then starts its gap function above its zero, not on it).
+    let overlap = -rc.gap((behind, ahead), &y[first..first + n]);
+    let b = (0..mode.clusters.len())
+        .find(|&c| mode.clusters.members(c).contains(&ahead))
+        .expect("every weight is in a cluster");
+    for &j in mode.clusters.members(b) {
+        y[first + j] += overlap;
+    }
+    if e > 0.0 {
+        return;
+    }
+    // A ring all of whose pairs are linked would have no place to start
+    // its clusters: weights that fill the race keep one pair open.
+    let ring = mode.ring_pairs.partition_point(|&p| p <= k) - 1;
+    let ring_first = mode.ring_pairs[ring];
+    let ring_len = mode.rings[ring].len();
+    let open_elsewhere = (ring_first..ring_first + ring_len).any(|p| p != k && !mode.linked[p]);
+    if !open_elsewhere {
+        return;
+    }
+    mode.linked[k] = true;
+    mode.rebuild(n);
+    // One velocity for the merged cluster: the impulse left its members
+    // equal to rounding; the inertia-weighted mean keeps its momentum.
+    let c = (0..mode.clusters.len())
+        .find(|&c| mode.clusters.members(c).contains(&ahead))
+        .expect("every weight is in a cluster");
+    let inertia = |j: usize| rc.inertia[j];
+    let members = mode.clusters.members(c);
+    let total: f64 = members.iter().map(|&j| inertia(j)).sum();
+    let moment: f64 = members.iter().map(|&j| inertia(j) * rate_of(y, j)).sum();
+    let common = moment / total;
+    for &j in members {
+        y[nq + first + j] = common;
+    }
+}
+
+/// Open link `k`.
+fn unlink(rc: &RigidContact, k: usize) {
+    let n = rc.half_angle.len();
+    let mut mode = rc.mode.borrow_mut();
+    mode.linked[k] = false;
+    mode.torque[k] = 0.0;
+    mode.rebuild(n);
+}
+
+/// Open the link that pulls hardest, again and again, until every link
+/// presses (or pulls less than the tolerance); whether one opened. Ends:
+/// links only vanish.
+fn open_pulling_links<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64]) -> bool {
+    let rc = system.rigid();
+    let mut opened = false;
+    loop {
+        if !rc.mode.borrow().any_linked() {
+            return opened;
+        }
+        refresh_torques(system, t, y);
+        let worst = {
+            let mode = rc.mode.borrow();
+            (0..mode.pairs.len())
+                .filter(|&k| mode.linked[k])
+                .min_by(|&a, &b| mode.torque[a].total_cmp(&mode.torque[b]))
+        };
+        match worst {
+            Some(k) if rc.mode.borrow().torque[k] <= -rc.pull_tolerance => {
+                unlink(rc, k);
+                opened = true;
+            }
+            _ => return opened,
+        }
+    }
+}
+
+/// Whether the current mode holds at (t, y) with room to spare: every open
+/// pair more than `margin` (rad) apart and every link pressing by more than
+/// `press` times the parting tolerance. A stretch of the run on which it
+/// holds is smooth: no event can fall in it.
+pub fn mode_holds<S: Clustered + ?Sized>(
+    system: &S,
+    t: f64,
+    y: &[f64],
+    margin: f64,
+    press: f64,
+) -> bool {
+    let rc = system.rigid();
+    if rc.mode.borrow().any_linked() {
+        refresh_torques(system, t, y);
+    }
+    let first = system.first_weight();
+    let psi = &y[first..first + rc.half_angle.len()];
+    let mode = rc.mode.borrow();
+    (0..mode.pairs.len()).all(|k| {
+        if mode.linked[k] {
+            mode.torque[k] > press * rc.pull_tolerance
+        } else {
+            rc.gap(mode.pairs[k], psi) > margin
+        }
+    })
+}

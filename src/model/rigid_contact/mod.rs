@@ -1,0 +1,345 @@
+//! Rigid contact between weights (`[effects.contact] model = "rigid"`).
+//!
+//! Weights that touch move as one cluster under a constraint, part when the
+//! torque between them would pull, and meet in impacts: dead (the default,
+//! balls in oil) or with a stated restitution. No contact stiffness is left,
+//! so the explicit method keeps its steps through a touch; the price is an
+//! event at every impact and parting, located on the integrator's dense
+//! output ([`crate::integrate::events`]).
+//!
+//! The sized weights of a plane form a ring in race order, fixed for the run
+//! (solid weights cannot pass each other). Between each weight and the next
+//! along its ring sits a pair, open or linked:
+//! - an open pair's event function is its gap: at zero the two meet;
+//! - a linked pair's is its contact torque λ (positive pressing): below
+//!   −λ_tol the two part (the tolerance is hysteresis against rounding).
+//!
+//! Maximal runs of linked pairs are clusters. A system sums its members'
+//! rows (the λ cancel), eliminates clusters instead of weights in its
+//! arrowhead mass matrix, and gives every member the cluster's
+//! acceleration; λ then follows from the members' own rows
+//! ([`Mode::record_torques`]). Linked members share bit-identical
+//! velocities, so their gaps stay put to rounding.
+
+mod events;
+
+pub use events::{Clustered, handle, mode_holds, rates, start, values};
+
+use super::cargo::Cargo;
+use super::race_ring::for_each_ring;
+use std::cell::{RefCell, RefMut};
+use std::f64::consts::TAU;
+
+/// λ_tol over the largest weight's I ω²: a parting needs a pull this far
+/// past zero, well above the rounding of the torques (about 1e-16 of them)
+/// and far below any torque the motion is made of.
+const PULL_TOLERANCE: f64 = 1e-9;
+/// Closing speeds below this fraction of ω end in a dead impact whatever the
+/// restitution: rebounds that small would only chatter (a Zeno sequence).
+const STICKING_SPEED: f64 = 1e-6;
+/// An open pair's event fires this far (rad) past touching: the pair then
+/// links and its gap is moved to zero, so that a later parting starts its
+/// gap function this far above its zero rather than on it.
+pub const GAP_OFFSET: f64 = 1e-12;
+/// Pairs within this gap (rad) at the start touch: clustered starts are
+/// computed at 2α in floating point.
+const TOUCHING_AT_START: f64 = 1e-10;
+/// A forward angle along the ring is taken in [−this, 2π − this): overlaps
+/// up to it stay overlaps instead of wrapping to nearly a turn.
+const WRAP_BACK: f64 = 0.5;
+
+/// The rigid contact of one system's weights: geometry, tolerances and the
+/// run's current mode.
+#[derive(Debug)]
+pub struct RigidContact {
+    /// α_j = asin(r/l) of each weight (0: no size, never touches).
+    half_angle: Vec<f64>,
+    /// Plane of each weight.
+    plane: Vec<usize>,
+    /// κ m l² of each weight: a merged cluster's velocity is their
+    /// inertia-weighted mean.
+    inertia: Vec<f64>,
+    /// Parting over closing speed in an impact.
+    restitution: f64,
+    /// λ below −this parts a link (N·m).
+    pull_tolerance: f64,
+    /// Closing speeds below this stick (rad/s).
+    sticking_speed: f64,
+    /// Which pairs are linked, the clusters and the latest torques. A
+    /// `RefCell` because the integrator sees the system through `&self`;
+    /// only events change it, the right-hand side writes λ.
+    mode: RefCell<Mode>,
+    /// Scratch for a right-hand side evaluated to learn λ, and for the
+    /// weights' forces the torques are computed from (no allocation per call).
+    scratch: RefCell<Scratch>,
+}
+
+/// Buffers of [`RigidContact`] reused from call to call.
+#[derive(Debug, Default)]
+pub struct Scratch {
+    /// A derivative the events ask for.
+    pub dydt: Vec<f64>,
+    /// Each weight's generalised force before the constraint (N·m).
+    pub forces: Vec<f64>,
+    /// A generalised impulse on each weight, and the velocity change it makes.
+    pub impulse: Vec<f64>,
+    /// Velocity change of every coordinate.
+    pub response: Vec<f64>,
+}
+
+/// Which pairs are linked, and what follows from it.
+#[derive(Debug, Clone, Default)]
+pub struct Mode {
+    /// (behind, ahead) of every pair, ring after ring; `ahead` is the next
+    /// weight along the race in the direction of growing angle.
+    pairs: Vec<(usize, usize)>,
+    /// Weights of each ring, in race order.
+    rings: Vec<Vec<usize>>,
+    /// Index of each ring's first pair.
+    ring_pairs: Vec<usize>,
+    /// Whether each pair is linked.
+    linked: Vec<bool>,
+    /// Contact torque of each linked pair from the latest right-hand side
+    /// (N·m, positive pressing); 0 for open pairs.
+    torque: Vec<f64>,
+    /// The clusters of the current links.
+    clusters: Clusters,
+}
+
+/// Maximal linked runs of weights (a weight alone is a cluster of one).
+#[derive(Debug, Clone, Default)]
+pub struct Clusters {
+    /// Weights cluster after cluster, each cluster in race order.
+    members: Vec<usize>,
+    /// One past each cluster's last entry in `members`.
+    ends: Vec<usize>,
+    /// The pair linking `members[i]` to `members[i + 1]` in one cluster
+    /// (`usize::MAX` after a cluster's last member).
+    link_after: Vec<usize>,
+}
+
+impl Clusters {
+    /// Number of clusters.
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// True when there is no weight.
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+
+    /// The weights of cluster `c`, in race order.
+    pub fn members(&self, c: usize) -> &[usize] {
+        let start = if c == 0 { 0 } else { self.ends[c - 1] };
+        &self.members[start..self.ends[c]]
+    }
+
+    /// The links of cluster `c`: entry i joins member i to member i + 1.
+    pub fn links(&self, c: usize) -> &[usize] {
+        let start = if c == 0 { 0 } else { self.ends[c - 1] };
+        &self.link_after[start..self.ends[c] - 1]
+    }
+}
+
+impl Mode {
+    /// The clusters of the current links.
+    pub fn clusters(&self) -> &Clusters {
+        &self.clusters
+    }
+
+    /// Whether any pair is linked (otherwise every weight moves alone).
+    pub fn any_linked(&self) -> bool {
+        self.linked.iter().any(|&l| l)
+    }
+
+    /// Store the contact torques of every cluster's links from its members'
+    /// forces `forces` (before the constraint), accelerations `accel` and
+    /// the part of their rows each owes the head, `head_part(j)` = w_j·z
+    /// (plus any other known term): λ after member i is the sum over members
+    /// up to i of Q − I a − head_part.
+    pub fn record_torques(
+        &mut self,
+        inertia: &[f64],
+        forces: &[f64],
+        accel: &[f64],
+        head_part: impl Fn(usize) -> f64,
+    ) {
+        for c in 0..self.clusters.len() {
+            let start = if c == 0 { 0 } else { self.clusters.ends[c - 1] };
+            let end = self.clusters.ends[c];
+            let mut carried = 0.0;
+            for i in start..end - 1 {
+                let j = self.clusters.members[i];
+                carried += forces[j] - inertia[j] * accel[j] - head_part(j);
+                self.torque[self.clusters.link_after[i]] = carried;
+            }
+        }
+    }
+
+    /// Rebuild the clusters from the links (after an event).
+    fn rebuild(&mut self, weights: usize) {
+        let c = &mut self.clusters;
+        c.members.clear();
+        c.ends.clear();
+        c.link_after.clear();
+        let mut in_ring = vec![false; weights];
+        for (r, ring) in self.rings.iter().enumerate() {
+            let m = ring.len();
+            for &j in ring {
+                in_ring[j] = true;
+            }
+            let first_pair = self.ring_pairs[r];
+            let pairs = if m >= 2 { m } else { 0 };
+            // Start after an open pair, so that no cluster wraps past the
+            // ring's start (a fully linked ring is never made).
+            let open = (0..pairs).find(|&i| !self.linked[first_pair + i]);
+            let begin = open.map_or(0, |i| (i + 1) % m.max(1));
+            for step in 0..m {
+                let pos = (begin + step) % m;
+                c.members.push(ring[pos]);
+                let link = first_pair + pos;
+                if pairs > 0 && step + 1 < m && self.linked[link] {
+                    c.link_after.push(link);
+                } else {
+                    c.link_after.push(usize::MAX);
+                    c.ends.push(c.members.len());
+                }
+            }
+        }
+        for (j, inside) in in_ring.iter().enumerate() {
+            if !inside {
+                c.members.push(j);
+                c.link_after.push(usize::MAX);
+                c.ends.push(c.members.len());
+            }
+        }
+    }
+}
+
+impl RigidContact {
+    /// The rigid contact of these weights at nominal speed `omega`.
+    pub fn new(cargo: &[Cargo], omega: f64, restitution: f64) -> Self {
+        let largest = cargo.iter().map(Cargo::inertia).fold(0.0, f64::max);
+        RigidContact {
+            half_angle: cargo.iter().map(Cargo::contact_half_angle).collect(),
+            plane: cargo.iter().map(|c| c.plane).collect(),
+            inertia: cargo.iter().map(Cargo::inertia).collect(),
+            restitution,
+            pull_tolerance: PULL_TOLERANCE * largest * omega * omega,
+            sticking_speed: STICKING_SPEED * omega,
+            mode: RefCell::new(Mode::default()),
+            scratch: RefCell::new(Scratch::default()),
+        }
+    }
+
+    /// The run's current mode (the right-hand side reads the clusters and
+    /// writes the torques).
+    pub fn mode(&self) -> RefMut<'_, Mode> {
+        self.mode.borrow_mut()
+    }
+
+    /// The buffers the systems fill for the events.
+    pub fn scratch(&self) -> RefMut<'_, Scratch> {
+        self.scratch.borrow_mut()
+    }
+
+    /// Number of event functions: one per pair (known once the run has started).
+    pub fn count(&self) -> usize {
+        self.mode.borrow().pairs.len()
+    }
+
+    /// The gap (rad) of pair (behind, ahead) at angles `psi`: their centre
+    /// angle along the race less the touching angle α_b + α_a.
+    pub fn gap(&self, (behind, ahead): (usize, usize), psi: &[f64]) -> f64 {
+        let forward = (psi[ahead] - psi[behind] + WRAP_BACK).rem_euclid(TAU) - WRAP_BACK;
+        forward - self.half_angle[behind] - self.half_angle[ahead]
+    }
+
+    /// Find the rings and pairs at angles `psi`, every pair open.
+    fn arrange(&self, psi: &[f64]) {
+        let n = psi.len();
+        let mut mode = self.mode.borrow_mut();
+        let mode = &mut *mode;
+        mode.rings.clear();
+        mode.pairs.clear();
+        mode.ring_pairs.clear();
+        for_each_ring(
+            n,
+            |j| self.plane[j],
+            |j| self.half_angle[j] > 0.0,
+            |j| psi[j],
+            |ring| {
+                if ring.is_empty() {
+                    return;
+                }
+                mode.ring_pairs.push(mode.pairs.len());
+                let m = ring.len();
+                if m >= 2 {
+                    for i in 0..m {
+                        mode.pairs
+                            .push((ring[i] as usize, ring[(i + 1) % m] as usize));
+                    }
+                }
+                mode.rings.push(ring.iter().map(|&j| j as usize).collect());
+            },
+        );
+        mode.linked = vec![false; mode.pairs.len()];
+        mode.torque = vec![0.0; mode.pairs.len()];
+        mode.rebuild(n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ball(plane: usize) -> Cargo {
+        Cargo {
+            radius: 0.01,
+            plane,
+            ..Cargo::point(0.05, 0.1, 0.0, 1.4)
+        }
+    }
+
+    #[test]
+    fn clusters_are_the_linked_runs_of_each_ring() {
+        let cargo = vec![
+            ball(0),
+            ball(0),
+            ball(0),
+            ball(0),
+            Cargo::point(0.1, 0.1, 0.0, 1.0),
+        ];
+        let rc = RigidContact::new(&cargo, 100.0, 0.0);
+        // Race order 2, 0, 3, 1 (by angle); weight 4 has no size.
+        rc.arrange(&[1.0, 3.0, 0.5, 2.0, 0.0]);
+        let mut mode = rc.mode();
+        assert_eq!(mode.rings, vec![vec![2, 0, 3, 1]]);
+        assert_eq!(mode.pairs, vec![(2, 0), (0, 3), (3, 1), (1, 2)]);
+        // Link 1→2 across the ring's start, and 0→3.
+        mode.linked[3] = true;
+        mode.linked[1] = true;
+        mode.rebuild(5);
+        let c = mode.clusters().clone();
+        let all: Vec<Vec<usize>> = (0..c.len()).map(|i| c.members(i).to_vec()).collect();
+        assert_eq!(all, vec![vec![0, 3], vec![1, 2], vec![4]]);
+        assert_eq!(c.links(0), &[1]);
+        assert_eq!(c.links(1), &[3]);
+        assert!(c.links(2).is_empty());
+    }
+
+    #[test]
+    fn a_gap_is_the_forward_angle_less_the_touching_angle() {
+        let cargo = vec![ball(0), ball(0)];
+        let rc = RigidContact::new(&cargo, 100.0, 0.0);
+        let two_alpha = 2.0 * cargo[0].contact_half_angle();
+        let psi = [6.2, 6.2 + two_alpha + 0.01];
+        assert!((rc.gap((0, 1), &psi) - 0.01).abs() < 1e-12);
+        // The other side of a ring of two is the rest of the turn.
+        assert!((rc.gap((1, 0), &psi) - (TAU - 2.0 * two_alpha - 0.01)).abs() < 1e-12);
+        // A slight overlap stays an overlap.
+        let psi = [0.0, two_alpha - 1e-9];
+        assert!((rc.gap((0, 1), &psi) + 1e-9).abs() < 1e-15);
+    }
+}
