@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue 31's peer design (bench/lean/peer.toml) against the lean reference:
 # runs/s per core and RHS calls per run of `study run --threads 1` with
-# contact on (as shipped) and off, and of the lean program (a careful DP5
+# contact on (as shipped: the penalty model), on as rigid contact, and
+# off, and of the lean program (a careful DP5
 # of this one design, full hold, contact off like the issue's peer) on the
 # same runs. Rounds alternate which side goes first; per run the fastest
 # round counts on each side (runs/s per core = runs / Σ per-run times).
@@ -32,18 +33,20 @@ study=${CARGO_TARGET_DIR:-$root/target}/$profile/study
 out=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/autobal-peer.XXXXXX")}
 mkdir -p "$out"
 echo "results: $out   (autobal $profile build; load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown))" >&2
-for contact in on off; do
+for contact in on rigid off; do
     enabled=true
     [ "$contact" = off ] && enabled=false
+    model=penalty
+    [ "$contact" = rigid ] && model=rigid
     sed -e "s/^samples = [0-9]*/samples = $samples/" \
-        -e "s/^enabled = .*/enabled = $enabled/" \
+        -e "s/^enabled = .*/enabled = $enabled\nmodel = \"$model\"/" \
         -e "s|^seed = \(.*\)\$|seed = \1\noutput = \"$out/study\"|" \
         "$here/peer.toml" >"$out/peer_$contact.toml"
 done
 "$study" bench --lean-inputs "$out/runs.csv" --lean-study "$out/peer_off.toml" --samples "$samples"
 
 run_autobal() {
-    for contact in on off; do
+    for contact in on rigid off; do
         "$study" run "$out/peer_$contact.toml" --threads 1 --quiet --overwrite >/dev/null
         cp "$out/study/peer_$contact/runs.parquet" "$out/autobal-$contact-$1.parquet"
     done
@@ -82,9 +85,9 @@ lt, lc = lean()
 lean_rate = len(lt) / sum(lt.values())
 print(f"{'path':<40} {'runs':>5} {'runs/s per core':>16} {'vs lean':>8} {'RHS calls per run':>18}")
 print(f"{'lean DP5, contact off, full hold':<40} {len(lt):>5} {lean_rate:>16.0f} {1.0:>8.2f} {sum(lc.values()) / len(lc):>18.0f}")
-for contact in ("on", "off"):
+for contact, label in (("on", "on (penalty)"), ("rigid", "on (rigid)"), ("off", "off")):
     t, c = autobal(contact)
     rate = len(t) / sum(t.values())
-    print(f"{'study run --threads 1, contact ' + contact:<40} {len(t):>5} {rate:>16.0f} {rate / lean_rate:>8.2f} {sum(c.values()) / len(c):>18.0f}")
+    print(f"{'study run --threads 1, contact ' + label:<40} {len(t):>5} {rate:>16.0f} {rate / lean_rate:>8.2f} {sum(c.values()) / len(c):>18.0f}")
 PY
 echo "(load average after: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown))"

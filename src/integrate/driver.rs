@@ -65,11 +65,7 @@ where
     // The events' values at the current point, a step's end, and scratch.
     let events = system.events();
     let n_events = events.map_or(0, |e| e.count());
-    let (mut g_now, mut g_end, mut g_probe) = (
-        vec![0.0; n_events],
-        vec![0.0; n_events],
-        vec![0.0; n_events],
-    );
+    let (mut g_now, mut g_end) = (vec![0.0; n_events], vec![0.0; n_events]);
     let mut probe = vec![0.0; if n_events > 0 { y.len() } else { 0 }];
     // Their rates at the current point and a step's end, where cheap.
     let (mut r_now, mut r_end) = (vec![0.0; n_events], vec![0.0; n_events]);
@@ -135,8 +131,7 @@ where
                 let dense = stepper.dense();
                 let mut g_at = |s: f64| {
                     dense.eval(s, &mut probe);
-                    ev.values(s, &probe, &mut g_probe);
-                    g_probe[k]
+                    ev.value(k, s, &probe)
                 };
                 // The far end of the bracket: the step's end, or the bottom
                 // of a dip below zero inside it.

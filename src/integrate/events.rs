@@ -26,6 +26,14 @@ pub trait Events {
     fn count(&self) -> usize;
     /// g_k(t, y) for every k into `out` (length [`Events::count`]).
     fn values(&self, t: f64, y: &[f64], out: &mut [f64]);
+    /// g_k(t, y) alone: what the search for a crossing evaluates, so a
+    /// system whose functions differ in cost (a gap against a force) pays
+    /// for the one sought. The default evaluates them all.
+    fn value(&self, k: usize, t: f64, y: &[f64]) -> f64 {
+        let mut g = vec![0.0; self.count()];
+        self.values(t, y, &mut g);
+        g[k]
+    }
     /// Function `k` reached zero at (t, y), falling (from positive) when
     /// `falling`: change `y` in place (an impulse, a new mode) and say
     /// whether the run goes on.
@@ -37,6 +45,20 @@ pub trait Events {
     /// test at the ends alone cannot see.
     fn rates(&self, _t: f64, _y: &[f64], _out: &mut [f64]) -> bool {
         false
+    }
+    /// Whether (t, y) lies inside the current mode with room to spare, so
+    /// that a smooth flow from it can be trusted for a while (e.g. by a
+    /// linearisation). The default: no event function at its zero.
+    fn clear(&self, t: f64, y: &[f64]) -> bool {
+        let mut g = vec![0.0; self.count()];
+        self.values(t, y, &mut g);
+        g.iter().all(|&g| g != 0.0)
+    }
+    /// Right-hand sides the events have evaluated so far (e.g. for a force
+    /// their functions read), beyond the integrator's own: a run's cost
+    /// counts them. The default: none.
+    fn rhs_calls(&self) -> u64 {
+        0
     }
     /// Put the initial state (t0, y) into a mode the system can start from
     /// (e.g. link weights that start touching), before the first step; the

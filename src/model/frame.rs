@@ -61,6 +61,9 @@ pub struct RotatingSystem {
     rotor_unbalance: (f64, f64),
     /// Rigid contact between the weights, when the scene asks for it.
     rigid: Option<RigidContact>,
+    /// (1/I, w, Q) of each cluster in a clustered right-hand side (a field,
+    /// not a local, so that a call allocates nothing).
+    cluster_sums: RefCell<Vec<[f64; 4]>>,
 }
 
 impl RotatingSystem {
@@ -78,6 +81,7 @@ impl RotatingSystem {
             unreachable!("checked above")
         };
         let cargo = scene.cargoes()?;
+        let cargo_count = cargo.len();
         let Ok(r) = scene.rotor.as_rotor().isotropic_plane() else {
             unreachable!("checked above")
         };
@@ -105,6 +109,7 @@ impl RotatingSystem {
             effects,
             rotor_unbalance: (me, r.unbalance_angle),
             rigid,
+            cluster_sums: RefCell::new(Vec::with_capacity(cargo_count)),
         })
     }
 
@@ -246,6 +251,7 @@ impl RotatingSystem {
     /// effects' forces on the weights, and return the head's right-hand side
     /// G before the weights' terms and the frame acceleration 2iωẇ − ω²w
     /// (see the module docs): what both eliminations start from.
+    #[inline]
     fn head_and_weight_forces(
         &self,
         t: f64,
@@ -338,6 +344,7 @@ impl RotatingSystem {
             let (s, co) = trig[j];
             self.mass_track[j] * (co * ai - s * ar)
         });
+        mode.recorded_at(t, y);
     }
 
     /// Solve M·(ü, v̈, ψ̈) = (g, forces) with the clusters moving as one:
@@ -352,7 +359,10 @@ impl RotatingSystem {
         accel: &mut [f64],
     ) -> (f64, f64) {
         let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
-        let sums = |c: usize| {
+        // Each cluster's (1/I, w, Q) once: the sums serve both passes.
+        let mut sums = self.cluster_sums.borrow_mut();
+        sums.clear();
+        for c in 0..clusters.len() {
             let (mut inertia, mut wr, mut wi, mut q) = (0.0, 0.0, 0.0, 0.0);
             for &j in clusters.members(c) {
                 let (s, co) = trig[j];
@@ -362,23 +372,19 @@ impl RotatingSystem {
                 wi += ml * co;
                 q += forces[j];
             }
-            (inertia, wr, wi, q)
-        };
-        for c in 0..clusters.len() {
-            let (inertia, wr, wi, q) = sums(c);
             let inv = 1.0 / inertia;
             a11 -= wr * wr * inv;
             a12 -= wr * wi * inv;
             a22 -= wi * wi * inv;
             gr -= wr * q * inv;
             gi -= wi * q * inv;
+            sums.push([inv, wr, wi, q]);
         }
         let det = a11 * a22 - a12 * a12;
         let ar = (gr * a22 - gi * a12) / det;
         let ai = (gi * a11 - gr * a12) / det;
-        for c in 0..clusters.len() {
-            let (inertia, wr, wi, q) = sums(c);
-            let a = (q - (wr * ar + wi * ai)) / inertia;
+        for (c, &[inv, wr, wi, q]) in sums.iter().enumerate() {
+            let a = (q - (wr * ar + wi * ai)) * inv;
             for &j in clusters.members(c) {
                 accel[j] = a;
             }
@@ -430,8 +436,26 @@ impl Events for RotatingSystem {
         rigid_contact::values(self, t, y, out);
     }
 
+    fn value(&self, k: usize, t: f64, y: &[f64]) -> f64 {
+        rigid_contact::value(self, k, t, y)
+    }
+
     fn handle(&self, t: f64, y: &mut [f64], k: usize, falling: bool) -> EventFlow {
         rigid_contact::handle(self, t, y, k, falling)
+    }
+
+    fn rhs_calls(&self) -> u64 {
+        self.rigid().rhs_calls()
+    }
+
+    fn clear(&self, t: f64, y: &[f64]) -> bool {
+        rigid_contact::mode_holds(
+            self,
+            t,
+            y,
+            rigid_contact::CLEAR_GAP,
+            rigid_contact::CLEAR_PRESS,
+        )
     }
 
     fn rates(&self, _t: f64, y: &[f64], out: &mut [f64]) -> bool {

@@ -202,6 +202,9 @@ impl Simulation {
         if self.metrics.certified_not_settled && !record {
             observer = observer.certify_not_settled();
         }
+        if let Some(events) = ode.events() {
+            observer = observer.with_events(events);
+        }
         if let Some(w) = frame {
             observer = observer.in_rotating_frame(w);
             // A recorded series keeps every integrated sample.

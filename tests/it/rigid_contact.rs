@@ -11,8 +11,9 @@
 //! tolerance, see [`options`].) The impact map itself is checked on a light
 //! rotor, where the impulse must go through the whole mass matrix.
 //!
-//! Tests marked `#[ignore]` reproduce bugs found at db75c6f (their reasons
-//! say which); the branch stays green without them.
+//! Four tests pin bugs found in the first version (the far pair of a ring
+//! of two close weights read as overlapping; a touching pair at rest was
+//! left open at the start).
 
 use autobal::integrate::{Flow, Method, SolverOptions, Status, Step, StepObserver, solve};
 use autobal::model::cargo::Cargo;
@@ -349,7 +350,6 @@ fn an_impact_with_restitution_parts_the_pair_at_e_times_the_closing_speed() {
 /// one instant and ends in a dead impact (both at V/3, parting 0 instead of
 /// V/2).
 #[test]
-#[ignore = "bug at db75c6f: the far pair of a ring of two close weights reads as overlapping (WRAP_BACK), and a rebound then teleports both weights"]
 fn an_impact_with_restitution_between_the_only_two_weights_of_a_race() {
     check_restitution(false);
 }
@@ -357,7 +357,6 @@ fn an_impact_with_restitution_between_the_only_two_weights_of_a_race() {
 /// The direct symptom: two weights 0.05 rad beyond touching, 5.8 rad apart
 /// the other way round, have a far-pair event value of −0.45 rad.
 #[test]
-#[ignore = "bug at db75c6f: the far pair of a ring of two close weights reads as overlapping (WRAP_BACK)"]
 fn the_far_pair_of_two_close_weights_is_wide_open() {
     let system = heavy(contact(ContactModel::Rigid, 0.0), false);
     let mut y = closing_start(2);
@@ -560,7 +559,6 @@ impl Effect for PushBack {
 /// db75c6f: `resolve` skips a pair whose closing speed is `>= 0.0`, so a
 /// pair at rest (closing exactly 0) stays open.
 #[test]
-#[ignore = "bug at db75c6f: start() leaves a touching pair at rest (closing speed 0) open, against its doc"]
 fn a_touching_pair_at_rest_starts_linked() {
     let system = heavy(contact(ContactModel::Rigid, 0.0), false);
     let mut y = vec![0.0; 8];
@@ -577,7 +575,6 @@ fn a_touching_pair_at_rest_starts_linked() {
 /// and B sinks into A by ~1e-4 rad. Expected: they stay touching (gap ≥
 /// −1e-10) until the torque turns at π/Ω.
 #[test]
-#[ignore = "bug at db75c6f: a pair starting at rest within the 1e-10 touching window but overlapped by more than 1e-12 is never linked and sinks"]
 fn a_pair_starting_slightly_overlapped_at_rest_never_sinks() {
     let (torque, freq) = (1e-6, 2.0 * PI);
     let system = heavy(contact(ContactModel::Rigid, 0.0), false)

@@ -132,7 +132,9 @@ impl SettlingObserver<'_> {
             reason,
             t_final,
             steps: report.stats.steps,
-            rhs_calls: report.stats.rhs_calls + self.certifier.as_ref().map_or(0, |c| c.rhs_calls),
+            rhs_calls: report.stats.rhs_calls
+                + self.certifier.as_ref().map_or(0, |c| c.rhs_calls)
+                + self.events.map_or(0, |e| e.rhs_calls()),
             method: String::new(),
             fidelity: String::new(),
             min_gap_rad: self.gap.as_ref().map(|_| self.closest.smallest()),

@@ -19,7 +19,7 @@ use super::reference::{
 };
 use super::{MetricOptions, Outcome, RunMetrics};
 use crate::design::transient::position_parameter;
-use crate::integrate::{Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
+use crate::integrate::{Events, Failure, Flow, OdeSystem, SolveReport, Status, Step, StepObserver};
 use crate::model::gap::{ClosestApproach, GapGauge};
 use crate::model::start::is_plane_translation;
 use crate::model::system::RotorSystem;
@@ -79,6 +79,9 @@ pub struct SettlingObserver<'a> {
     series: Option<Series>,
     frame: Option<f64>,
     certifier: Option<HoldCertifier<'a>>,
+    /// The integrated system's events (rigid contact), which decide whether
+    /// a state is clear of touches and partings in place of the gaps.
+    events: Option<&'a dyn Events>,
     /// How much the certified hold may move Σ r² over the window.
     residual_share: f64,
     /// The sample (t, state) at which a certified hold ended the run.
@@ -133,6 +136,15 @@ impl<'a> SettlingObserver<'a> {
     /// same, the recorded (x, y) are turned back to the inertial frame.
     pub fn in_rotating_frame(mut self, omega: f64) -> Self {
         self.frame = Some(omega);
+        self
+    }
+
+    /// The integrated system has `events`: rigid contact between the
+    /// weights. They keep the weights apart (no two can coincide) and say
+    /// whether a state is clear of touches and partings.
+    pub fn with_events(mut self, events: &'a dyn Events) -> Self {
+        self.events = Some(events);
+        self.twins.clear();
         self
     }
 
@@ -220,6 +232,7 @@ impl<'a> SettlingObserver<'a> {
             }),
             frame: None,
             certifier: None,
+            events: None,
             residual_share: 0.0,
             certified: None,
             plan: None,
@@ -369,6 +382,10 @@ impl<'a> SettlingObserver<'a> {
     /// Whether no two weights are within [`CONTACT_MARGIN`] of touching (in
     /// contact or apart) at the latest sample.
     fn contacts_settled(&self) -> bool {
+        if let Some(events) = self.events {
+            let t = self.sample_time(self.next_index.saturating_sub(1));
+            return events.clear(t, &self.scratch);
+        }
         let psi = &self.scratch[self.system.layout().head()..self.system.layout().nq()];
         self.gap
             .as_ref()

@@ -20,6 +20,16 @@ pub(super) struct TailPlan {
 /// turn; for angles far beyond, the tracking check still guards).
 pub(super) const CONTACT_MARGIN: f64 = 2.5e-8;
 
+/// With rigid contact, the predicted state is checked clear of touches and
+/// partings on every this many samples: each check is a right-hand side
+/// (a link's torque), and the torques move as slowly as ε deep in the band.
+const EVENT_CHECK_STRIDE: usize = 4 * TAIL_CHECK_STRIDE;
+
+/// With rigid contact, linked weights sit at their touching angle to
+/// rounding: the predicted closest approach may differ from the run's by
+/// this much (rad) and still be the same approach.
+const LINKED_GAP_ROUNDING: f64 = 1e-12;
+
 /// After a prediction that fails (ε or the gaps), the next try comes this
 /// many revolutions later.
 const REPLAN_REVS: f64 = 3.0;
@@ -171,15 +181,30 @@ impl SettlingObserver<'_> {
         let mut x = vec![0.0; dim + 1];
         let mut tmp = vec![0.0; dim + 1];
         // Positions only: r, ε and the gaps need no more.
-        let mut state = vec![0.0; lay.nq()];
+        let mut state = vec![0.0; if self.events.is_some() { dim } else { lay.nq() }];
         let mut r = Vec::with_capacity(count);
         flow.lift(&self.scratch, &mut x);
         for k in 0..count {
             flow.advance(&mut x, &mut tmp);
             let checked = k % TAIL_CHECK_STRIDE == 0 || k + 1 == count;
-            // r needs the rotor's coordinates only; the angles, when checked.
-            let needed = if checked { lay.nq() } else { lay.head() };
+            let events_checked =
+                self.events.is_some() && (k % EVENT_CHECK_STRIDE == 0 || k + 1 == count);
+            // r needs the rotor's coordinates only; the angles, when
+            // checked; the whole state, for the events.
+            let needed = if events_checked {
+                dim
+            } else if checked {
+                lay.nq()
+            } else {
+                lay.head()
+            };
             flow.lower(&x, &mut state[..needed]);
+            if let Some(events) = self.events
+                && events_checked
+                && !events.clear(self.sample_time(first + k as u64), &state)
+            {
+                return None;
+            }
             r.push(self.whirl(&state));
             if checked {
                 let angles = &state[psi.clone()];
@@ -188,9 +213,18 @@ impl SettlingObserver<'_> {
                 }
                 // A contact that opens or closes would change the flow, and
                 // the closest approach so far must stay the run's.
+                // With rigid contact the events decide the first (above).
+                let same = self.events.is_some()
+                    || self.gap.as_ref().is_none_or(|g| {
+                        g.same_contacts(&self.scratch[psi.clone()], angles, CONTACT_MARGIN)
+                    });
+                let slack = if self.events.is_some() {
+                    LINKED_GAP_ROUNDING
+                } else {
+                    0.0
+                };
                 if let Some(g) = &self.gap
-                    && !(g.same_contacts(&self.scratch[psi.clone()], angles, CONTACT_MARGIN)
-                        && g.min_gap(angles) >= self.closest.smallest())
+                    && !(same && g.min_gap(angles) >= self.closest.smallest() - slack)
                 {
                     return None;
                 }

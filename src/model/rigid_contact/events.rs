@@ -43,7 +43,11 @@ pub fn start<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64]) {
 /// linked pair's torque past −λ_tol.
 pub fn values<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64], out: &mut [f64]) {
     let rc = system.rigid();
-    if rc.mode.borrow().any_linked() {
+    let stale = {
+        let mode = rc.mode.borrow();
+        mode.any_linked() && !mode.torques_current(t, y)
+    };
+    if stale {
         refresh_torques(system, t, y);
     }
     let first = system.first_weight();
@@ -56,6 +60,23 @@ pub fn values<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64], out: &mut [f
             rc.gap(mode.pairs[k], psi) + GAP_OFFSET
         };
     }
+}
+
+/// g_k(t, y) of one pair: an open pair's gap needs the angles alone.
+pub fn value<S: Clustered + ?Sized>(system: &S, k: usize, t: f64, y: &[f64]) -> f64 {
+    let rc = system.rigid();
+    let (pair, linked) = {
+        let mode = rc.mode.borrow();
+        (mode.pairs[k], mode.linked[k])
+    };
+    if !linked {
+        let first = system.first_weight();
+        return rc.gap(pair, &y[first..first + rc.half_angle.len()]) + GAP_OFFSET;
+    }
+    if !rc.mode.borrow().torques_current(t, y) {
+        refresh_torques(system, t, y);
+    }
+    rc.mode.borrow().torque[k] + rc.pull_tolerance
 }
 
 /// dg_k/dt for the open pairs (the closing rate, from the state alone); 0
@@ -119,8 +140,10 @@ fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f
             if linked || rc.gap((behind, ahead), &y[first..first + n]) > touching {
                 continue;
             }
+            // Touching and not parting: they meet (at rest relative to each
+            // other, as in a clustered start, they link with no impulse).
             let closing = y[nq + first + ahead] - y[nq + first + behind];
-            if closing >= 0.0 {
+            if closing > 0.0 {
                 continue;
             }
             let e = if -closing < rc.sticking_speed {
@@ -146,6 +169,7 @@ fn refresh_torques<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64]) {
     dydt.resize(y.len(), 0.0);
     system.rhs(t, y, &mut dydt);
     rc.scratch().dydt = dydt;
+    rc.rhs_calls.set(rc.rhs_calls.get() + 1);
 }
 
 /// Open pair `k` (behind A, ahead B) meets: the impulse along the pair that
@@ -261,7 +285,11 @@ pub fn mode_holds<S: Clustered + ?Sized>(
     press: f64,
 ) -> bool {
     let rc = system.rigid();
-    if rc.mode.borrow().any_linked() {
+    let stale = {
+        let mode = rc.mode.borrow();
+        mode.any_linked() && !mode.torques_current(t, y)
+    };
+    if stale {
         refresh_torques(system, t, y);
     }
     let first = system.first_weight();

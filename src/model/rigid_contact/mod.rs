@@ -23,7 +23,7 @@
 
 mod events;
 
-pub use events::{Clustered, handle, mode_holds, rates, start, values};
+pub use events::{Clustered, handle, mode_holds, rates, start, value, values};
 
 use super::cargo::Cargo;
 use super::race_ring::for_each_ring;
@@ -41,11 +41,19 @@ const STICKING_SPEED: f64 = 1e-6;
 /// links and its gap is moved to zero, so that a later parting starts its
 /// gap function this far above its zero rather than on it.
 pub const GAP_OFFSET: f64 = 1e-12;
+/// A state is clear of events ([`crate::integrate::Events::clear`]) with
+/// every open pair this far (rad) apart, the penalty model's margin around
+/// its kink (beyond the central differences' step in an angle)...
+pub const CLEAR_GAP: f64 = 2.5e-8;
+/// ... and every link pressing by this many times the parting tolerance.
+pub const CLEAR_PRESS: f64 = 10.0;
 /// Pairs within this gap (rad) at the start touch: clustered starts are
 /// computed at 2α in floating point.
 const TOUCHING_AT_START: f64 = 1e-10;
-/// A forward angle along the ring is taken in [−this, 2π − this): overlaps
-/// up to it stay overlaps instead of wrapping to nearly a turn.
+/// A pair's forward angle along the ring is taken in [(1 − this)·2α,
+/// (1 − this)·2α + 2π), 2α its touching angle: overlaps up to this share
+/// of 2α stay overlaps instead of wrapping to nearly a turn, and the far
+/// pair of a ring of two close weights reads as the rest of the turn.
 const WRAP_BACK: f64 = 0.5;
 
 /// The rigid contact of one system's weights: geometry, tolerances and the
@@ -65,6 +73,8 @@ pub struct RigidContact {
     pull_tolerance: f64,
     /// Closing speeds below this stick (rad/s).
     sticking_speed: f64,
+    /// Right-hand sides evaluated for the events (counted in a run's cost).
+    rhs_calls: std::cell::Cell<u64>,
     /// Which pairs are linked, the clusters and the latest torques. A
     /// `RefCell` because the integrator sees the system through `&self`;
     /// only events change it, the right-hand side writes λ.
@@ -99,11 +109,18 @@ pub struct Mode {
     ring_pairs: Vec<usize>,
     /// Whether each pair is linked.
     linked: Vec<bool>,
+    /// How many are (kept by [`Mode::rebuild`]: the right-hand side asks
+    /// on every call).
+    links: usize,
     /// Contact torque of each linked pair from the latest right-hand side
     /// (N·m, positive pressing); 0 for open pairs.
     torque: Vec<f64>,
     /// The clusters of the current links.
     clusters: Clusters,
+    /// The (t, y) the torques were recorded at, while the links have not
+    /// changed since: an explicit method's last stage is its step's end, so
+    /// the events read the torques it left instead of a call of their own.
+    torques_at: Option<(f64, Vec<f64>)>,
 }
 
 /// Maximal linked runs of weights (a weight alone is a cluster of one).
@@ -150,7 +167,7 @@ impl Mode {
 
     /// Whether any pair is linked (otherwise every weight moves alone).
     pub fn any_linked(&self) -> bool {
-        self.linked.iter().any(|&l| l)
+        self.links > 0
     }
 
     /// Store the contact torques of every cluster's links from its members'
@@ -177,8 +194,28 @@ impl Mode {
         }
     }
 
+    /// Note that the torques just recorded are those at (t, y).
+    pub fn recorded_at(&mut self, t: f64, y: &[f64]) {
+        match &mut self.torques_at {
+            Some((at, state)) if state.len() == y.len() => {
+                *at = t;
+                state.copy_from_slice(y);
+            }
+            slot => *slot = Some((t, y.to_vec())),
+        }
+    }
+
+    /// Whether the torques are those at (t, y) under the current links.
+    fn torques_current(&self, t: f64, y: &[f64]) -> bool {
+        self.torques_at
+            .as_ref()
+            .is_some_and(|(at, state)| *at == t && state[..] == *y)
+    }
+
     /// Rebuild the clusters from the links (after an event).
     fn rebuild(&mut self, weights: usize) {
+        self.torques_at = None;
+        self.links = self.linked.iter().filter(|&&l| l).count();
         let c = &mut self.clusters;
         c.members.clear();
         c.ends.clear();
@@ -228,6 +265,7 @@ impl RigidContact {
             restitution,
             pull_tolerance: PULL_TOLERANCE * largest * omega * omega,
             sticking_speed: STICKING_SPEED * omega,
+            rhs_calls: std::cell::Cell::new(0),
             mode: RefCell::new(Mode::default()),
             scratch: RefCell::new(Scratch::default()),
         }
@@ -244,6 +282,11 @@ impl RigidContact {
         self.scratch.borrow_mut()
     }
 
+    /// Right-hand sides evaluated for the events so far.
+    pub fn rhs_calls(&self) -> u64 {
+        self.rhs_calls.get()
+    }
+
     /// Number of event functions: one per pair (known once the run has started).
     pub fn count(&self) -> usize {
         self.mode.borrow().pairs.len()
@@ -252,8 +295,9 @@ impl RigidContact {
     /// The gap (rad) of pair (behind, ahead) at angles `psi`: their centre
     /// angle along the race less the touching angle α_b + α_a.
     pub fn gap(&self, (behind, ahead): (usize, usize), psi: &[f64]) -> f64 {
-        let forward = (psi[ahead] - psi[behind] + WRAP_BACK).rem_euclid(TAU) - WRAP_BACK;
-        forward - self.half_angle[behind] - self.half_angle[ahead]
+        let touching = self.half_angle[behind] + self.half_angle[ahead];
+        let lowest = (1.0 - WRAP_BACK) * touching;
+        (psi[ahead] - psi[behind] - lowest).rem_euclid(TAU) + lowest - touching
     }
 
     /// Find the rings and pairs at angles `psi`, every pair open.
@@ -341,5 +385,8 @@ mod tests {
         // A slight overlap stays an overlap.
         let psi = [0.0, two_alpha - 1e-9];
         assert!((rc.gap((0, 1), &psi) + 1e-9).abs() < 1e-15);
+        // Two close weights: the far pair is open by the rest of the turn.
+        let psi = [0.0, two_alpha + 0.05];
+        assert!((rc.gap((1, 0), &psi) - (TAU - 2.0 * two_alpha - 0.05)).abs() < 1e-12);
     }
 }
