@@ -316,34 +316,62 @@ impl RotatingSystem {
         let ((mut gr, mut gi), (fr, fi)) = self.head_and_weight_forces(t, y, dydt);
         let w = self.omega;
         let (psi, psi_rate) = (&y[2..nq], &y[nq + 2..]);
-        let mut scratch = rigid.scratch();
-        let forces = &mut scratch.forces;
-        forces.resize(n, 0.0);
-        let mut trig = self.trig.borrow_mut();
-        for j in 0..n {
-            let (s, co) = super::trig::sin_cos(psi[j]);
-            trig[j] = (s, co);
-            let ml = self.mass_track[j];
-            let rate = w + psi_rate[j];
-            gr += ml * rate * rate * co;
-            gi += ml * rate * rate * s;
-            forces[j] = dydt[nq + 2 + j] - ml * (fi * co - fr * s);
-        }
         let mut mode = rigid.mode();
-        let (ar, ai) = self.solve_clusters(
-            mode.clusters(),
-            &trig,
-            forces,
-            (gr, gi),
-            &mut dydt[nq + 2..],
-        );
+        let (clusters, torque) = mode.clusters_and_torques();
+        let mut trig = self.trig.borrow_mut();
+        let mut sums = self.cluster_sums.borrow_mut();
+        sums.clear();
+        // One pass over the clusters: each weight's force Q (kept in its
+        // slot of dydt for the torques), the head's centrifugal terms, and
+        // the cluster's (1/I, w, Q) eliminated from the head at once.
+        let cargo_f = &mut dydt[nq + 2..];
+        let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
+        for c in 0..clusters.len() {
+            let (mut inertia, mut wr, mut wi, mut q) = (0.0, 0.0, 0.0, 0.0);
+            for &j in clusters.members(c) {
+                let (s, co) = super::trig::sin_cos(psi[j]);
+                trig[j] = (s, co);
+                let ml = self.mass_track[j];
+                let rate = w + psi_rate[j];
+                gr += ml * rate * rate * co;
+                gi += ml * rate * rate * s;
+                let qj = cargo_f[j] - ml * (fi * co - fr * s);
+                cargo_f[j] = qj;
+                inertia += self.inertia[j];
+                wr -= ml * s;
+                wi += ml * co;
+                q += qj;
+            }
+            let inv = 1.0 / inertia;
+            a11 -= wr * wr * inv;
+            a12 -= wr * wi * inv;
+            a22 -= wi * wi * inv;
+            gr -= wr * q * inv;
+            gi -= wi * q * inv;
+            sums.push([inv, wr, wi, q]);
+        }
+        let det = a11 * a22 - a12 * a12;
+        let ar = (gr * a22 - gi * a12) / det;
+        let ai = (gi * a11 - gr * a12) / det;
+        // Each member's acceleration is its cluster's; the torque of the
+        // link after member i is what members up to i owe their own rows,
+        // Σ (Q − I a − w·z).
+        for (c, &[inv, wr, wi, q]) in sums.iter().enumerate() {
+            let a = (q - (wr * ar + wi * ai)) * inv;
+            let links = clusters.links(c);
+            let mut carried = 0.0;
+            for (i, &j) in clusters.members(c).iter().enumerate() {
+                if let Some(&link) = links.get(i) {
+                    let (s, co) = trig[j];
+                    carried +=
+                        cargo_f[j] - self.inertia[j] * a - self.mass_track[j] * (co * ai - s * ar);
+                    torque[link] = carried;
+                }
+                cargo_f[j] = a;
+            }
+        }
         dydt[nq] = ar;
         dydt[nq + 1] = ai;
-        let accel = &dydt[nq + 2..];
-        mode.record_torques(&self.inertia, forces, accel, |j| {
-            let (s, co) = trig[j];
-            self.mass_track[j] * (co * ai - s * ar)
-        });
         mode.recorded_at(t, y);
     }
 

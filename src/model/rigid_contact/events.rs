@@ -32,7 +32,6 @@ pub fn start<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64]) {
     {
         let mut s = rc.scratch();
         s.dydt.resize(y.len(), 0.0);
-        s.forces.resize(n, 0.0);
         s.impulse.resize(n, 0.0);
         s.response.resize(nq, 0.0);
     }

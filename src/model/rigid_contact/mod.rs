@@ -18,7 +18,8 @@
 //! rows (the λ cancel), eliminates clusters instead of weights in its
 //! arrowhead mass matrix, and gives every member the cluster's
 //! acceleration; λ then follows from the members' own rows
-//! ([`Mode::record_torques`]). Linked members share bit-identical
+//! (`RotatingSystem`'s clustered right-hand side, which fills them in through
+//! [`Mode::clusters_and_torques`]). Linked members share bit-identical
 //! velocities, so their gaps stay put to rounding.
 
 mod events;
@@ -79,8 +80,8 @@ pub struct RigidContact {
     /// `RefCell` because the integrator sees the system through `&self`;
     /// only events change it, the right-hand side writes λ.
     mode: RefCell<Mode>,
-    /// Scratch for a right-hand side evaluated to learn λ, and for the
-    /// weights' forces the torques are computed from (no allocation per call).
+    /// Scratch for a right-hand side evaluated to learn λ and for an
+    /// impact's impulse (no allocation per event).
     scratch: RefCell<Scratch>,
 }
 
@@ -89,8 +90,6 @@ pub struct RigidContact {
 pub struct Scratch {
     /// A derivative the events ask for.
     pub dydt: Vec<f64>,
-    /// Each weight's generalised force before the constraint (N·m).
-    pub forces: Vec<f64>,
     /// A generalised impulse on each weight, and the velocity change it makes.
     pub impulse: Vec<f64>,
     /// Velocity change of every coordinate.
@@ -170,28 +169,10 @@ impl Mode {
         self.links > 0
     }
 
-    /// Store the contact torques of every cluster's links from its members'
-    /// forces `forces` (before the constraint), accelerations `accel` and
-    /// the part of their rows each owes the head, `head_part(j)` = w_j·z
-    /// (plus any other known term): λ after member i is the sum over members
-    /// up to i of Q − I a − head_part.
-    pub fn record_torques(
-        &mut self,
-        inertia: &[f64],
-        forces: &[f64],
-        accel: &[f64],
-        head_part: impl Fn(usize) -> f64,
-    ) {
-        for c in 0..self.clusters.len() {
-            let start = if c == 0 { 0 } else { self.clusters.ends[c - 1] };
-            let end = self.clusters.ends[c];
-            let mut carried = 0.0;
-            for i in start..end - 1 {
-                let j = self.clusters.members[i];
-                carried += forces[j] - inertia[j] * accel[j] - head_part(j);
-                self.torque[self.clusters.link_after[i]] = carried;
-            }
-        }
+    /// The clusters, and the torques of the links to fill in (a
+    /// right-hand side computes them with the accelerations).
+    pub fn clusters_and_torques(&mut self) -> (&Clusters, &mut [f64]) {
+        (&self.clusters, &mut self.torque)
     }
 
     /// Note that the torques just recorded are those at (t, y).
@@ -297,7 +278,18 @@ impl RigidContact {
     pub fn gap(&self, (behind, ahead): (usize, usize), psi: &[f64]) -> f64 {
         let touching = self.half_angle[behind] + self.half_angle[ahead];
         let lowest = (1.0 - WRAP_BACK) * touching;
-        (psi[ahead] - psi[behind] - lowest).rem_euclid(TAU) + lowest - touching
+        let d = psi[ahead] - psi[behind] - lowest;
+        // Within a turn either way, as neighbours almost always are: the
+        // bits of `rem_euclid` without its fmod (called for every pair at
+        // every step).
+        let within = if (0.0..TAU).contains(&d) {
+            d
+        } else if d < 0.0 && d > -TAU {
+            d + TAU
+        } else {
+            d.rem_euclid(TAU)
+        };
+        within + lowest - touching
     }
 
     /// Find the rings and pairs at angles `psi`, every pair open.
