@@ -120,6 +120,11 @@ where
         if let Err(f) = committed {
             return report(Status::Failed(f), t, y, stats, &window);
         }
+        // Back onto the mode's constraints: an explicit method keeps them
+        // to rounding and changes nothing here; an implicit one takes f at
+        // the new point afresh in `advance`, and an explicit one that did
+        // drift starts afresh (its last stage was at the old state).
+        let projected = events.is_some_and(|ev| ev.project(t, &mut y));
         // The earliest event within the step, if any: the step ends there.
         let mut event = None;
         if let Some(ev) = events {
@@ -201,6 +206,14 @@ where
         {
             let f = Failure::Dearer { t, rate, ratio };
             return report(Status::Failed(f), t, y, stats, &window);
+        }
+        if projected && !St::IMPLICIT {
+            h = match stepper.start(system, t, &y, h_max.min(t_end - t), &mut stats) {
+                Ok(h0) => h0.min(h_max),
+                Err(f) => return report(Status::Failed(f), t, y, stats, &window),
+            };
+            last_rejected = false;
+            continue;
         }
         if let Err(f) = stepper.advance(system, t, &y, &mut stats) {
             return report(Status::Failed(f), t, y, stats, &window);

@@ -54,6 +54,13 @@ pub trait Events {
         self.values(t, y, &mut g);
         g.iter().all(|&g| g != 0.0)
     }
+    /// After an accepted step, move the state back onto the current mode's
+    /// constraints where the method let it drift (an implicit method's
+    /// Newton iterations need not keep linked weights' velocities equal),
+    /// and say whether it changed. The default: nothing to keep.
+    fn project(&self, _t: f64, _y: &mut [f64]) -> bool {
+        false
+    }
     /// Right-hand sides the events have evaluated so far (e.g. for a force
     /// their functions read), beyond the integrator's own: a run's cost
     /// counts them. The default: none.

@@ -239,6 +239,10 @@ pub struct RunMetrics {
     pub method: String,
     /// Formulation that produced it ("rotating", "full", "analytic").
     pub fidelity: String,
+    /// How contact between the weights was modelled ("rigid" or
+    /// "penalty"); `None` when the run models none (contact off, point
+    /// masses, or an estimate).
+    pub contact_model: Option<&'static str>,
     /// Smallest gap between two weights of one plane over the sampled run
     /// (rad of centre angle beyond touching, 2α); negative: they overlapped.
     /// `None` for point masses, which have no size.
@@ -316,6 +320,7 @@ impl std::fmt::Debug for RunMetrics {
         s.field("rhs_calls", &self.rhs_calls);
         s.field("method", &self.method);
         s.field("fidelity", &self.fidelity);
+        s.field("contact_model", &self.contact_model);
         s.field("min_gap_rad", &self.min_gap_rad);
         s.field("final_min_gap_rad", &self.final_min_gap_rad);
         s.field("censoring_revs", &self.censoring_revs);
@@ -384,6 +389,7 @@ impl RunMetrics {
             rhs_calls: 0,
             method: method.to_string(),
             fidelity: String::new(),
+            contact_model: None,
             min_gap_rad: None,
             final_min_gap_rad: None,
             censoring_revs: None,

@@ -87,14 +87,15 @@ impl RotatingSystem {
         };
         let me = r.unbalance;
         let (s, c) = super::trig::sin_cos(r.unbalance_angle);
-        let effects = scene
-            .effects
-            .build(&super::effect::BuildSetup::plane(&cargo, omega));
         let rigid = scene
             .effects
             .contact
             .as_ref()
             .and_then(|c| c.rigid(&cargo, omega));
+        let effects = scene.effects.build(&super::effect::BuildSetup {
+            rigid_contact: rigid.is_some(),
+            ..super::effect::BuildSetup::plane(&cargo, omega)
+        });
         Ok(RotatingSystem {
             omega,
             m_total: r.mass + cargo.iter().map(|c| c.mass).sum::<f64>(),
@@ -118,6 +119,19 @@ impl RotatingSystem {
     pub fn with_effect(mut self, effect: Box<dyn Effect>) -> Self {
         self.effects.push(effect);
         self
+    }
+
+    /// How contact between the weights is modelled: "rigid" (held here as
+    /// constraints), "penalty" (a force among the effects) or none.
+    pub fn contact_model(&self) -> Option<&'static str> {
+        if self.rigid.is_some() {
+            Some("rigid")
+        } else {
+            self.effects
+                .iter()
+                .any(|e| e.name() == "contact")
+                .then_some("penalty")
+        }
     }
 
     /// The constant spin speed ω.
@@ -474,6 +488,10 @@ impl Events for RotatingSystem {
 
     fn rhs_calls(&self) -> u64 {
         self.rigid().rhs_calls()
+    }
+
+    fn project(&self, _t: f64, y: &mut [f64]) -> bool {
+        rigid_contact::project(self, y)
     }
 
     fn clear(&self, t: f64, y: &[f64]) -> bool {

@@ -308,6 +308,7 @@ impl Scene {
             omega: self.speed.nominal_speed(),
             plane_maps: &plane_maps,
             gravity: 0.0,
+            rigid_contact: false,
         });
         Ok(RotorSystem::new(rotor, cargo, self.speed.clone(), effects))
     }

@@ -129,9 +129,19 @@ impl Simulation {
                 let [u, ud, v, vd] = rotating.from_inertial(0.0, y0[0], y0[nq], y0[1], y0[nq + 1]);
                 let mut z0 = y0.clone();
                 (z0[0], z0[1], z0[nq], z0[nq + 1]) = (u, v, ud, vd);
-                self.integrate(&rotating, &system, &z0, Some(omega), record)
+                let (mut metrics, series) =
+                    self.integrate(&rotating, &system, &z0, Some(omega), record);
+                metrics.contact_model = rotating.contact_model();
+                (metrics, series)
             }
-            Fidelity::Full | Fidelity::Auto => self.integrate(&system, &system, &y0, None, record),
+            Fidelity::Full | Fidelity::Auto => {
+                let (mut metrics, series) = self.integrate(&system, &system, &y0, None, record);
+                metrics.contact_model = system
+                    .effect_names()
+                    .contains(&"contact")
+                    .then_some("penalty");
+                (metrics, series)
+            }
         };
         metrics.fidelity = fidelity.name().to_string();
         if self

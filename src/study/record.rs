@@ -191,6 +191,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("method", |r: &RunRecord| r.method.clone()),
         col!("fidelity", |r: &RunRecord| r.metrics.fidelity.clone()),
         col!("contact", |r: &RunRecord| r.contact),
+        col!("contact_model", |r: &RunRecord| r.metrics.contact_model),
         col!("min_gap_rad", |r: &RunRecord| r.metrics.min_gap_rad),
         col!("final_min_gap_rad", |r: &RunRecord| r
             .metrics
@@ -413,6 +414,19 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     let (steps, rhs, wall) = (u64s("steps")?, u64s("rhs_calls")?, req("wall_time_s")?);
     let fidelity = strs("fidelity")?;
     let contact = bools("contact")?;
+    // Absent from tables written before rigid contact existed (all penalty).
+    let contact_model: Vec<Option<&'static str>> = match df.column("contact_model") {
+        Ok(c) => c
+            .str()?
+            .iter()
+            .map(|v| match v {
+                Some("rigid") => Some("rigid"),
+                Some(_) => Some("penalty"),
+                None => None,
+            })
+            .collect(),
+        Err(_) => contact.iter().map(|&on| on.then_some("penalty")).collect(),
+    };
     // Absent from tables written before the certified hold existed.
     let certified = match df.column("hold_certified") {
         Ok(_) => bools("hold_certified")?,
@@ -525,6 +539,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                 rhs_calls: rhs[i],
                 method: method[i].clone(),
                 fidelity: fidelity[i].clone(),
+                contact_model: contact_model[i],
                 min_gap_rad: min_gap[i],
                 final_min_gap_rad: final_gap[i],
                 censoring_revs: censoring[i],

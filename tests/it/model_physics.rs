@@ -207,12 +207,17 @@ fn constant_speed_runs_are_identical_for_balls_rollers_and_pendulums_of_equal_ka
         .run(true)
         .unwrap();
     // The balls never touch here, so contact adds nothing; only they have a
-    // size, so only they have a gap to report.
+    // size, so only they have a gap to report and a contact model.
     assert!(a.metrics.min_gap_rad.unwrap() > 0.0);
     assert_eq!(b.metrics.min_gap_rad, None);
+    assert_eq!(
+        (a.metrics.contact_model, b.metrics.contact_model),
+        (Some("penalty"), None)
+    );
     let sizeless = RunMetrics {
         min_gap_rad: None,
         final_min_gap_rad: None,
+        contact_model: None,
         ..a.metrics.clone()
     };
     assert_eq!(sizeless, b.metrics);
@@ -374,9 +379,12 @@ fn vertical_axis_gravity_adds_no_term() {
 fn weights_in_contact_carry_the_capacity_of_seed_000() {
     // An unbalance beyond what the weights can cancel presses them together
     // opposite it: with contact their total unbalance is then the capacity
-    // m l sin(nα)/sin α of eq 5; without contact they all meet in one point (n m l).
+    // m l sin(nα)/sin α of eq 5; without contact they all meet in one point
+    // (n m l). Both contact models; the starts overlap for n = 4 (40° apart,
+    // 2α = 50.8°), which penalty contact pushes apart in its first instants
+    // and rigid contact before it begins.
     use autobal::design::capacity::cluster_factor;
-    use autobal::model::effect::contact::ContactSpec;
+    use autobal::model::effect::contact::{ContactModel, ContactSpec};
     for (n, rho) in [(3_u32, 0.25), (4, 0.3), (5, 0.2)] {
         let g = Geometry {
             race_radius: 1.0,
@@ -391,11 +399,14 @@ fn weights_in_contact_carry_the_capacity_of_seed_000() {
         }
         let ml = cargo[0].unbalance();
         let start: Vec<f64> = (0..n).map(|j| 60.0 + 40.0 * f64::from(j)).collect();
-        let run = |contact: bool| {
+        let run = |contact: Option<ContactModel>| {
             let mut rotor = rotor();
             rotor.eccentricity = 1.5 * f64::from(n) * ml / rotor.mass;
             let mut sim = simulation(rotor, cargo.clone(), 4.0, &start);
-            sim.scene.effects.contact = contact.then(ContactSpec::default);
+            sim.scene.effects.contact = contact.map(|model| ContactSpec {
+                model,
+                ..ContactSpec::default()
+            });
             sim.metrics.t_end_revs = 300.0;
             let m = sim.run(false).unwrap().metrics;
             assert!(
@@ -414,12 +425,14 @@ fn weights_in_contact_carry_the_capacity_of_seed_000() {
             sx.hypot(sy)
         };
         let expected = ml * cluster_factor(n, rho).unwrap();
-        let with = run(true);
-        assert!(
-            (with / expected - 1.0).abs() < 0.01,
-            "n={n} ρ={rho}: {with} vs S_AB {expected}"
-        );
-        let without = run(false);
+        for model in [ContactModel::Penalty, ContactModel::Rigid] {
+            let with = run(Some(model));
+            assert!(
+                (with / expected - 1.0).abs() < 0.01,
+                "n={n} ρ={rho} {model:?}: {with} vs S_AB {expected}"
+            );
+        }
+        let without = run(None);
         assert!(
             (without / (f64::from(n) * ml) - 1.0).abs() < 0.01,
             "n={n}: {without} vs n m l"

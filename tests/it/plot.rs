@@ -277,6 +277,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                     rhs_calls: 600,
                     method: "dp5".into(),
                     fidelity: "full".into(),
+                    contact_model: None,
                     min_gap_rad: None,
                     final_min_gap_rad: None,
                     censoring_revs: None,

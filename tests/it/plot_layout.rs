@@ -230,6 +230,7 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         rhs_calls: 600,
         method: "dp5".into(),
         fidelity: "full".into(),
+        contact_model: None,
         min_gap_rad: None,
         final_min_gap_rad: None,
         censoring_revs: None,

@@ -72,6 +72,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
             rhs_calls: 600,
             method: "dp5".into(),
             fidelity: "full".into(),
+            contact_model: None,
             min_gap_rad: None,
             final_min_gap_rad: None,
             censoring_revs: None,

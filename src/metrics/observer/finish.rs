@@ -137,6 +137,7 @@ impl SettlingObserver<'_> {
                 + self.events.map_or(0, |e| e.rhs_calls()),
             method: String::new(),
             fidelity: String::new(),
+            contact_model: None,
             min_gap_rad: self.gap.as_ref().map(|_| self.closest.smallest()),
             censoring_revs: matches!(outcome, Outcome::Censored | Outcome::NotSettled).then(|| {
                 let t_op = self.operating_since.unwrap_or(t_final);

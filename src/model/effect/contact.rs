@@ -37,8 +37,8 @@ pub struct ContactSpec {
     pub damping_ratio: f64,
     /// How contact is modelled: `penalty` (a stiff spring and damper
     /// between overlapping weights, the default) or `rigid` (weights that
-    /// touch move as one until the force between them would pull; no
-    /// overlap and no stiffness; the rotating frame only).
+    /// touch move as one until the force between them would pull: no
+    /// overlap, no stiffness; the rotating frame only, so far).
     #[serde(default)]
     pub model: ContactModel,
     /// Rigid contact: the ratio of parting to closing speed in an impact,
@@ -130,8 +130,9 @@ impl EffectSpec for ContactSpec {
     }
 
     fn build(&self, setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>> {
-        // Rigid contact is no force: the system holds it as constraints.
-        if self.model == ContactModel::Rigid {
+        // Rigid contact is no force: the system holds it as constraints
+        // (and a system that cannot is refused rigid contact up front).
+        if setup.rigid_contact || self.model == ContactModel::Rigid {
             return None;
         }
         Contact::new(self, setup.cargo, setup.omega).map(|c| Box::new(c) as Box<dyn Effect>)
@@ -139,10 +140,12 @@ impl EffectSpec for ContactSpec {
 }
 
 impl ContactSpec {
-    /// The rigid contact of these cargoes, when the file asks for it and a
-    /// weight has a size; `omega` sets the scale of its force tolerance.
+    /// The rigid contact of these cargoes for a system that can hold it,
+    /// when the file asks for it and a weight has a size; `omega` sets the
+    /// scale of its force tolerance.
     pub fn rigid(&self, cargo: &[Cargo], omega: f64) -> Option<RigidContact> {
-        (self.enabled && self.model == ContactModel::Rigid && cargo.iter().any(|c| c.radius > 0.0))
+        let wanted = self.model == ContactModel::Rigid;
+        (self.enabled && wanted && cargo.iter().any(|c| c.radius > 0.0))
             .then(|| RigidContact::new(cargo, omega, self.restitution))
     }
 }

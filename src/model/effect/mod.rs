@@ -87,6 +87,9 @@ pub struct BuildSetup<'a> {
     /// gravity effect): what presses a weight on its race besides its
     /// centripetal load, for effects that need the contact force.
     pub gravity: f64,
+    /// The system holds contact between the weights as rigid constraints
+    /// itself, so the contact effect adds no force.
+    pub rigid_contact: bool,
 }
 
 /// The plane rotor's one plane: its centre is the rotor's (x, y).
@@ -101,6 +104,7 @@ impl<'a> BuildSetup<'a> {
             omega,
             plane_maps: &PLANE_ROTOR_MAP,
             gravity: 0.0,
+            rigid_contact: false,
         }
     }
 }

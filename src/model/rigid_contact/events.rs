@@ -29,6 +29,7 @@ pub fn start<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64]) {
     let (first, nq) = (system.first_weight(), system.coordinates());
     let n = rc.half_angle.len();
     rc.arrange(&y[first..first + n]);
+    rc.unfold(&mut y[first..first + n]);
     {
         let mut s = rc.scratch();
         s.dydt.resize(y.len(), 0.0);
@@ -158,6 +159,48 @@ fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f
             return;
         }
     }
+}
+
+/// Give every cluster one velocity (inertia-weighted, keeping its momentum)
+/// and its links zero gap, where the method let them drift by more than
+/// [`GAP_OFFSET`] or at all; whether anything moved. An explicit method
+/// gives linked members bit-identical velocities, so for it nothing does.
+pub fn project<S: Clustered + ?Sized>(system: &S, y: &mut [f64]) -> bool {
+    let rc = system.rigid();
+    let (first, nq) = (system.first_weight(), system.coordinates());
+    let n = rc.half_angle.len();
+    let mode = rc.mode.borrow();
+    if !mode.any_linked() {
+        return false;
+    }
+    let mut moved = false;
+    for c in 0..mode.clusters.len() {
+        let members = mode.clusters.members(c);
+        if members.len() < 2 {
+            continue;
+        }
+        let rate = |y: &[f64], j: usize| y[nq + first + j];
+        if members.iter().any(|&j| rate(y, j) != rate(y, members[0])) {
+            let total: f64 = members.iter().map(|&j| rc.inertia[j]).sum();
+            let moment: f64 = members.iter().map(|&j| rc.inertia[j] * rate(y, j)).sum();
+            let common = moment / total;
+            for &j in members {
+                y[nq + first + j] = common;
+            }
+            moved = true;
+        }
+        for (i, &link) in mode.clusters.links(c).iter().enumerate() {
+            let gap = rc.gap(mode.pairs[link], &y[first..first + n]);
+            if gap.abs() > GAP_OFFSET {
+                // The members ahead of the link move onto touching.
+                for &j in &members[i + 1..] {
+                    y[first + j] -= gap;
+                }
+                moved = true;
+            }
+        }
+    }
+    moved
 }
 
 /// Evaluate the right-hand side at (t, y) for its side effect: the mode's

@@ -24,7 +24,7 @@
 
 mod events;
 
-pub use events::{Clustered, handle, mode_holds, rates, start, value, values};
+pub use events::{Clustered, handle, mode_holds, project, rates, start, value, values};
 
 use super::cargo::Cargo;
 use super::race_ring::for_each_ring;
@@ -290,6 +290,44 @@ impl RigidContact {
             d.rem_euclid(TAU)
         };
         within + lowest - touching
+    }
+
+    /// Move weights that start overlapping apart, onto touching: along
+    /// each ring from the end of its widest gap, each weight is pushed
+    /// ahead to at least its touching angle past the one before. A start
+    /// built in code may overlap (scene files refuse it); penalty contact
+    /// would push such weights apart in the first instants, rigid contact
+    /// needs them apart before it can begin.
+    fn unfold(&self, psi: &mut [f64]) {
+        let mode = self.mode.borrow();
+        for ring in &mode.rings {
+            let m = ring.len();
+            if m < 2 {
+                continue;
+            }
+            let forward = |a: usize, b: usize, psi: &[f64]| (psi[b] - psi[a]).rem_euclid(TAU);
+            let widest = (0..m)
+                .max_by(|&a, &b| {
+                    let gap = |i: usize| forward(ring[i], ring[(i + 1) % m], psi);
+                    gap(a).total_cmp(&gap(b))
+                })
+                .unwrap_or(0);
+            let begin = (widest + 1) % m;
+            // Unwrapped angles along the ring as given (each the one
+            // before plus the forward angle to it), then pushed apart.
+            let mut given = psi[ring[begin]];
+            let mut pushed = given;
+            let mut shifts = Vec::with_capacity(m);
+            for step in 1..m {
+                let (prev, j) = (ring[(begin + step - 1) % m], ring[(begin + step) % m]);
+                given += forward(prev, j, psi);
+                pushed = given.max(pushed + self.half_angle[prev] + self.half_angle[j]);
+                shifts.push((j, pushed - given));
+            }
+            for (j, shift) in shifts {
+                psi[j] += shift;
+            }
+        }
     }
 
     /// Find the rings and pairs at angles `psi`, every pair open.
