@@ -49,6 +49,7 @@ mod report;
 mod results_columns;
 mod results_folder;
 mod return_when_dearer;
+mod rigid_agreement;
 mod rigid_contact;
 mod rolling_resistance;
 mod sample_bounds;
