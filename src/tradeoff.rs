@@ -1,13 +1,18 @@
 //! `study tradeoff`: what each fidelity and tolerance costs and how far its
 //! answers are from a reference, on a sample of a study's runs.
 //!
-//! Reference: the inertial (`full`) equations with DOP853 at rtol 1e-11. Each
-//! setting is measured on the same runs; errors are per run (settling time in
+//! Reference: the inertial (`full`) equations with DOP853 at rtol 1e-11,
+//! with penalty contact (the only contact model the inertial frame has).
+//! Where the rotating frame applies and the weights touch, the other contact
+//! model is measured too: rigid contact for a penalty study, penalty for a
+//! rigid one (whose inertial settings run penalty). Each setting is
+//! measured on the same runs; errors are per run (settling time in
 //! revolutions, residual vibration in units of A_ref, final cargo angles,
 //! outcome class), costs are wall time and right-hand-side calls.
 
 use crate::integrate::Method;
 use crate::metrics::RunMetrics;
+use crate::model::effect::contact::ContactModel;
 use crate::model::frame::rotating_frame_obstacle;
 use crate::simulation::{Fidelity, MethodChoice};
 use crate::stats::quantile::{Interpolation, quantile_sorted};
@@ -30,6 +35,8 @@ pub struct Setting {
     /// Whether a run handed over to Radau5 may return to the explicit
     /// method (`[solver] return_when_dearer`).
     pub return_when_dearer: bool,
+    /// The contact model, when not the study's own.
+    pub contact: Option<ContactModel>,
 }
 
 impl Setting {
@@ -43,8 +50,11 @@ impl Setting {
             } else {
                 "/kept on radau5"
             };
+            let contact = self
+                .contact
+                .map_or(String::new(), |m| format!("/{} contact", m.name()));
             format!(
-                "{}/{}/{:.0e}{kept}",
+                "{}/{}/{:.0e}{kept}{contact}",
                 self.fidelity.name(),
                 self.method.name(),
                 self.rtol
@@ -65,8 +75,11 @@ impl Setting {
             } else {
                 ", return_when_dearer = false"
             };
+            let contact = self.contact.map_or(String::new(), |m| {
+                format!("; [scene.effects.contact] model = \"{}\"", m.name())
+            });
             format!(
-                "{fidelity}, method = \"{}\", rtol = {:.0e}{kept}",
+                "{fidelity}, method = \"{}\", rtol = {:.0e}{kept}{contact}",
                 self.method.name(),
                 self.rtol
             )
@@ -140,7 +153,11 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
         method: MethodChoice::Auto,
         rtol: 0.0,
         return_when_dearer: true,
+        contact: None,
     };
+    let study_rigid = study_contact(plan) == Some(ContactModel::Rigid);
+    // The inertial frame holds penalty contact only.
+    let inertial_contact = study_rigid.then_some(ContactModel::Penalty);
     let mut v = Vec::new();
     let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
     let mut frames = vec![
@@ -162,6 +179,28 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
                 method,
                 rtol: 10f64.powi(-e),
                 return_when_dearer: true,
+                contact: (fidelity == Fidelity::Full)
+                    .then_some(inertial_contact)
+                    .flatten(),
+            });
+        }
+    }
+    // The other contact model, where the weights touch and the rotating
+    // frame can hold rigid contact: at the study's tolerance and at 1e-10.
+    if let Some(model) = study_contact(plan)
+        && rotating_frame_obstacle(&probe).is_none()
+    {
+        let other = match model {
+            ContactModel::Penalty => ContactModel::Rigid,
+            ContactModel::Rigid => ContactModel::Penalty,
+        };
+        for rtol in [plan.file.solver.rtol, 1e-10] {
+            v.push(Setting {
+                fidelity: Fidelity::Rotating,
+                method: MethodChoice::Fixed(Method::Dp5),
+                rtol,
+                return_when_dearer: true,
+                contact: Some(other),
             });
         }
     }
@@ -174,9 +213,37 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
             method: MethodChoice::Fixed(Method::Dp5),
             rtol: solver.rtol,
             return_when_dearer: false,
+            contact: inertial_contact,
         });
     }
     v
+}
+
+/// The setting every other is measured against: the inertial equations with
+/// DOP853 at rtol 1e-11 (with penalty contact, which a rigid study's
+/// inertial settings run too).
+pub fn reference(plan: &StudyPlan) -> Setting {
+    Setting {
+        fidelity: Fidelity::Full,
+        method: MethodChoice::Fixed(Method::Dop853),
+        rtol: 1e-11,
+        return_when_dearer: true,
+        contact: (study_contact(plan) == Some(ContactModel::Rigid))
+            .then_some(ContactModel::Penalty),
+    }
+}
+
+/// The study's contact model, when its weights can touch (contact on and
+/// the first design's weights have a size).
+fn study_contact(plan: &StudyPlan) -> Option<ContactModel> {
+    let spec = plan.file.scene.effects.contact.as_ref()?;
+    let sized = plan
+        .scene(&plan.designs[0], 0.0, 0.0)
+        .cargoes()
+        .ok()?
+        .iter()
+        .any(|c| c.radius > 0.0);
+    (spec.enabled && sized).then_some(spec.model)
 }
 
 /// Run `run_id` of the plan at a setting (early stop as the study says).
@@ -187,6 +254,9 @@ fn simulate(plan: &StudyPlan, run_id: u64, setting: Setting) -> (RunMetrics, f64
     sim.solver.fidelity = setting.fidelity;
     sim.solver.method = setting.method;
     sim.solver.return_when_dearer = setting.return_when_dearer;
+    if let (Some(model), Some(contact)) = (setting.contact, sim.scene.effects.contact.as_mut()) {
+        contact.model = model;
+    }
     if setting.rtol > 0.0 {
         sim.solver.rtol = setting.rtol;
         sim.solver.atol = None;
@@ -208,12 +278,7 @@ fn sorted_angles(m: &RunMetrics) -> Vec<f64> {
 /// Measure every setting on `runs` of the plan (run indices), serially so
 /// that wall times are comparable.
 pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
-    let reference = Setting {
-        fidelity: Fidelity::Full,
-        method: MethodChoice::Fixed(Method::Dop853),
-        rtol: 1e-11,
-        return_when_dearer: true,
-    };
+    let reference = reference(plan);
     let mut rows = Vec::new();
     let samples = u64::from(plan.file.sampling.samples);
     let horizon_revs = crate::study::verdict::settling_horizon(plan);

@@ -107,7 +107,8 @@ pub fn run(args: &TradeoffArgs) -> Result<(), UserError> {
         )),
     }
     crate::output::say_err(&format!(
-        "reference: full/dop853/1e-11; wrote {}",
+        "reference: {}; wrote {}",
+        autobal::tradeoff::reference(&plan).label(),
         path.display()
     ));
     Ok(())
