@@ -125,6 +125,14 @@ where
         // the new point afresh in `advance`, and an explicit one that did
         // drift starts afresh (its last stage was at the old state).
         let projected = events.is_some_and(|ev| ev.project(t, &mut y));
+        // An implicit method takes f at the new point before its next step
+        // anyway: with events, take it now, so that functions reading the
+        // derivative (a contact torque) find it instead of a call of their
+        // own. Wasted only on the step that ends the run or meets an event.
+        let advanced = St::IMPLICIT && events.is_some();
+        if advanced && let Err(f) = stepper.advance(system, t, &y, &mut stats) {
+            return report(Status::Failed(f), t, y, stats, &window);
+        }
         // The earliest event within the step, if any: the step ends there.
         let mut event = None;
         if let Some(ev) = events {
@@ -215,7 +223,7 @@ where
             last_rejected = false;
             continue;
         }
-        if let Err(f) = stepper.advance(system, t, &y, &mut stats) {
+        if !advanced && let Err(f) = stepper.advance(system, t, &y, &mut stats) {
             return report(Status::Failed(f), t, y, stats, &window);
         }
         // A step right after a rejection does not grow (Hairer).
