@@ -179,11 +179,6 @@ impl SceneFile {
             }));
         }
         self.metrics.check_horizon(&scene.speed).map_err(invalid)?;
-        if let Some(refusal) =
-            crate::simulation::rigid_contact_obstacle(&scene, self.solver.fidelity)
-        {
-            return Err(invalid(refusal));
-        }
         Ok(Simulation {
             scene,
             start: self.start.mode,

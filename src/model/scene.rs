@@ -303,13 +303,19 @@ impl Scene {
         let cargo = self.cargoes()?;
         let rotor = self.rotor.build();
         let plane_maps: Vec<_> = (0..rotor.planes()).map(|p| rotor.plane_map(p)).collect();
+        let omega = self.speed.nominal_speed();
+        let rigid = self
+            .effects
+            .contact
+            .as_ref()
+            .and_then(|c| c.rigid(&cargo, omega));
         let effects = self.effects.build(&BuildSetup {
             cargo: &cargo,
-            omega: self.speed.nominal_speed(),
+            omega,
             plane_maps: &plane_maps,
             gravity: 0.0,
-            rigid_contact: false,
+            rigid_contact: rigid.is_some(),
         });
-        Ok(RotorSystem::new(rotor, cargo, self.speed.clone(), effects))
+        Ok(RotorSystem::new(rotor, cargo, self.speed.clone(), effects).with_rigid_contact(rigid))
     }
 }

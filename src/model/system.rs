@@ -14,10 +14,11 @@
 
 use super::cargo::Cargo;
 use super::effect::{Effect, EffectContext, Forces};
+use super::rigid_contact::{self, Clustered, RigidContact};
 use super::rotor::{DofVec, MAX_DOF, Rotor};
 use super::speed::SpeedLaw;
 use super::tilt_inertia::TiltTerms;
-use crate::integrate::{CouplingStructure, HeadEquation, OdeSystem};
+use crate::integrate::{CouplingStructure, EventFlow, Events, HeadEquation, OdeSystem};
 
 /// Largest head block: rotor coordinates plus the spin angle.
 const MAX_HEAD: usize = MAX_DOF + 1;
@@ -81,6 +82,12 @@ pub struct RotorSystem {
     /// call for the elimination and reused by the back-substitution. A field,
     /// not a local, so that a call allocates nothing.
     trig: std::cell::RefCell<Vec<(f64, f64)>>,
+    /// Rigid contact between the weights, when the scene asks for it.
+    rigid: Option<RigidContact>,
+    /// Each weight's (w, Q) in a clustered right-hand side, and each
+    /// cluster's summed row (fields, not locals: a call allocates nothing).
+    rows: std::cell::RefCell<Vec<(DofVec, f64)>>,
+    cluster_sums: std::cell::RefCell<Vec<ClusterRow>>,
 }
 
 impl RotorSystem {
@@ -114,6 +121,9 @@ impl RotorSystem {
         RotorSystem {
             inertia: cargo.iter().map(Cargo::inertia).collect(),
             trig: std::cell::RefCell::new(vec![(0.0, 0.0); cargo.len()]),
+            rigid: None,
+            rows: std::cell::RefCell::new(vec![([0.0; MAX_DOF], 0.0); cargo.len()]),
+            cluster_sums: std::cell::RefCell::new(Vec::with_capacity(cargo.len())),
             rotor_unbalance: rotor.static_unbalance(),
             rotor,
             cargo,
@@ -125,6 +135,26 @@ impl RotorSystem {
             layout,
             head_mass,
             spin_inertia,
+        }
+    }
+
+    /// The same system with `rigid` contact between its weights, held as
+    /// constraints instead of a force (the effects must then leave contact out).
+    pub fn with_rigid_contact(mut self, rigid: Option<RigidContact>) -> Self {
+        self.rigid = rigid;
+        self
+    }
+
+    /// How contact between the weights is modelled: "rigid" (held here as
+    /// constraints), "penalty" (a force among the effects) or none.
+    pub fn contact_model(&self) -> Option<&'static str> {
+        if self.rigid.is_some() {
+            Some("rigid")
+        } else {
+            self.effects
+                .iter()
+                .any(|e| e.name() == "contact")
+                .then_some("penalty")
         }
     }
 
@@ -231,6 +261,10 @@ impl OdeSystem for RotorSystem {
     }
 
     fn coupling_structure(&self, t: f64, y: &[f64], out: &mut CouplingStructure) -> bool {
+        // A cluster couples all its members: dense Newton matrices.
+        if self.rigid.is_some() {
+            return false;
+        }
         let lay = self.layout;
         let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
         let (q, qd) = y.split_at(nq);
@@ -268,6 +302,7 @@ impl OdeSystem for RotorSystem {
         // scenes keep the directional differences.
         let lay = self.layout;
         if lay.spin_free
+            || self.rigid.is_some()
             || self.tilt_maps.iter().any(Option::is_some)
             || self.effects.iter().any(|e| e.rotor_forces_from_weights())
         {
@@ -302,6 +337,82 @@ impl OdeSystem for RotorSystem {
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        if let Some(rigid) = &self.rigid
+            && rigid.mode().any_linked()
+        {
+            return self.rhs_clustered(rigid, t, y, dydt);
+        }
+        let lay = self.layout;
+        let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
+        let (kin, mut h) = self.begin(t, y, dydt);
+        let cargo_f = &mut dydt[nq + head..];
+
+        // Eliminate the cargo rows. Cargo row j reads
+        //   I_j ψ̈_j + c_j·z = Q_j,  c_j = (w_j, I_j − J_j),
+        // and contributes e_j·ψ̈_j to the head rows, e_j = (w_j, −J_j), with
+        // w_j = m l (−sin φ_j G_u + cos φ_j G_v) and J_j the rolling coupling.
+        let mut trig = self.trig.borrow_mut();
+        for j in 0..self.cargo.len() {
+            let (w, qj) = self.weight_row::<true>(j, &kin, &mut h, &mut trig, cargo_f);
+            let c = &self.cargo[j];
+            self.eliminate(&mut h, self.inertia[j], c.rolling_coupling, &w, qj);
+        }
+        let z = self.finish_head(&kin, &mut h);
+
+        // Back-substitute the cargo accelerations.
+        let q = &y[..nq];
+        let qd = &y[nq..];
+        let z_spin = if lay.spin_free { z[k] } else { 0.0 };
+        for (j, c) in self.cargo.iter().enumerate() {
+            let (s, co) = trig[j];
+            let ml = c.mass * c.track_radius;
+            let [gu, gv] = &self.plane_maps[c.plane];
+            let mut wz = 0.0;
+            for i in 0..k {
+                wz += ml * (co * gv[i] - s * gu[i]) * z[i];
+            }
+            let rate = kin.spin_rate + qd[head + j];
+            if let Some(t) = self.tilt_terms(c, (s, co), rate, &q[..k], &qd[..k]) {
+                wz += (0..k).map(|i| t.coupling[i] * z[i]).sum::<f64>();
+            }
+            let spin_term = (self.inertia[j] - c.rolling_coupling) * z_spin;
+            cargo_f[j] = (cargo_f[j] - wz - spin_term) / self.inertia[j];
+        }
+        dydt[nq..nq + head].copy_from_slice(&z[..head]);
+    }
+
+    fn events(&self) -> Option<&dyn Events> {
+        self.rigid.as_ref().map(|_| self as &dyn Events)
+    }
+}
+
+/// The head block of the elimination as it is assembled: the matrix, the
+/// right-hand side, and the column and diagonal of φ̈.
+struct Head {
+    a: [[f64; MAX_HEAD]; MAX_HEAD],
+    g: [f64; MAX_HEAD],
+    spin_col: DofVec,
+    spin_diag: f64,
+    /// The rotor's own column of φ̈ (its unbalance), kept for the spin row.
+    coupling: DofVec,
+    spin_f: f64,
+}
+
+/// The spin and the state a right-hand side reads, once per call.
+struct Kinematics<'y> {
+    phi: f64,
+    spin_rate: f64,
+    spin_accel: f64,
+    q: &'y [f64],
+    qd: &'y [f64],
+}
+
+impl RotorSystem {
+    /// Copy q̇ into dydt's first half, put the effects' forces on the
+    /// weights into its weight slots, and start the head block: the rotor's
+    /// and the effects' forces, the rotor's mass matrix and its φ̈ column.
+    #[inline(always)]
+    fn begin<'y>(&self, t: f64, y: &'y [f64], dydt: &mut [f64]) -> (Kinematics<'y>, Head) {
         let lay = self.layout;
         let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
         let (q, qd) = y.split_at(nq);
@@ -356,101 +467,318 @@ impl OdeSystem for RotorSystem {
         for r in 0..k {
             a[r][..k].copy_from_slice(&self.head_mass[r][..k]);
         }
+        let kin = Kinematics {
+            phi,
+            spin_rate,
+            spin_accel,
+            q,
+            qd,
+        };
         // Column of φ̈ in the rotor rows (rotor unbalance plus every cargo's).
-        let mut spin_col: DofVec = coupling;
-        let mut spin_diag = self.spin_inertia;
+        let h = Head {
+            a,
+            g,
+            spin_col: coupling,
+            spin_diag: self.spin_inertia,
+            coupling,
+            spin_f,
+        };
+        (kin, h)
+    }
 
-        // Eliminate the cargo rows. Cargo row j reads
-        //   I_j ψ̈_j + c_j·z = Q_j,  c_j = (w_j, I_j − J_j),
-        // and contributes e_j·ψ̈_j to the head rows, e_j = (w_j, −J_j), with
-        // w_j = m l (−sin φ_j G_u + cos φ_j G_v) and J_j the rolling coupling.
-        let mut trig = self.trig.borrow_mut();
-        for (j, c) in self.cargo.iter().enumerate() {
-            let (s, co) = super::trig::sin_cos(phi + psi[j]);
-            trig[j] = (s, co);
-            let ml = c.mass * c.track_radius;
-            let [gu, gv] = &self.plane_maps[c.plane];
-            let rate = spin_rate + psi_rate[j];
-            let mut w: DofVec = [0.0; MAX_DOF];
-            for i in 0..k {
-                w[i] = ml * (co * gv[i] - s * gu[i]);
-                g[i] += ml * rate * rate * (co * gu[i] + s * gv[i]);
-                spin_col[i] += w[i];
+    /// Weight j's share of the head block (its centrifugal force, its φ̈
+    /// column, its tilt terms) and its row: the reaction w_j on the rotor
+    /// coordinates (tilt coupling included) and its generalised force Q_j
+    /// (also written back into its slot of `cargo_f`). Without `FORCES`
+    /// only the mass matrix is assembled (an impulse's response).
+    #[inline(always)]
+    fn weight_row<const FORCES: bool>(
+        &self,
+        j: usize,
+        kin: &Kinematics<'_>,
+        h: &mut Head,
+        trig: &mut [(f64, f64)],
+        cargo_f: &mut [f64],
+    ) -> (DofVec, f64) {
+        let lay = self.layout;
+        let (k, head) = (lay.rotor_dof, lay.head());
+        let c = &self.cargo[j];
+        let (s, co) = super::trig::sin_cos(kin.phi + kin.q[head + j]);
+        trig[j] = (s, co);
+        let ml = c.mass * c.track_radius;
+        let [gu, gv] = &self.plane_maps[c.plane];
+        let rate = kin.spin_rate + kin.qd[head + j];
+        let mut w: DofVec = [0.0; MAX_DOF];
+        for i in 0..k {
+            w[i] = ml * (co * gv[i] - s * gu[i]);
+            if FORCES {
+                h.g[i] += ml * rate * rate * (co * gu[i] + s * gv[i]);
             }
-            let inertia = self.inertia[j];
-            let jc = c.rolling_coupling;
-            spin_diag -= jc;
-            let mut qj = cargo_f[j];
-            if !lay.spin_free {
-                qj -= (inertia - jc) * spin_accel;
-                cargo_f[j] = qj;
-            }
-            // The m R² terms (src/model/tilt_inertia.rs); the scene
-            // guarantees a prescribed speed.
-            if let Some(t) = self.tilt_terms(c, (s, co), rate, &q[..k], &qd[..k]) {
-                for r in 0..k {
-                    for col in 0..k {
-                        a[r][col] += t.mu * t.jac[r] * t.jac[col];
-                    }
-                    g[r] -= t.rotor_force * t.jac[r] + t.coupling[r] * spin_accel;
-                    w[r] += t.coupling[r];
+            h.spin_col[i] += w[i];
+        }
+        let inertia = self.inertia[j];
+        let jc = c.rolling_coupling;
+        h.spin_diag -= jc;
+        let mut qj = cargo_f[j];
+        if FORCES && !lay.spin_free {
+            qj -= (inertia - jc) * kin.spin_accel;
+            cargo_f[j] = qj;
+        }
+        // The m R² terms (src/model/tilt_inertia.rs); the scene
+        // guarantees a prescribed speed.
+        if let Some(t) = self.tilt_terms(c, (s, co), rate, &kin.q[..k], &kin.qd[..k]) {
+            for r in 0..k {
+                for col in 0..k {
+                    h.a[r][col] += t.mu * t.jac[r] * t.jac[col];
                 }
+                if FORCES {
+                    h.g[r] -= t.rotor_force * t.jac[r] + t.coupling[r] * kin.spin_accel;
+                }
+                w[r] += t.coupling[r];
+            }
+            if FORCES {
                 qj += t.cargo_force;
                 cargo_f[j] = qj;
             }
-            let inv = 1.0 / inertia;
-            for r in 0..k {
-                let er = w[r] * inv;
-                for col in 0..k {
-                    a[r][col] -= er * w[col];
-                }
-                g[r] -= er * qj;
+        }
+        (w, qj)
+    }
+
+    /// Eliminate one row I ψ̈ + w·z + (I − J) φ̈ = Q (a weight's, or a
+    /// cluster's sum) from the head block.
+    #[inline(always)]
+    fn eliminate(&self, h: &mut Head, inertia: f64, jc: f64, w: &DofVec, qj: f64) {
+        let lay = self.layout;
+        let k = lay.rotor_dof;
+        let inv = 1.0 / inertia;
+        for r in 0..k {
+            let er = w[r] * inv;
+            for col in 0..k {
+                h.a[r][col] -= er * w[col];
             }
-            if lay.spin_free {
-                for r in 0..k {
-                    // e_r · c_φ and e_φ · c_r terms.
-                    a[r][k] -= w[r] * inv * (inertia - jc);
-                    a[k][r] += jc * inv * w[r];
-                }
-                a[k][k] += jc * inv * (inertia - jc);
-                g[k] += jc * inv * qj;
-            }
+            h.g[r] -= er * qj;
         }
         if lay.spin_free {
             for r in 0..k {
-                a[r][k] += spin_col[r];
-                a[k][r] += coupling[r];
+                // e_r · c_φ and e_φ · c_r terms.
+                h.a[r][k] -= w[r] * inv * (inertia - jc);
+                h.a[k][r] += jc * inv * w[r];
             }
-            a[k][k] += spin_diag;
-            g[k] += spin_f;
+            h.a[k][k] += jc * inv * (inertia - jc);
+            h.g[k] += jc * inv * qj;
+        }
+    }
+
+    /// Close the head block (the spin row, or the prescribed φ̈'s share)
+    /// and solve it for z = (rotor accelerations, φ̈).
+    #[inline(always)]
+    fn finish_head(&self, kin: &Kinematics<'_>, h: &mut Head) -> [f64; MAX_HEAD] {
+        let lay = self.layout;
+        let k = lay.rotor_dof;
+        if lay.spin_free {
+            for r in 0..k {
+                h.a[r][k] += h.spin_col[r];
+                h.a[k][r] += h.coupling[r];
+            }
+            h.a[k][k] += h.spin_diag;
+            h.g[k] += h.spin_f;
         } else {
             for r in 0..k {
-                g[r] -= spin_col[r] * spin_accel;
+                h.g[r] -= h.spin_col[r] * kin.spin_accel;
             }
         }
+        solve_small(&mut h.a, &mut h.g, lay.head())
+    }
 
-        let z = solve_small(&mut a, &mut g, head);
-
-        // Back-substitute the cargo accelerations.
-        let mut z_rotor: DofVec = [0.0; MAX_DOF];
-        z_rotor[..k].copy_from_slice(&z[..k]);
+    /// The right-hand side with weights linked by rigid contact: each
+    /// cluster's rows summed (the contact torques cancel) and eliminated as
+    /// one row, I_C = Σ I, w_C = Σ w, J_C = Σ J, Q_C = Σ Q; every member gets
+    /// the cluster's acceleration, and the links' torques are recorded for
+    /// the events (docs/model.md, "Rigid contact").
+    fn rhs_clustered(&self, rigid: &RigidContact, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let lay = self.layout;
+        let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
+        let (kin, mut h) = self.begin(t, y, dydt);
+        let cargo_f = &mut dydt[nq + head..];
+        let mut mode = rigid.mode();
+        let (clusters, torque) = mode.clusters_and_torques();
+        let mut trig = self.trig.borrow_mut();
+        let mut rows = self.rows.borrow_mut();
+        let mut sums = self.cluster_sums.borrow_mut();
+        sums.clear();
+        for c in 0..clusters.len() {
+            let mut sum = ClusterRow::default();
+            for &j in clusters.members(c) {
+                let (w, qj) = self.weight_row::<true>(j, &kin, &mut h, &mut trig, cargo_f);
+                rows[j] = (w, qj);
+                sum.add(self.inertia[j], self.cargo[j].rolling_coupling, &w, qj, k);
+            }
+            self.eliminate(&mut h, sum.inertia, sum.coupling, &sum.w, sum.q);
+            sums.push(sum);
+        }
+        let z = self.finish_head(&kin, &mut h);
         let z_spin = if lay.spin_free { z[k] } else { 0.0 };
-        for (j, c) in self.cargo.iter().enumerate() {
-            let (s, co) = trig[j];
-            let ml = c.mass * c.track_radius;
-            let [gu, gv] = &self.plane_maps[c.plane];
-            let mut wz = 0.0;
-            for i in 0..k {
-                wz += ml * (co * gv[i] - s * gu[i]) * z_rotor[i];
+        let reaction = |w: &DofVec, i: f64, jc: f64| {
+            (0..k).map(|r| w[r] * z[r]).sum::<f64>() + (i - jc) * z_spin
+        };
+        for (c, sum) in sums.iter().enumerate() {
+            let a = (sum.q - reaction(&sum.w, sum.inertia, sum.coupling)) / sum.inertia;
+            let links = clusters.links(c);
+            let mut carried = 0.0;
+            for (i, &j) in clusters.members(c).iter().enumerate() {
+                if let Some(&link) = links.get(i) {
+                    let (w, qj) = &rows[j];
+                    let (inertia, jc) = (self.inertia[j], self.cargo[j].rolling_coupling);
+                    carried += qj - inertia * a - reaction(w, inertia, jc);
+                    torque[link] = carried;
+                }
+                cargo_f[j] = a;
             }
-            let rate = spin_rate + psi_rate[j];
-            if let Some(t) = self.tilt_terms(c, (s, co), rate, &q[..k], &qd[..k]) {
-                wz += (0..k).map(|i| t.coupling[i] * z_rotor[i]).sum::<f64>();
-            }
-            let spin_term = (self.inertia[j] - c.rolling_coupling) * z_spin;
-            cargo_f[j] = (cargo_f[j] - wz - spin_term) / self.inertia[j];
         }
         dydt[nq..nq + head].copy_from_slice(&z[..head]);
+        mode.recorded_at(t, y);
+    }
+}
+
+/// A cluster's summed row: I_C, J_C, w_C and Q_C.
+#[derive(Debug, Clone, Copy, Default)]
+struct ClusterRow {
+    inertia: f64,
+    coupling: f64,
+    w: DofVec,
+    q: f64,
+}
+
+impl ClusterRow {
+    fn add(&mut self, inertia: f64, coupling: f64, w: &DofVec, q: f64, k: usize) {
+        self.inertia += inertia;
+        self.coupling += coupling;
+        for r in 0..k {
+            self.w[r] += w[r];
+        }
+        self.q += q;
+    }
+}
+
+impl Clustered for RotorSystem {
+    fn rigid(&self) -> &RigidContact {
+        self.rigid
+            .as_ref()
+            .expect("asked only of a system with rigid contact")
+    }
+
+    fn first_weight(&self) -> usize {
+        self.layout.head()
+    }
+
+    fn coordinates(&self) -> usize {
+        self.layout.nq()
+    }
+
+    fn impulse_response(&self, t: f64, y: &[f64], impulse: &[f64], response: &mut [f64]) {
+        let lay = self.layout;
+        let (k, nq, head) = (lay.rotor_dof, lay.nq(), lay.head());
+        let (q, qd) = y.split_at(nq);
+        let (phi, spin_rate, _) = if lay.spin_free {
+            (q[lay.phi()], qd[lay.phi()], 0.0)
+        } else {
+            self.speed.prescribed(t)
+        };
+        let kin = Kinematics {
+            phi,
+            spin_rate,
+            spin_accel: 0.0,
+            q,
+            qd,
+        };
+        let coupling = self.rotor.spin_coupling(phi, &q[..k]);
+        let mut h = Head {
+            a: [[0.0; MAX_HEAD]; MAX_HEAD],
+            g: [0.0; MAX_HEAD],
+            spin_col: coupling,
+            spin_diag: self.spin_inertia,
+            coupling,
+            spin_f: 0.0,
+        };
+        for r in 0..k {
+            h.a[r][..k].copy_from_slice(&self.head_mass[r][..k]);
+        }
+        let mode = self.rigid().mode();
+        let clusters = mode.clusters();
+        let mut trig = self.trig.borrow_mut();
+        let mut forces = impulse.to_vec();
+        let mut sums = Vec::with_capacity(clusters.len());
+        for c in 0..clusters.len() {
+            let mut sum = ClusterRow::default();
+            for &j in clusters.members(c) {
+                let (w, qj) = self.weight_row::<false>(j, &kin, &mut h, &mut trig, &mut forces);
+                sum.add(self.inertia[j], self.cargo[j].rolling_coupling, &w, qj, k);
+            }
+            self.eliminate(&mut h, sum.inertia, sum.coupling, &sum.w, sum.q);
+            sums.push(sum);
+        }
+        // The mass matrix only: the spin row's entries, no forces.
+        h.spin_f = 0.0;
+        let z = if lay.spin_free {
+            self.finish_head(&kin, &mut h)
+        } else {
+            solve_small(&mut h.a, &mut h.g, head)
+        };
+        let z_spin = if lay.spin_free { z[k] } else { 0.0 };
+        for (c, sum) in sums.iter().enumerate() {
+            let reaction = (0..k).map(|r| sum.w[r] * z[r]).sum::<f64>()
+                + (sum.inertia - sum.coupling) * z_spin;
+            let a = (sum.q - reaction) / sum.inertia;
+            for &j in clusters.members(c) {
+                response[head + j] = a;
+            }
+        }
+        response[..head].copy_from_slice(&z[..head]);
+    }
+}
+
+impl Events for RotorSystem {
+    fn count(&self) -> usize {
+        self.rigid().count()
+    }
+
+    fn values(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        rigid_contact::values(self, t, y, out);
+    }
+
+    fn value(&self, k: usize, t: f64, y: &[f64]) -> f64 {
+        rigid_contact::value(self, k, t, y)
+    }
+
+    fn handle(&self, t: f64, y: &mut [f64], k: usize, falling: bool) -> EventFlow {
+        rigid_contact::handle(self, t, y, k, falling)
+    }
+
+    fn rhs_calls(&self) -> u64 {
+        self.rigid().rhs_calls()
+    }
+
+    fn project(&self, _t: f64, y: &mut [f64]) -> bool {
+        rigid_contact::project(self, y)
+    }
+
+    fn clear(&self, t: f64, y: &[f64]) -> bool {
+        rigid_contact::mode_holds(
+            self,
+            t,
+            y,
+            rigid_contact::CLEAR_GAP,
+            rigid_contact::CLEAR_PRESS,
+        )
+    }
+
+    fn rates(&self, _t: f64, y: &[f64], out: &mut [f64]) -> bool {
+        rigid_contact::rates(self, y, out);
+        true
+    }
+
+    fn start(&self, t: f64, y: &mut [f64]) {
+        rigid_contact::start(self, t, y);
     }
 }
 

@@ -36,34 +36,6 @@ pub struct Simulation {
     pub metrics: MetricOptions,
 }
 
-/// Why `scene` cannot run with rigid contact at `fidelity`, when it asks for
-/// rigid contact: the model is built in the rotating frame only, so far
-/// (the inertial frame would silently fall back to no contact at all).
-pub fn rigid_contact_obstacle(scene: &Scene, fidelity: Fidelity) -> Option<SceneError> {
-    use crate::model::effect::contact::ContactModel;
-    let rigid = scene
-        .effects
-        .contact
-        .as_ref()
-        .is_some_and(|c| c.enabled && c.model == ContactModel::Rigid);
-    let why = match fidelity {
-        _ if !rigid => return None,
-        Fidelity::Full => "the full (inertial-frame) fidelity".to_string(),
-        Fidelity::Auto => format!(
-            "this scene, which cannot use the rotating frame ({})",
-            rotating_frame_obstacle(scene)?
-        ),
-        Fidelity::Analytic | Fidelity::Linear | Fidelity::Rotating => return None,
-    };
-    Some(SceneError::Invalid {
-        field: "effects.contact.model".into(),
-        value: "rigid".into(),
-        reason: format!(
-            "rigid contact is built for the rotating frame only (a constant speed, an isotropic plane rotor, no gravity), not for {why}; use model = \"penalty\""
-        ),
-    })
-}
-
 /// The result of one run.
 #[derive(Debug, Clone)]
 pub struct RunResult {
@@ -87,9 +59,6 @@ impl Simulation {
     pub fn run(&self, record: bool) -> Result<RunResult, SceneError> {
         /// Most samples a recorded series may hold (each a few f64 per weight).
         const MAX_SERIES_SAMPLES: f64 = 1e7;
-        if let Some(refusal) = rigid_contact_obstacle(&self.scene, self.solver.fidelity) {
-            return Err(refusal);
-        }
         let system = self.scene.build()?;
         let n = system.cargo().len();
         if self.initial_angles.len() != n {
@@ -136,10 +105,7 @@ impl Simulation {
             }
             Fidelity::Full | Fidelity::Auto => {
                 let (mut metrics, series) = self.integrate(&system, &system, &y0, None, record);
-                metrics.contact_model = system
-                    .effect_names()
-                    .contains(&"contact")
-                    .then_some("penalty");
+                metrics.contact_model = system.contact_model();
                 (metrics, series)
             }
         };

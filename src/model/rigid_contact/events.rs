@@ -3,7 +3,7 @@
 //! systems supply their equations through [`Clustered`]; the logic is the
 //! same in every frame.
 
-use super::{GAP_OFFSET, RigidContact, TOUCHING_AT_START};
+use super::{GAP_OFFSET, RigidContact, RingPair, TOUCHING_AT_START};
 use crate::integrate::{EventFlow, OdeSystem};
 
 /// A system whose weights may be held in clusters by rigid contact.
@@ -36,7 +36,7 @@ pub fn start<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64]) {
         s.impulse.resize(n, 0.0);
         s.response.resize(nq, 0.0);
     }
-    resolve(system, t, y, TOUCHING_AT_START);
+    resolve(system, t, y, TOUCHING_AT_START, true);
 }
 
 /// g_k(t, y) for every pair: an open pair's gap past [`GAP_OFFSET`], a
@@ -57,7 +57,7 @@ pub fn values<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64], out: &mut [f
         *g = if mode.linked[k] {
             mode.torque[k] + rc.pull_tolerance
         } else {
-            rc.gap(mode.pairs[k], psi) + GAP_OFFSET
+            rc.gap(&mode.pairs[k], psi) + GAP_OFFSET
         };
     }
 }
@@ -67,11 +67,11 @@ pub fn value<S: Clustered + ?Sized>(system: &S, k: usize, t: f64, y: &[f64]) -> 
     let rc = system.rigid();
     let (pair, linked) = {
         let mode = rc.mode.borrow();
-        (mode.pairs[k], mode.linked[k])
+        (mode.pairs[k].clone(), mode.linked[k])
     };
     if !linked {
         let first = system.first_weight();
-        return rc.gap(pair, &y[first..first + rc.half_angle.len()]) + GAP_OFFSET;
+        return rc.gap(&pair, &y[first..first + rc.half_angle.len()]) + GAP_OFFSET;
     }
     if !rc.mode.borrow().torques_current(t, y) {
         refresh_torques(system, t, y);
@@ -86,7 +86,7 @@ pub fn rates<S: Clustered + ?Sized>(system: &S, y: &[f64], out: &mut [f64]) {
     let (first, nq) = (system.first_weight(), system.coordinates());
     let mode = rc.mode.borrow();
     for (k, r) in out.iter_mut().enumerate() {
-        let (behind, ahead) = mode.pairs[k];
+        let RingPair { behind, ahead, .. } = mode.pairs[k];
         *r = if mode.linked[k] {
             0.0
         } else {
@@ -111,8 +111,9 @@ pub fn handle<S: Clustered + ?Sized>(
         unlink(rc, k);
     }
     // A gap growing through its zero (a pair that touched without closing)
-    // changes nothing; `resolve` finds every pair that meets.
-    resolve(system, t, y, -GAP_OFFSET);
+    // changes nothing; `resolve` finds every pair that meets, this one and
+    // any other at touching (to the event's offset) and closing.
+    resolve(system, t, y, GAP_OFFSET, false);
     EventFlow::Continue
 }
 
@@ -122,10 +123,14 @@ pub fn handle<S: Clustered + ?Sized>(
 const MAX_ROUNDS: usize = 64;
 
 /// Settle the mode at (t, y): every open pair within `touching` (rad) of
-/// touching and closing meets in an impact (several may meet at once, or
-/// one impact drive the next pair together), and every link that would
-/// pull opens, until neither happens.
-fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f64) {
+/// touching and closing meets in an impact, and every link that would pull
+/// opens, until neither happens. Several pairs may touch at once, and one
+/// impact may drive the next pair together: pairwise dead impacts repeated
+/// until none closes converge to the simultaneous one (each round takes a
+/// fixed share of the closing speed; without the rounds here, every round
+/// was an event of its own, nanoseconds apart). With `at_rest`, a touching
+/// pair that is not closing links too (the start).
+fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f64, at_rest: bool) {
     let rc = system.rigid();
     let (first, nq) = (system.first_weight(), system.coordinates());
     let n = rc.half_angle.len();
@@ -133,17 +138,18 @@ fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f
         let mut changed = false;
         let count = rc.mode.borrow().pairs.len();
         for k in 0..count {
-            let (behind, ahead, linked) = {
+            let (pair, linked) = {
                 let mode = rc.mode.borrow();
-                (mode.pairs[k].0, mode.pairs[k].1, mode.linked[k])
+                (mode.pairs[k].clone(), mode.linked[k])
             };
-            if linked || rc.gap((behind, ahead), &y[first..first + n]) > touching {
+            let RingPair { behind, ahead, .. } = pair;
+            if linked || rc.gap(&pair, &y[first..first + n]) > touching {
                 continue;
             }
-            // Touching and not parting: they meet (at rest relative to each
-            // other, as in a clustered start, they link with no impulse).
+            // Touching and closing: they meet (at the start, touching at
+            // rest relative to each other, they link with no impulse).
             let closing = y[nq + first + ahead] - y[nq + first + behind];
-            if closing > 0.0 {
+            if closing > 0.0 || (closing == 0.0 && !at_rest) {
                 continue;
             }
             let e = if -closing < rc.sticking_speed {
@@ -190,7 +196,7 @@ pub fn project<S: Clustered + ?Sized>(system: &S, y: &mut [f64]) -> bool {
             moved = true;
         }
         for (i, &link) in mode.clusters.links(c).iter().enumerate() {
-            let gap = rc.gap(mode.pairs[link], &y[first..first + n]);
+            let gap = rc.gap(&mode.pairs[link], &y[first..first + n]);
             if gap.abs() > GAP_OFFSET {
                 // The members ahead of the link move onto touching.
                 for &j in &members[i + 1..] {
@@ -223,7 +229,8 @@ fn impact<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], k: usize, e:
     let rc = system.rigid();
     let (first, nq) = (system.first_weight(), system.coordinates());
     let n = rc.half_angle.len();
-    let (behind, ahead) = rc.mode.borrow().pairs[k];
+    let pair = rc.mode.borrow().pairs[k].clone();
+    let RingPair { behind, ahead, .. } = pair;
     let mut scratch = rc.scratch();
     let scratch = &mut *scratch;
     scratch.impulse.iter_mut().for_each(|p| *p = 0.0);
@@ -243,7 +250,7 @@ fn impact<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], k: usize, e:
     let mode = &mut *mode;
     // B's members move forward by the overlap onto touching (a rebound
     // then starts its gap function above its zero, not on it).
-    let overlap = -rc.gap((behind, ahead), &y[first..first + n]);
+    let overlap = -rc.gap(&pair, &y[first..first + n]);
     let b = (0..mode.clusters.len())
         .find(|&c| mode.clusters.members(c).contains(&ahead))
         .expect("every weight is in a cluster");
@@ -341,7 +348,7 @@ pub fn mode_holds<S: Clustered + ?Sized>(
         if mode.linked[k] {
             mode.torque[k] > press * rc.pull_tolerance
         } else {
-            rc.gap(mode.pairs[k], psi) > margin
+            rc.gap(&mode.pairs[k], psi) > margin
         }
     })
 }

@@ -51,11 +51,6 @@ pub const CLEAR_PRESS: f64 = 10.0;
 /// Pairs within this gap (rad) at the start touch: clustered starts are
 /// computed at 2α in floating point.
 const TOUCHING_AT_START: f64 = 1e-10;
-/// A pair's forward angle along the ring is taken in [(1 − this)·2α,
-/// (1 − this)·2α + 2π), 2α its touching angle: overlaps up to this share
-/// of 2α stay overlaps instead of wrapping to nearly a turn, and the far
-/// pair of a ring of two close weights reads as the rest of the turn.
-const WRAP_BACK: f64 = 0.5;
 
 /// The rigid contact of one system's weights: geometry, tolerances and the
 /// run's current mode.
@@ -96,12 +91,27 @@ pub struct Scratch {
     pub response: Vec<f64>,
 }
 
+/// Two neighbours along a ring: `ahead` is the next weight along the race
+/// in the direction of growing angle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RingPair {
+    /// The weight behind.
+    pub behind: usize,
+    /// The weight ahead.
+    pub ahead: usize,
+    /// The whole turns (2π n) that make ψ_ahead − ψ_behind + this the
+    /// forward angle from one to the other: fixed for the run, since the
+    /// weights cannot pass, so that the gap is continuous in the angles
+    /// however far they turn or overlap (a wrapped difference would jump by
+    /// a turn at an overlap a step can cross).
+    turns: f64,
+}
+
 /// Which pairs are linked, and what follows from it.
 #[derive(Debug, Clone, Default)]
 pub struct Mode {
-    /// (behind, ahead) of every pair, ring after ring; `ahead` is the next
-    /// weight along the race in the direction of growing angle.
-    pairs: Vec<(usize, usize)>,
+    /// Every pair, ring after ring.
+    pairs: Vec<RingPair>,
     /// Weights of each ring, in race order.
     rings: Vec<Vec<usize>>,
     /// Index of each ring's first pair.
@@ -273,23 +283,11 @@ impl RigidContact {
         self.mode.borrow().pairs.len()
     }
 
-    /// The gap (rad) of pair (behind, ahead) at angles `psi`: their centre
-    /// angle along the race less the touching angle α_b + α_a.
-    pub fn gap(&self, (behind, ahead): (usize, usize), psi: &[f64]) -> f64 {
-        let touching = self.half_angle[behind] + self.half_angle[ahead];
-        let lowest = (1.0 - WRAP_BACK) * touching;
-        let d = psi[ahead] - psi[behind] - lowest;
-        // Within a turn either way, as neighbours almost always are: the
-        // bits of `rem_euclid` without its fmod (called for every pair at
-        // every step).
-        let within = if (0.0..TAU).contains(&d) {
-            d
-        } else if d < 0.0 && d > -TAU {
-            d + TAU
-        } else {
-            d.rem_euclid(TAU)
-        };
-        within + lowest - touching
+    /// The gap (rad) of `pair` at angles `psi`: their centre angle along
+    /// the race less the touching angle α_b + α_a.
+    pub fn gap(&self, pair: &RingPair, psi: &[f64]) -> f64 {
+        psi[pair.ahead] - psi[pair.behind] + pair.turns
+            - (self.half_angle[pair.behind] + self.half_angle[pair.ahead])
     }
 
     /// Move weights that start overlapping apart, onto touching: along
@@ -351,8 +349,15 @@ impl RigidContact {
                 let m = ring.len();
                 if m >= 2 {
                     for i in 0..m {
-                        mode.pairs
-                            .push((ring[i] as usize, ring[(i + 1) % m] as usize));
+                        let (behind, ahead) = (ring[i] as usize, ring[(i + 1) % m] as usize);
+                        // Sorted by angle: the forward angle is in [0, 2π).
+                        let d = psi[ahead] - psi[behind];
+                        let turns = TAU * ((d.rem_euclid(TAU) - d) / TAU).round();
+                        mode.pairs.push(RingPair {
+                            behind,
+                            ahead,
+                            turns,
+                        });
                     }
                 }
                 mode.rings.push(ring.iter().map(|&j| j as usize).collect());
@@ -390,7 +395,8 @@ mod tests {
         rc.arrange(&[1.0, 3.0, 0.5, 2.0, 0.0]);
         let mut mode = rc.mode();
         assert_eq!(mode.rings, vec![vec![2, 0, 3, 1]]);
-        assert_eq!(mode.pairs, vec![(2, 0), (0, 3), (3, 1), (1, 2)]);
+        let pairs: Vec<_> = mode.pairs.iter().map(|p| (p.behind, p.ahead)).collect();
+        assert_eq!(pairs, vec![(2, 0), (0, 3), (3, 1), (1, 2)]);
         // Link 1→2 across the ring's start, and 0→3.
         mode.linked[3] = true;
         mode.linked[1] = true;
@@ -408,15 +414,29 @@ mod tests {
         let cargo = vec![ball(0), ball(0)];
         let rc = RigidContact::new(&cargo, 100.0, 0.0);
         let two_alpha = 2.0 * cargo[0].contact_half_angle();
+        let gaps = |arranged_at: &[f64], psi: &[f64]| {
+            rc.arrange(arranged_at);
+            let mode = rc.mode.borrow();
+            let pair = |b: usize, a: usize| {
+                let p = mode.pairs.iter().find(|p| (p.behind, p.ahead) == (b, a));
+                rc.gap(p.expect("both pairs of a ring of two"), psi)
+            };
+            (pair(0, 1), pair(1, 0))
+        };
+        // Across 2π: the near pair's forward angle is 2α + 0.01.
         let psi = [6.2, 6.2 + two_alpha + 0.01];
-        assert!((rc.gap((0, 1), &psi) - 0.01).abs() < 1e-12);
+        let (near, far) = gaps(&psi, &psi);
+        assert!((near - 0.01).abs() < 1e-12);
         // The other side of a ring of two is the rest of the turn.
-        assert!((rc.gap((1, 0), &psi) - (TAU - 2.0 * two_alpha - 0.01)).abs() < 1e-12);
-        // A slight overlap stays an overlap.
-        let psi = [0.0, two_alpha - 1e-9];
-        assert!((rc.gap((0, 1), &psi) + 1e-9).abs() < 1e-15);
+        assert!((far - (TAU - 2.0 * two_alpha - 0.01)).abs() < 1e-12);
         // Two close weights: the far pair is open by the rest of the turn.
         let psi = [0.0, two_alpha + 0.05];
-        assert!((rc.gap((1, 0), &psi) - (TAU - 2.0 * two_alpha - 0.05)).abs() < 1e-12);
+        let (_, far) = gaps(&psi, &psi);
+        assert!((far - (TAU - 2.0 * two_alpha - 0.05)).abs() < 1e-12);
+        // Later, however far the pair turns or sinks in, the gap moves with
+        // the angles: no jump of a turn.
+        let later = [-60.0, -60.0 + two_alpha - 0.3];
+        let (near, _) = gaps(&psi, &later);
+        assert!((near + 0.3).abs() < 1e-9, "{near}");
     }
 }

@@ -213,23 +213,6 @@ impl StudyFile {
         }
         self.metrics.validate().map_err(refused)?;
         self.solver.validate().map_err(refused)?;
-        if let Some(crate::model::validate::SceneError::Invalid {
-            field,
-            value,
-            reason,
-        }) = crate::simulation::rigid_contact_obstacle(
-            &Scene {
-                rotor: self.scene.rotor.without_unbalance(),
-                balancer: None,
-                balancers: Vec::new(),
-                cargo: Vec::new(),
-                speed: self.scene.speed.clone(),
-                effects: self.scene.effects.clone(),
-            },
-            self.solver.fidelity,
-        ) {
-            return Err(invalid(&format!("scene.{field}"), value, &reason));
-        }
         if let Err(crate::model::validate::SceneError::Invalid {
             field,
             value,
