@@ -24,7 +24,14 @@ use std::f64::consts::PI;
 
 /// Angle in (−π, π].
 fn wrap(a: f64) -> f64 {
-    let r = a.rem_euclid(2.0 * PI);
+    // `rem_euclid` without its fmod where that is a no-op (same bits).
+    let r = if (0.0..2.0 * PI).contains(&a) {
+        a
+    } else if a < 0.0 && a > -2.0 * PI {
+        a + 2.0 * PI
+    } else {
+        a.rem_euclid(2.0 * PI)
+    };
     if r > PI { r - 2.0 * PI } else { r }
 }
 
@@ -172,11 +179,11 @@ impl<'a> Arcs<'a> {
             return false;
         }
         let count = 1 + 2 * (1usize << self.c.len().min(6));
-        if self.descend(*first, threshold) <= threshold {
+        if self.descend(*first, threshold) {
             return true;
         }
         for start in (0..count).filter(|&s| s != *first) {
-            if self.descend(start, threshold) <= threshold {
+            if self.descend(start, threshold) {
                 *first = start;
                 return true;
             }
@@ -254,12 +261,13 @@ impl<'a> Arcs<'a> {
         beyond.then(|| if r.im > 0.0 { 1.0 } else { -1.0 })
     }
 
-    /// The least |Σ c_j e^{i(φ_j + δ_j)} − T| that exact coordinate-wise
-    /// minimisation reaches from start `start`: 0 the centre of every arc,
+    /// Whether the least |Σ c_j e^{i(φ_j + δ_j)} − T| that exact
+    /// coordinate-wise minimisation reaches from start `start` is within
+    /// `threshold`. Start 0 is the centre of every arc,
     /// then every pattern of arc ends (up to 2⁶ of them) at full and at half
     /// length. The problem is not convex; the starts cover the centre and
     /// both ends of every arc.
-    fn descend(&self, start: usize, threshold: f64) -> f64 {
+    fn descend(&self, start: usize, threshold: f64) -> bool {
         let (c, phi, target, t) = (self.c, self.phi, self.target, self.t);
         let n = c.len();
         let patterns = 1usize << n.min(6);
@@ -280,7 +288,10 @@ impl<'a> Arcs<'a> {
             })
             .collect();
         let mut sum: Complex64 = terms.iter().sum();
-        let mut last = (sum - target).norm();
+        // The distances' moduli (`norm`, a hypot) are only taken when their
+        // squares leave a decision in doubt.
+        let mut last = sum - target;
+        let mut within = false;
         for _ in 0..300 {
             for j in 0..n {
                 let rest = sum - terms[j];
@@ -314,14 +325,45 @@ impl<'a> Arcs<'a> {
                 }
                 sum = rest + terms[j];
             }
-            let now = (sum - target).norm();
-            if now <= threshold || last - now <= 1e-12 * last {
-                last = now;
+            let now = sum - target;
+            within = no_farther(now, threshold);
+            if within || stalled(last, now) {
                 break;
             }
             last = now;
         }
-        last
+        within
+    }
+}
+
+/// `a.norm() <= limit`, by the squares when they differ clearly.
+fn no_farther(a: Complex64, limit: f64) -> bool {
+    let (a2, limit2) = (a.norm_sqr(), limit * limit);
+    if !(1e-100..1e100).contains(&limit) {
+        a.norm() <= limit
+    } else if a2 < limit2 * (1.0 - 1e-9) {
+        true
+    } else if a2 > limit2 * (1.0 + 1e-9) {
+        false
+    } else {
+        a.norm() <= limit
+    }
+}
+
+/// `last.norm() − now.norm() <= 1e-12 * last.norm()` (the descent gains
+/// nothing more), by the squares when they differ clearly from the
+/// boundary (1 − 1e-12)² ≈ 1 − 2·10⁻¹².
+fn stalled(last: Complex64, now: Complex64) -> bool {
+    let (l2, n2) = (last.norm_sqr(), now.norm_sqr());
+    let exact = || last.norm() - now.norm() <= 1e-12 * last.norm();
+    if !(1e-200..1e200).contains(&l2) {
+        exact()
+    } else if n2 > l2 * (1.0 - 2e-12 + 1e-13) {
+        true
+    } else if n2 < l2 * (1.0 - 2e-12 - 1e-13) {
+        false
+    } else {
+        exact()
     }
 }
 
