@@ -10,7 +10,10 @@
 //! answer is closed form; for more, the smallest t whose arcs
 //! {c_j e^{i(φ_j + δ)} : |δ| ≤ t} can still sum to T is found by bisection,
 //! each t decided by exact coordinate-wise minimisation of the distance to
-//! T over the arcs, from several starts.
+//! T over the arcs, from several starts. A t whose arcs provably cannot
+//! reach T (a line separates T from their convex hull by more than the
+//! tolerance) is decided without the minimisation: the descents could not
+//! have reached it either, so the answer is the same to the bit.
 //!
 //! The weights are treated as points here: the gaps between solid weights
 //! are not a constraint of the balanced set (a nearest balanced state of
@@ -21,7 +24,14 @@ use std::f64::consts::PI;
 
 /// Angle in (−π, π].
 fn wrap(a: f64) -> f64 {
-    let r = a.rem_euclid(2.0 * PI);
+    // `rem_euclid` without its fmod where that is a no-op (same bits).
+    let r = if (0.0..2.0 * PI).contains(&a) {
+        a
+    } else if a < 0.0 && a > -2.0 * PI {
+        a + 2.0 * PI
+    } else {
+        a.rem_euclid(2.0 * PI)
+    };
     if r > PI { r - 2.0 * PI } else { r }
 }
 
@@ -76,7 +86,26 @@ const REACHED: f64 = 1e-10;
 /// 1e-8 rad, 6·10⁻⁷°).
 fn bisect(c: &[f64], phi: &[f64], target: Complex64, upper: f64) -> f64 {
     let scale: f64 = c.iter().sum();
-    let reached = |t: f64| distance(c, phi, target, t) <= REACHED * scale;
+    let threshold = REACHED * scale;
+    // e^{−iφ_j}: turns T − rest into weight j's frame, to see without an
+    // atan2 that it points well outside the arc.
+    // Only for angles small enough that wrap(arg − φ_j) is good to far
+    // better than the 1e-12 rad margin of `Arcs::tan_off`.
+    let unturn: Vec<Complex64> = if phi.iter().all(|p| p.abs() < 100.0) {
+        phi.iter()
+            .map(|&p| Complex64::new(p.cos(), -p.sin()))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // Whether a t is reached does not depend on the order of the starts
+    // (any start that reaches decides it), so the start that reached last
+    // is tried first.
+    let mut first = 0;
+    let mut reached = |t: f64| {
+        let arcs = Arcs::new(c, phi, &unturn, target, t);
+        arcs.reaches(threshold, &mut first)
+    };
     if reached(0.0) {
         return 0.0;
     }
@@ -94,63 +123,260 @@ fn bisect(c: &[f64], phi: &[f64], target: Complex64, upper: f64) -> f64 {
     hi
 }
 
-/// The least |Σ c_j e^{i(φ_j + δ_j)} − T| over |δ_j| ≤ t, by exact
-/// coordinate-wise minimisation from several starts (the problem is not
-/// convex; the starts cover the centre and both ends of every arc).
-fn distance(c: &[f64], phi: &[f64], target: Complex64, t: f64) -> f64 {
-    let n = c.len();
-    // Starts: the centre of every arc, then every pattern of arc ends (up to
-    // 2⁶ of them) at full and at half length.
-    let patterns = 1u32 << n.min(6);
-    let starts = std::iter::once((0, 0.0))
-        .chain((0..patterns).map(|m| (m, 1.0)))
-        .chain((0..patterns).map(|m| (m, 0.5)));
-    let mut best = f64::INFINITY;
-    for (mask, size) in starts {
-        let mut delta: Vec<f64> = (0..n)
+/// The arcs {c_j e^{i(φ_j + δ)} : |δ| ≤ t} of one probe, with the ends'
+/// points computed once.
+struct Arcs<'a> {
+    c: &'a [f64],
+    phi: &'a [f64],
+    unturn: &'a [Complex64],
+    target: Complex64,
+    t: f64,
+    /// c_j e^{i(φ_j + t)} and c_j e^{i(φ_j − t)}.
+    plus: Vec<Complex64>,
+    minus: Vec<Complex64>,
+    /// tan(t + 1e-12) when 1e-9 < t < 1 (a direction whose angle from φ_j
+    /// has a tangent beyond it is off the arc whatever the rounding), else
+    /// NaN (never beyond).
+    tan_off: f64,
+}
+
+impl<'a> Arcs<'a> {
+    fn new(
+        c: &'a [f64],
+        phi: &'a [f64],
+        unturn: &'a [Complex64],
+        target: Complex64,
+        t: f64,
+    ) -> Self {
+        let plus = (0..c.len())
+            .map(|j| Complex64::from_polar(c[j], phi[j] + t))
+            .collect();
+        let minus = (0..c.len())
+            .map(|j| Complex64::from_polar(c[j], phi[j] + -t))
+            .collect();
+        let tan_off = if t > 1e-9 && t < 1.0 && !unturn.is_empty() {
+            (t + 1e-12).tan()
+        } else {
+            f64::NAN
+        };
+        Arcs {
+            c,
+            phi,
+            unturn,
+            target,
+            t,
+            plus,
+            minus,
+            tan_off,
+        }
+    }
+
+    /// Whether any start's descent (`descend`) reaches T within
+    /// `threshold`, trying start `first` before the others and leaving in
+    /// it the one that did.
+    fn reaches(&self, threshold: f64, first: &mut usize) -> bool {
+        if self.surely_unreached(threshold) {
+            return false;
+        }
+        let count = 1 + 2 * (1usize << self.c.len().min(6));
+        if self.descend(*first, threshold) {
+            return true;
+        }
+        for start in (0..count).filter(|&s| s != *first) {
+            if self.descend(start, threshold) {
+                *first = start;
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Whether T is provably farther than `threshold` from every sum of
+    /// points on the arcs, by a direction u in which T lies beyond the
+    /// arcs' extent: Re(ū T) − Σ_j max over arc j of Re(ū c_j e^{iθ}) is a
+    /// lower bound of every distance the descents can return (the
+    /// separating-line bound of the arcs' convex hull, with the arcs
+    /// widened by 1e-12 rad and a margin of 1e-12 Σ c_j against rounding).
+    fn surely_unreached(&self, threshold: f64) -> bool {
+        if self.tan_off.is_nan() {
+            return false;
+        }
+        let (c, phi, target) = (self.c, self.phi, self.target);
+        let n = c.len();
+        let wide = self.t + 1e-12;
+        let ends: Vec<(Complex64, Complex64)> = (0..n)
             .map(|j| {
-                let sign = if mask >> (j % 6) & 1 == 1 { 1.0 } else { -1.0 };
-                sign * size * t
+                (
+                    Complex64::from_polar(c[j], phi[j] + wide),
+                    Complex64::from_polar(c[j], phi[j] - wide),
+                )
             })
             .collect();
-        let term = |j: usize, d: f64| Complex64::from_polar(c[j], phi[j] + d);
-        let mut sum: Complex64 = (0..n).map(|j| term(j, delta[j])).sum();
-        let mut last = (sum - target).norm();
+        let limit = threshold + 1e-12 * c.iter().sum::<f64>();
+        // How far T lies beyond the arcs in direction θ.
+        let beyond = |theta: f64| {
+            let u = Complex64::from_polar(1.0, theta);
+            let dot = |z: Complex64| u.re * z.re + u.im * z.im;
+            let mut gap = dot(target);
+            for j in 0..n {
+                gap -= if wrap(theta - phi[j]).abs() <= wide + 1e-9 {
+                    c[j]
+                } else {
+                    dot(ends[j].0).max(dot(ends[j].1))
+                };
+            }
+            gap
+        };
+        let centre: Complex64 = (0..n).map(|j| Complex64::from_polar(c[j], phi[j])).sum();
+        let mut theta = (target - centre).arg();
+        let mut best = beyond(theta);
+        let mut step = 0.1;
+        while best <= limit && step > 1e-9 {
+            let (left, right) = (beyond(theta - step), beyond(theta + step));
+            if left > best && left >= right {
+                (theta, best) = (theta - step, left);
+            } else if right > best {
+                (theta, best) = (theta + step, right);
+            } else {
+                step *= 0.5;
+            }
+        }
+        best > limit
+    }
+
+    /// The sign of weight j's best angle when T − rest (`w`) points clearly
+    /// outside its arc, `None` when that takes the exact angle to decide.
+    fn clearly_off(&self, j: usize, w: Complex64) -> Option<f64> {
+        if self.tan_off.is_nan() {
+            return None;
+        }
+        let r = w * self.unturn[j];
+        let beyond = if r.re > 0.0 {
+            r.im.abs() > self.tan_off * r.re
+        } else {
+            // Beyond a right angle (t < 1 here), unless so near ±π that the
+            // wrapped angle's sign is in doubt.
+            r.im.abs() > 1e-6 * -r.re
+        };
+        beyond.then(|| if r.im > 0.0 { 1.0 } else { -1.0 })
+    }
+
+    /// Whether the least |Σ c_j e^{i(φ_j + δ_j)} − T| that exact
+    /// coordinate-wise minimisation reaches from start `start` is within
+    /// `threshold`. Start 0 is the centre of every arc,
+    /// then every pattern of arc ends (up to 2⁶ of them) at full and at half
+    /// length. The problem is not convex; the starts cover the centre and
+    /// both ends of every arc.
+    fn descend(&self, start: usize, threshold: f64) -> bool {
+        let (c, phi, target, t) = (self.c, self.phi, self.target, self.t);
+        let n = c.len();
+        let patterns = 1usize << n.min(6);
+        let (mask, size) = match start {
+            0 => (0, 0.0),
+            s if s <= patterns => (s - 1, 1.0),
+            s => (s - 1 - patterns, 0.5),
+        };
+        let mut terms: Vec<Complex64> = (0..n)
+            .map(|j| {
+                let up = mask >> (j % 6) & 1 == 1;
+                if size == 1.0 {
+                    if up { self.plus[j] } else { self.minus[j] }
+                } else {
+                    let sign = if up { 1.0 } else { -1.0 };
+                    Complex64::from_polar(c[j], phi[j] + sign * size * t)
+                }
+            })
+            .collect();
+        let mut sum: Complex64 = terms.iter().sum();
+        // The distances' moduli (`norm`, a hypot) are only taken when their
+        // squares leave a decision in doubt.
+        let mut last = sum - target;
+        let mut within = false;
         for _ in 0..300 {
             for j in 0..n {
-                let rest = sum - term(j, delta[j]);
+                let rest = sum - terms[j];
                 // The best angle for weight j points it at T − rest, clamped
                 // to its arc.
-                let want = wrap((target - rest).arg() - phi[j]);
-                let d = want.clamp(-t, t);
-                // On a clamped arc the nearer end is the better one.
-                let d = if want.abs() > t {
-                    let other = -d;
-                    if (rest + term(j, other) - target).norm() < (rest + term(j, d) - target).norm()
-                    {
-                        other
-                    } else {
-                        d
+                let w = target - rest;
+                let up = match self.clearly_off(j, w) {
+                    Some(sign) => Some(sign > 0.0),
+                    None => {
+                        let want = wrap(w.arg() - phi[j]);
+                        if want.abs() > t {
+                            Some(want > 0.0)
+                        } else {
+                            terms[j] = Complex64::from_polar(c[j], phi[j] + want);
+                            None
+                        }
                     }
-                } else {
-                    d
                 };
-                delta[j] = d;
-                sum = rest + term(j, d);
+                if let Some(up) = up {
+                    // On a clamped arc the nearer end is the better one.
+                    let (near, far) = if up {
+                        (self.plus[j], self.minus[j])
+                    } else {
+                        (self.minus[j], self.plus[j])
+                    };
+                    terms[j] = if nearer(rest + far - target, rest + near - target) {
+                        far
+                    } else {
+                        near
+                    };
+                }
+                sum = rest + terms[j];
             }
-            let now = (sum - target).norm();
-            if now <= REACHED * c.iter().sum::<f64>() || last - now <= 1e-12 * last {
-                last = now;
+            let now = sum - target;
+            within = no_farther(now, threshold);
+            if within || stalled(last, now) {
                 break;
             }
             last = now;
         }
-        best = best.min(last);
-        if best <= REACHED * c.iter().sum::<f64>() {
-            break;
-        }
+        within
     }
-    best
+}
+
+/// `a.norm() <= limit`, by the squares when they differ clearly.
+fn no_farther(a: Complex64, limit: f64) -> bool {
+    let (a2, limit2) = (a.norm_sqr(), limit * limit);
+    if !(1e-100..1e100).contains(&limit) {
+        a.norm() <= limit
+    } else if a2 < limit2 * (1.0 - 1e-9) {
+        true
+    } else if a2 > limit2 * (1.0 + 1e-9) {
+        false
+    } else {
+        a.norm() <= limit
+    }
+}
+
+/// `last.norm() − now.norm() <= 1e-12 * last.norm()` (the descent gains
+/// nothing more), by the squares when they differ clearly from the
+/// boundary (1 − 1e-12)² ≈ 1 − 2·10⁻¹².
+fn stalled(last: Complex64, now: Complex64) -> bool {
+    let (l2, n2) = (last.norm_sqr(), now.norm_sqr());
+    let exact = || last.norm() - now.norm() <= 1e-12 * last.norm();
+    if !(1e-200..1e200).contains(&l2) {
+        exact()
+    } else if n2 > l2 * (1.0 - 2e-12 + 1e-13) {
+        true
+    } else if n2 < l2 * (1.0 - 2e-12 - 1e-13) {
+        false
+    } else {
+        exact()
+    }
+}
+
+/// `a.norm() < b.norm()`, by the squares when they differ clearly.
+fn nearer(a: Complex64, b: Complex64) -> bool {
+    let (a2, b2) = (a.norm_sqr(), b.norm_sqr());
+    if a2 < b2 * (1.0 - 1e-9) {
+        true
+    } else if a2 > b2 * (1.0 + 1e-9) {
+        false
+    } else {
+        a.norm() < b.norm()
+    }
 }
 
 #[cfg(test)]
@@ -251,6 +477,128 @@ mod tests {
             );
             // The old metric overstated by a wide margin in every one of these.
             assert!(old > got + 3.0);
+        }
+    }
+
+    /// The bisection and minimiser as they were before the probes were made
+    /// cheaper, to check that every answer is unchanged to the bit.
+    mod reference {
+        use super::super::{REACHED, wrap};
+        use num_complex::Complex64;
+        use std::f64::consts::PI;
+
+        pub fn bisect(c: &[f64], phi: &[f64], target: Complex64, upper: f64) -> f64 {
+            let scale: f64 = c.iter().sum();
+            let reached = |t: f64| distance(c, phi, target, t) <= REACHED * scale;
+            if reached(0.0) {
+                return 0.0;
+            }
+            let mut hi = upper;
+            while !reached(hi) && hi < PI {
+                hi = (2.0 * hi).min(PI);
+            }
+            let mut lo = 0.0;
+            while hi - lo > 1e-8 {
+                let mid = 0.5 * (lo + hi);
+                if reached(mid) { hi = mid } else { lo = mid }
+            }
+            hi
+        }
+
+        fn distance(c: &[f64], phi: &[f64], target: Complex64, t: f64) -> f64 {
+            let n = c.len();
+            let patterns = 1u32 << n.min(6);
+            let starts = std::iter::once((0, 0.0))
+                .chain((0..patterns).map(|m| (m, 1.0)))
+                .chain((0..patterns).map(|m| (m, 0.5)));
+            let mut best = f64::INFINITY;
+            for (mask, size) in starts {
+                let mut delta: Vec<f64> = (0..n)
+                    .map(|j| {
+                        let sign = if mask >> (j % 6) & 1 == 1 { 1.0 } else { -1.0 };
+                        sign * size * t
+                    })
+                    .collect();
+                let term = |j: usize, d: f64| Complex64::from_polar(c[j], phi[j] + d);
+                let mut sum: Complex64 = (0..n).map(|j| term(j, delta[j])).sum();
+                let mut last = (sum - target).norm();
+                for _ in 0..300 {
+                    for j in 0..n {
+                        let rest = sum - term(j, delta[j]);
+                        let want = wrap((target - rest).arg() - phi[j]);
+                        let d = want.clamp(-t, t);
+                        let d = if want.abs() > t {
+                            let other = -d;
+                            if (rest + term(j, other) - target).norm()
+                                < (rest + term(j, d) - target).norm()
+                            {
+                                other
+                            } else {
+                                d
+                            }
+                        } else {
+                            d
+                        };
+                        delta[j] = d;
+                        sum = rest + term(j, d);
+                    }
+                    let now = (sum - target).norm();
+                    if now <= REACHED * c.iter().sum::<f64>() || last - now <= 1e-12 * last {
+                        last = now;
+                        break;
+                    }
+                    last = now;
+                }
+                best = best.min(last);
+                if best <= REACHED * c.iter().sum::<f64>() {
+                    break;
+                }
+            }
+            best
+        }
+    }
+
+    fn same_as_reference(c: &[f64], phi: &[f64], target: Complex64, upper: f64) {
+        let got = bisect(c, phi, target, upper);
+        let want = reference::bisect(c, phi, target, upper);
+        assert_eq!(
+            got.to_bits(),
+            want.to_bits(),
+            "{c:?} {phi:?} {target} {upper}: {got} against {want}"
+        );
+    }
+
+    #[test]
+    fn cheaper_probes_give_the_same_bits() {
+        for (c, phi, (re, im), _, old) in FRICTION_RUNS {
+            same_as_reference(c, phi, Complex64::new(re, im), old.to_radians());
+        }
+        // Weights stopped at random near a balanced state, with random sizes
+        // and angles beyond 2π; a small linear congruential generator.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..60 {
+            let n = 3 + case % 3;
+            let c: Vec<f64> = (0..n).map(|_| 0.002 * (0.5 + uniform())).collect();
+            let psi: Vec<f64> = (0..n).map(|_| 2.0 * PI * uniform()).collect();
+            let spread = [0.02, 0.2, 1.0][case % 3];
+            let phi: Vec<f64> = psi
+                .iter()
+                .map(|p| {
+                    p + spread * (2.0 * uniform() - 1.0)
+                        + if case % 7 == 0 { 4.0 * PI } else { 0.0 }
+                })
+                .collect();
+            let target: Complex64 = (0..n).map(|j| Complex64::from_polar(c[j], psi[j])).sum();
+            let upper = (0..n)
+                .map(|j| wrap(phi[j] - psi[j]).abs())
+                .fold(0.0, f64::max);
+            same_as_reference(&c, &phi, target, upper.min(PI));
         }
     }
 
