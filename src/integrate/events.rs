@@ -80,12 +80,17 @@ pub(crate) fn crossed(before: f64, after: f64) -> bool {
     (before > 0.0 && after <= 0.0) || (before < 0.0 && after >= 0.0)
 }
 
-/// Whether g, falling at the step's start (rate `r0` < 0) and rising at its
-/// end (`r1` > 0), may have dipped below zero in between: only when its
-/// ends are within twice the step's largest rate times the step length of
-/// zero (a dip below both ends is at most about that deep).
+/// Whether g, not rising at the step's start (rate `r0` ≤ 0: a pair that
+/// has just parted starts at rest) and rising at its end (`r1` > 0), may
+/// have dipped below zero in between: only when its ends are within twice
+/// the step's largest rate times the step length of zero (a dip below both
+/// ends is at most about that deep).
 pub(crate) fn may_dip(g: (f64, f64), r: (f64, f64), h: f64) -> bool {
-    r.0 < 0.0 && r.1 > 0.0 && g.0 > 0.0 && g.1 > 0.0 && g.0.min(g.1) <= 2.0 * h * r.0.abs().max(r.1)
+    r.0 <= 0.0
+        && r.1 > 0.0
+        && g.0 > 0.0
+        && g.1 > 0.0
+        && g.0.min(g.1) <= 2.0 * h * r.0.abs().max(r.1)
 }
 
 /// Golden-section steps of the search for a dip: the bracket shrinks to

@@ -51,6 +51,7 @@ mod results_folder;
 mod return_when_dearer;
 mod rigid_agreement;
 mod rigid_contact;
+mod rigid_drum;
 mod rolling_resistance;
 mod sample_bounds;
 mod schema;

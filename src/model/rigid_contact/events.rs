@@ -161,9 +161,61 @@ fn resolve<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64], touching: f
             changed = true;
         }
         changed |= open_pulling_links(system, t, y);
+        // Opening the link that pulls hardest, one at a time, can leave a
+        // pair at touching, at rest relative to each other, that the links
+        // left would still press together: it does not part, so it links
+        // again (otherwise it closes at once: an event nanoseconds later,
+        // or, within a step, an overlap the ends of the step do not show).
+        if !changed {
+            changed = link_pressed_pair(system, t, y, touching.max(GAP_OFFSET));
+        }
         if !changed {
             return;
         }
+    }
+}
+
+/// Link the first open pair within `touching` of touching, at rest
+/// relative to each other, whose free motion would close it; whether one
+/// was linked.
+fn link_pressed_pair<S: Clustered + ?Sized>(
+    system: &S,
+    t: f64,
+    y: &mut [f64],
+    touching: f64,
+) -> bool {
+    let rc = system.rigid();
+    let (first, nq) = (system.first_weight(), system.coordinates());
+    let n = rc.half_angle.len();
+    let resting: Vec<usize> = {
+        let mode = rc.mode.borrow();
+        (0..mode.pairs.len())
+            .filter(|&k| {
+                let RingPair { behind, ahead, .. } = mode.pairs[k];
+                !mode.linked[k]
+                    && y[nq + first + ahead] == y[nq + first + behind]
+                    && rc.gap(&mode.pairs[k], &y[first..first + n]) <= touching
+            })
+            .collect()
+    };
+    if resting.is_empty() {
+        return false;
+    }
+    refresh_torques(system, t, y);
+    let closing = {
+        let accel = &rc.scratch().dydt;
+        let mode = rc.mode.borrow();
+        resting.into_iter().find(|&k| {
+            let RingPair { behind, ahead, .. } = mode.pairs[k];
+            accel[nq + first + ahead] < accel[nq + first + behind]
+        })
+    };
+    match closing {
+        Some(k) => {
+            impact(system, t, y, k, 0.0);
+            true
+        }
+        None => false,
     }
 }
 
