@@ -2,10 +2,9 @@
 //! answers are from a reference, on a sample of a study's runs.
 //!
 //! Reference: the inertial (`full`) equations with DOP853 at rtol 1e-11,
-//! with penalty contact (the only contact model the inertial frame has).
-//! Where the rotating frame applies and the weights touch, the other contact
-//! model is measured too: rigid contact for a penalty study, penalty for a
-//! rigid one (whose inertial settings run penalty). Each setting is
+//! with the study's contact model. Where the weights touch, the other
+//! contact model is measured too (rigid contact for a penalty study, penalty
+//! for a rigid one), in the cheapest frame the scene has. Each setting is
 //! measured on the same runs; errors are per run (settling time in
 //! revolutions, residual vibration in units of A_ref, final cargo angles,
 //! outcome class), costs are wall time and right-hand-side calls.
@@ -155,9 +154,7 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
         return_when_dearer: true,
         contact: None,
     };
-    let study_rigid = study_contact(plan) == Some(ContactModel::Rigid);
-    // The inertial frame holds penalty contact only.
-    let inertial_contact = study_rigid.then_some(ContactModel::Penalty);
+
     let mut v = Vec::new();
     let probe = plan.scene(&plan.designs[0], 0.0, 0.0);
     let mut frames = vec![
@@ -179,24 +176,25 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
                 method,
                 rtol: 10f64.powi(-e),
                 return_when_dearer: true,
-                contact: (fidelity == Fidelity::Full)
-                    .then_some(inertial_contact)
-                    .flatten(),
+                contact: None,
             });
         }
     }
-    // The other contact model, where the weights touch and the rotating
-    // frame can hold rigid contact: at the study's tolerance and at 1e-10.
-    if let Some(model) = study_contact(plan)
-        && rotating_frame_obstacle(&probe).is_none()
-    {
+    // The other contact model, where the weights touch, in the cheapest
+    // frame: at the study's tolerance and at 1e-10.
+    if let Some(model) = study_contact(plan) {
         let other = match model {
             ContactModel::Penalty => ContactModel::Rigid,
             ContactModel::Rigid => ContactModel::Penalty,
         };
+        let fidelity = if rotating_frame_obstacle(&probe).is_none() {
+            Fidelity::Rotating
+        } else {
+            Fidelity::Full
+        };
         for rtol in [plan.file.solver.rtol, 1e-10] {
             v.push(Setting {
-                fidelity: Fidelity::Rotating,
+                fidelity,
                 method: MethodChoice::Fixed(Method::Dp5),
                 rtol,
                 return_when_dearer: true,
@@ -213,23 +211,21 @@ pub fn settings(plan: &StudyPlan) -> Vec<Setting> {
             method: MethodChoice::Fixed(Method::Dp5),
             rtol: solver.rtol,
             return_when_dearer: false,
-            contact: inertial_contact,
+            contact: None,
         });
     }
     v
 }
 
 /// The setting every other is measured against: the inertial equations with
-/// DOP853 at rtol 1e-11 (with penalty contact, which a rigid study's
-/// inertial settings run too).
-pub fn reference(plan: &StudyPlan) -> Setting {
+/// DOP853 at rtol 1e-11, with the study's contact model.
+pub fn reference(_plan: &StudyPlan) -> Setting {
     Setting {
         fidelity: Fidelity::Full,
         method: MethodChoice::Fixed(Method::Dop853),
         rtol: 1e-11,
         return_when_dearer: true,
-        contact: (study_contact(plan) == Some(ContactModel::Rigid))
-            .then_some(ContactModel::Penalty),
+        contact: None,
     }
 }
 

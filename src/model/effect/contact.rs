@@ -38,7 +38,7 @@ pub struct ContactSpec {
     /// How contact is modelled: `penalty` (a stiff spring and damper
     /// between overlapping weights, the default) or `rigid` (weights that
     /// touch move as one until the force between them would pull: no
-    /// overlap, no stiffness; the rotating frame only, so far).
+    /// overlap, no stiffness).
     #[serde(default)]
     pub model: ContactModel,
     /// Rigid contact: the ratio of parting to closing speed in an impact,
