@@ -30,7 +30,7 @@ CRATE_LAYERS = [
 ]
 MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",
-     "tilt_inertia", "sommerfeld"},
+     "tilt_inertia", "sommerfeld", "rigid_contact"},
     {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "balanced_family", "quasi_static", "start",
      "unbalance", "zero_approx", "critical_speeds"},
 ]

@@ -20,7 +20,7 @@ use super::rigid_contact::{self, Clustered, RigidContact};
 use super::scene::Scene;
 use super::speed::SpeedLaw;
 use super::validate::SceneError;
-use crate::integrate::{CouplingStructure, EventFlow, Events, HeadEquation, OdeSystem};
+use crate::integrate::{CouplingStructure, Events, HeadEquation, OdeSystem};
 use std::cell::RefCell;
 
 /// Why a scene cannot use the rotating frame.
@@ -124,14 +124,8 @@ impl RotatingSystem {
     /// How contact between the weights is modelled: "rigid" (held here as
     /// constraints), "penalty" (a force among the effects) or none.
     pub fn contact_model(&self) -> Option<&'static str> {
-        if self.rigid.is_some() {
-            Some("rigid")
-        } else {
-            self.effects
-                .iter()
-                .any(|e| e.name() == "contact")
-                .then_some("penalty")
-        }
+        let penalty = self.effects.iter().any(|e| e.name() == "contact");
+        RigidContact::model_name(self.rigid.is_some(), penalty)
     }
 
     /// The constant spin speed ω.
@@ -469,47 +463,4 @@ impl Clustered for RotatingSystem {
     }
 }
 
-impl Events for RotatingSystem {
-    fn count(&self) -> usize {
-        self.rigid().count()
-    }
-
-    fn values(&self, t: f64, y: &[f64], out: &mut [f64]) {
-        rigid_contact::values(self, t, y, out);
-    }
-
-    fn value(&self, k: usize, t: f64, y: &[f64]) -> f64 {
-        rigid_contact::value(self, k, t, y)
-    }
-
-    fn handle(&self, t: f64, y: &mut [f64], k: usize, falling: bool) -> EventFlow {
-        rigid_contact::handle(self, t, y, k, falling)
-    }
-
-    fn rhs_calls(&self) -> u64 {
-        self.rigid().rhs_calls()
-    }
-
-    fn project(&self, _t: f64, y: &mut [f64]) -> bool {
-        rigid_contact::project(self, y)
-    }
-
-    fn clear(&self, t: f64, y: &[f64]) -> bool {
-        rigid_contact::mode_holds(
-            self,
-            t,
-            y,
-            rigid_contact::CLEAR_GAP,
-            rigid_contact::CLEAR_PRESS,
-        )
-    }
-
-    fn rates(&self, _t: f64, y: &[f64], out: &mut [f64]) -> bool {
-        rigid_contact::rates(self, y, out);
-        true
-    }
-
-    fn start(&self, t: f64, y: &mut [f64]) {
-        rigid_contact::start(self, t, y);
-    }
-}
+crate::rigid_contact_events!(RotatingSystem);

@@ -43,13 +43,7 @@ pub fn start<S: Clustered + ?Sized>(system: &S, t: f64, y: &mut [f64]) {
 /// linked pair's torque past −λ_tol.
 pub fn values<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64], out: &mut [f64]) {
     let rc = system.rigid();
-    let stale = {
-        let mode = rc.mode.borrow();
-        mode.any_linked() && !mode.torques_current(t, y)
-    };
-    if stale {
-        refresh_torques(system, t, y);
-    }
+    current_torques(system, t, y);
     let first = system.first_weight();
     let psi = &y[first..first + rc.half_angle.len()];
     let mode = rc.mode.borrow();
@@ -261,6 +255,18 @@ pub fn project<S: Clustered + ?Sized>(system: &S, y: &mut [f64]) -> bool {
     moved
 }
 
+/// Make the mode's torques those at (t, y), unless no link needs one or
+/// they already are (an explicit method's last stage leaves them).
+fn current_torques<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64]) {
+    let stale = {
+        let mode = system.rigid().mode.borrow();
+        mode.any_linked() && !mode.torques_current(t, y)
+    };
+    if stale {
+        refresh_torques(system, t, y);
+    }
+}
+
 /// Evaluate the right-hand side at (t, y) for its side effect: the mode's
 /// torques.
 fn refresh_torques<S: Clustered + ?Sized>(system: &S, t: f64, y: &[f64]) {
@@ -386,13 +392,7 @@ pub fn mode_holds<S: Clustered + ?Sized>(
     press: f64,
 ) -> bool {
     let rc = system.rigid();
-    let stale = {
-        let mode = rc.mode.borrow();
-        mode.any_linked() && !mode.torques_current(t, y)
-    };
-    if stale {
-        refresh_torques(system, t, y);
-    }
+    current_torques(system, t, y);
     let first = system.first_weight();
     let psi = &y[first..first + rc.half_angle.len()];
     let mode = rc.mode.borrow();

@@ -24,6 +24,57 @@
 
 mod events;
 
+/// `impl Events for $system` by rigid contact's event logic, for a system
+/// that implements [`Clustered`]: the one registration line a system with
+/// rigid contact needs (both frames' systems use it).
+#[macro_export]
+macro_rules! rigid_contact_events {
+    ($system:ty) => {
+        impl $crate::integrate::Events for $system {
+            fn count(&self) -> usize {
+                $crate::model::rigid_contact::Clustered::rigid(self).count()
+            }
+            fn values(&self, t: f64, y: &[f64], out: &mut [f64]) {
+                $crate::model::rigid_contact::values(self, t, y, out);
+            }
+            fn value(&self, k: usize, t: f64, y: &[f64]) -> f64 {
+                $crate::model::rigid_contact::value(self, k, t, y)
+            }
+            fn handle(
+                &self,
+                t: f64,
+                y: &mut [f64],
+                k: usize,
+                falling: bool,
+            ) -> $crate::integrate::EventFlow {
+                $crate::model::rigid_contact::handle(self, t, y, k, falling)
+            }
+            fn rhs_calls(&self) -> u64 {
+                $crate::model::rigid_contact::Clustered::rigid(self).rhs_calls()
+            }
+            fn project(&self, _t: f64, y: &mut [f64]) -> bool {
+                $crate::model::rigid_contact::project(self, y)
+            }
+            fn clear(&self, t: f64, y: &[f64]) -> bool {
+                $crate::model::rigid_contact::mode_holds(
+                    self,
+                    t,
+                    y,
+                    $crate::model::rigid_contact::CLEAR_GAP,
+                    $crate::model::rigid_contact::CLEAR_PRESS,
+                )
+            }
+            fn rates(&self, _t: f64, y: &[f64], out: &mut [f64]) -> bool {
+                $crate::model::rigid_contact::rates(self, y, out);
+                true
+            }
+            fn start(&self, t: f64, y: &mut [f64]) {
+                $crate::model::rigid_contact::start(self, t, y);
+            }
+        }
+    };
+}
+
 pub use events::{Clustered, handle, mode_holds, project, rates, start, value, values};
 
 use super::cargo::Cargo;
@@ -271,6 +322,17 @@ impl RigidContact {
     /// The buffers the systems fill for the events.
     pub fn scratch(&self) -> RefMut<'_, Scratch> {
         self.scratch.borrow_mut()
+    }
+
+    /// How contact is modelled by a system that holds rigid contact (or
+    /// not) and has the penalty contact effect among its effects (or not):
+    /// "rigid", "penalty" or none.
+    pub fn model_name(rigid: bool, penalty: bool) -> Option<&'static str> {
+        if rigid {
+            Some("rigid")
+        } else {
+            penalty.then_some("penalty")
+        }
     }
 
     /// Right-hand sides evaluated for the events so far.
