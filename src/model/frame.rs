@@ -327,44 +327,23 @@ impl RotatingSystem {
         let mut mode = rigid.mode();
         let (clusters, torque) = mode.clusters_and_torques();
         let mut trig = self.trig.borrow_mut();
-        let mut sums = self.cluster_sums.borrow_mut();
-        sums.clear();
-        // One pass over the clusters: each weight's force Q (kept in its
-        // slot of dydt for the torques), the head's centrifugal terms, and
-        // the cluster's (1/I, w, Q) eliminated from the head at once.
+        // Each weight's force Q (kept in its slot of dydt for the torques)
+        // and the head's centrifugal terms.
         let cargo_f = &mut dydt[nq + 2..];
-        let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
-        for c in 0..clusters.len() {
-            let (mut inertia, mut wr, mut wi, mut q) = (0.0, 0.0, 0.0, 0.0);
-            for &j in clusters.members(c) {
-                let (s, co) = super::trig::sin_cos(psi[j]);
-                trig[j] = (s, co);
-                let ml = self.mass_track[j];
-                let rate = w + psi_rate[j];
-                gr += ml * rate * rate * co;
-                gi += ml * rate * rate * s;
-                let qj = cargo_f[j] - ml * (fi * co - fr * s);
-                cargo_f[j] = qj;
-                inertia += self.inertia[j];
-                wr -= ml * s;
-                wi += ml * co;
-                q += qj;
-            }
-            let inv = 1.0 / inertia;
-            a11 -= wr * wr * inv;
-            a12 -= wr * wi * inv;
-            a22 -= wi * wi * inv;
-            gr -= wr * q * inv;
-            gi -= wi * q * inv;
-            sums.push([inv, wr, wi, q]);
+        for j in 0..n {
+            let (s, co) = super::trig::sin_cos(psi[j]);
+            trig[j] = (s, co);
+            let ml = self.mass_track[j];
+            let rate = w + psi_rate[j];
+            gr += ml * rate * rate * co;
+            gi += ml * rate * rate * s;
+            cargo_f[j] -= ml * (fi * co - fr * s);
         }
-        let det = a11 * a22 - a12 * a12;
-        let ar = (gr * a22 - gi * a12) / det;
-        let ai = (gi * a11 - gr * a12) / det;
+        let (ar, ai) = self.eliminate_clusters(clusters, &trig, cargo_f, (gr, gi));
         // Each member's acceleration is its cluster's; the torque of the
         // link after member i is what members up to i owe their own rows,
         // Σ (Q − I a − w·z).
-        for (c, &[inv, wr, wi, q]) in sums.iter().enumerate() {
+        for (c, &[inv, wr, wi, q]) in self.cluster_sums.borrow().iter().enumerate() {
             let a = (q - (wr * ar + wi * ai)) * inv;
             let links = clusters.links(c);
             let mut carried = 0.0;
@@ -383,19 +362,19 @@ impl RotatingSystem {
         mode.recorded_at(t, y);
     }
 
-    /// Solve M·(ü, v̈, ψ̈) = (g, forces) with the clusters moving as one:
-    /// writes each weight's ψ̈ into `accel` and returns (ü, v̈). `trig` holds
-    /// (sin ψ, cos ψ) of each weight.
-    fn solve_clusters(
+    /// Eliminate the clusters from M·(ü, v̈, ψ̈) = (g, forces), each as one
+    /// weight of inertia Σ I, reaction Σ w and force Σ Q, and solve the head:
+    /// returns (ü, v̈) and leaves each cluster's (1/I, w, Q) in
+    /// `cluster_sums` for its acceleration (Q − w·z)/I. `trig` holds (sin ψ,
+    /// cos ψ) of each weight.
+    fn eliminate_clusters(
         &self,
         clusters: &rigid_contact::Clusters,
         trig: &[(f64, f64)],
         forces: &[f64],
         (mut gr, mut gi): (f64, f64),
-        accel: &mut [f64],
     ) -> (f64, f64) {
         let (mut a11, mut a12, mut a22) = (self.m_total, 0.0, self.m_total);
-        // Each cluster's (1/I, w, Q) once: the sums serve both passes.
         let mut sums = self.cluster_sums.borrow_mut();
         sums.clear();
         for c in 0..clusters.len() {
@@ -417,15 +396,7 @@ impl RotatingSystem {
             sums.push([inv, wr, wi, q]);
         }
         let det = a11 * a22 - a12 * a12;
-        let ar = (gr * a22 - gi * a12) / det;
-        let ai = (gi * a11 - gr * a12) / det;
-        for (c, &[inv, wr, wi, q]) in sums.iter().enumerate() {
-            let a = (q - (wr * ar + wi * ai)) * inv;
-            for &j in clusters.members(c) {
-                accel[j] = a;
-            }
-        }
-        (ar, ai)
+        ((gr * a22 - gi * a12) / det, (gi * a11 - gr * a12) / det)
     }
 }
 
@@ -451,13 +422,14 @@ impl Clustered for RotatingSystem {
             *tr = super::trig::sin_cos(p);
         }
         let mode = self.rigid().mode();
-        let (ar, ai) = self.solve_clusters(
-            mode.clusters(),
-            &trig,
-            impulse,
-            (0.0, 0.0),
-            &mut response[2..],
-        );
+        let clusters = mode.clusters();
+        let (ar, ai) = self.eliminate_clusters(clusters, &trig, impulse, (0.0, 0.0));
+        for (c, &[inv, wr, wi, q]) in self.cluster_sums.borrow().iter().enumerate() {
+            let a = (q - (wr * ar + wi * ai)) * inv;
+            for &j in clusters.members(c) {
+                response[2 + j] = a;
+            }
+        }
         response[0] = ar;
         response[1] = ai;
     }
