@@ -39,7 +39,7 @@ STUDY_LAYERS = [
     # design's measured runs, files.
     {"stream", "truncated", "distribution", "design", "measured_runs", "io", "lock", "runs_file", "summary_columns", "results_table"},
     # The parts of the study file that check, draw or measure on their own.
-    {"couple", "tolerance", "plane_designs", "criterion", "optimize_spec"},
+    {"couple", "tolerance", "uncertain", "plane_designs", "criterion", "optimize_spec"},
     # The study file and its resolved plan.
     {"config"},
     # One run or one design, from a plan.

@@ -7,6 +7,7 @@
 //! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
 //! - [`sample`]: the draws of one run (unbalance, direction, start angles).
 //! - [`tolerance`]: manufacturing tolerances of the weights, sampled per run.
+//! - [`uncertain`]: scene keys given a distribution (`[uncertain]`), drawn per sample.
 //! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
 //! - [`record`]: one row of `runs.parquet`.
@@ -59,4 +60,5 @@ pub mod summary_columns;
 pub mod sweep;
 pub mod tolerance;
 pub mod truncated;
+pub mod uncertain;
 pub mod verdict;

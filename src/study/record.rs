@@ -3,8 +3,10 @@
 
 use super::couple::{SampledCouple, plane_unbalances};
 use super::tolerance::SampledWeights;
+use super::uncertain::{COLUMN_PREFIX, UncertainValue};
 use crate::metrics::{Outcome, RunMetrics};
 use polars::prelude::*;
+use std::sync::Arc;
 
 /// Everything recorded about one run.
 #[derive(Clone, PartialEq)]
@@ -55,6 +57,9 @@ pub struct RunRecord {
     /// The couple part of the unbalance, when the study samples one
     /// (`[sampling.couple]`; columns [`COUPLE_COLUMNS`], absent otherwise).
     pub couple: Option<SampledCouple>,
+    /// The uncertain scene keys' drawn values (`[uncertain]`; a column
+    /// `scene.<key>` each, absent when the study has none).
+    pub uncertain: Vec<UncertainValue>,
 }
 
 /// As derived, but `weights` and `couple` are shown only when the study sampled them: the
@@ -87,6 +92,9 @@ impl std::fmt::Debug for RunRecord {
         }
         if let Some(c) = &self.couple {
             s.field("couple", c);
+        }
+        if !self.uncertain.is_empty() {
+            s.field("uncertain", &self.uncertain);
         }
         s.finish()
     }
@@ -293,7 +301,46 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
                 .map(|r| per_plane(r).iter().map(|p| p.1.to_degrees()).collect()),
         ));
     }
+    columns.extend(uncertain_columns(rows));
     DataFrame::new(rows.len(), columns)
+}
+
+/// One column `scene.<key>` per uncertain key, in the study's key order
+/// (every row of a study draws the same keys).
+fn uncertain_columns(rows: &[RunRecord]) -> Vec<Column> {
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    first
+        .uncertain
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let values: Vec<Option<f64>> = rows
+                .iter()
+                .map(|r| r.uncertain.get(k).map(|u| u.value))
+                .collect();
+            Column::new(format!("{COLUMN_PREFIX}{}", v.key).into(), values)
+        })
+        .collect()
+}
+
+/// Each row's uncertain keys, read back from the `scene.<key>` columns.
+fn uncertain_from(df: &DataFrame) -> PolarsResult<Vec<Vec<UncertainValue>>> {
+    let mut out = vec![Vec::new(); df.height()];
+    for column in df.columns() {
+        let Some(key) = column.name().as_str().strip_prefix(COLUMN_PREFIX) else {
+            continue;
+        };
+        let key: Arc<str> = Arc::from(key);
+        for (row, value) in out.iter_mut().zip(column.f64()?.iter()) {
+            row.push(UncertainValue {
+                key: key.clone(),
+                value: value.unwrap_or(f64::NAN),
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// A list column of f64 as one vector per row, nulls kept (a plane that did
@@ -500,6 +547,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
     } else {
         None
     };
+    let mut uncertain = uncertain_from(df)?.into_iter();
     let mut out = Vec::with_capacity(df.height());
     for i in 0..df.height() {
         out.push(RunRecord {
@@ -578,6 +626,7 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
             wall_time_s: wall[i],
             weights: weights.as_ref().map(|w| w[i].clone()),
             couple: couple.as_ref().map(|c| c[i]),
+            uncertain: uncertain.next().unwrap_or_default(),
         });
     }
     Ok(out)

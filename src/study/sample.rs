@@ -14,6 +14,7 @@ use super::distribution::{DirectionSpec, InitialSpec, Scale};
 use super::stream::{Draws, draws};
 pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
+use super::uncertain::UncertainValue;
 use crate::design::geometry::{half_angle, pressed_angles};
 use crate::model::scene::Scene;
 use crate::model::start::balanced_fan;
@@ -37,6 +38,12 @@ pub struct Sample {
     pub weights: Option<SampledWeights>,
     /// The couple part, when the study samples one (`[sampling.couple]`).
     pub couple: Option<super::couple::SampledCouple>,
+    /// The uncertain scene keys' values (`[uncertain]`, key order), empty
+    /// when the study has none.
+    pub uncertain: Vec<UncertainValue>,
+    /// Why the uncertain keys' draw could not be written into the scene
+    /// (the run is then recorded as failed with this reason).
+    pub uncertain_refused: Option<String>,
 }
 
 /// Draw the sample of run (design, sample index).
@@ -79,6 +86,8 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
                 (unbalance, direction),
             )
         }),
+        uncertain: super::uncertain::draw(&plan.file.uncertain, (seed, shared, sequence), sample),
+        uncertain_refused: None,
     }
 }
 

@@ -46,6 +46,9 @@ pub enum Purpose {
     /// Bootstrap resampling of a comparison at a look of a race
     /// (`super::racing`).
     Racing = 9,
+    /// An uncertain scene key (`super::uncertain`; the key's name is mixed
+    /// into the seed, so each key has a stream of its own).
+    Uncertain = 10,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for

@@ -297,6 +297,7 @@ fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<Run
                 wall_time_s: 0.001,
                 weights: None,
                 couple: None,
+                uncertain: Vec::new(),
             });
         }
     }

@@ -283,6 +283,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
                     wall_time_s: 0.001,
                     weights: None,
                     couple: None,
+                    uncertain: Vec::new(),
                 });
             }
             let p = settled_count as f64 / f64::from(samples);

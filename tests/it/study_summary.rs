@@ -92,6 +92,7 @@ fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> Ru
         wall_time_s: 0.001,
         weights: None,
         couple: None,
+        uncertain: Vec::new(),
     }
 }
 

@@ -46,6 +46,11 @@ pub struct StudyFile {
     pub designs: DesignGrid,
     /// What is sampled for each design.
     pub sampling: Sampling,
+    /// Scene keys nobody measured exactly, each with a distribution, drawn
+    /// per sample (`"effects.rolling_resistance.coefficient" = { distribution
+    /// = "log_uniform", min = 3e-4, max = 3e-3 }`).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub uncertain: super::uncertain::UncertainSpec,
     /// Integrator settings.
     #[serde(default)]
     pub solver: SolverSettings,

@@ -413,12 +413,14 @@ impl StudyFile {
                 ),
             ));
         }
-        Ok(StudyPlan {
+        let plan = StudyPlan {
             name,
             file: self,
             designs,
             text: text.to_string(),
-        })
+        };
+        plan.check_uncertain().map_err(refused)?;
+        Ok(plan)
     }
 
     /// The unbalance (kg·m) the weights must add, besides cancelling the
@@ -617,6 +619,58 @@ impl StudyFile {
 }
 
 /// Map a scene validation error onto the study file's keys.
+impl StudyPlan {
+    /// The `[uncertain]` keys against every design's scene: each key set by
+    /// the scene and by nothing the study draws per run, and both ends of
+    /// its distribution valid (scene checks and the metrics' horizon).
+    fn check_uncertain(&self) -> Result<(), InvalidKey> {
+        use super::super::uncertain::{read, validate};
+        let spec = &self.file.uncertain;
+        if let (Some(_), Some(key)) = (
+            self.file
+                .sampling
+                .tolerances
+                .as_ref()
+                .and_then(|t| t.eccentricity.as_ref()),
+            spec.keys()
+                .find(|k| k.starts_with("effects.race_eccentricity")),
+        ) {
+            return Err(InvalidKey::new(
+                format!("uncertain.\"{key}\""),
+                key.clone(),
+                "sampling.tolerances.eccentricity already draws the race's offset per run: give the race eccentricity one of the two",
+            ));
+        }
+        for design in &self.designs {
+            // Two runs' scenes: a key whose value moves between them, or
+            // away from the file's, is one the study sets itself.
+            let runs = [(0.5, 0.3), (0.8, 2.1)].map(|(fraction, direction)| {
+                self.scene(design, fraction * design.capacity, direction)
+            });
+            for key in spec.keys() {
+                let file = read(&self.file.scene, key).ok();
+                let ran = runs.each_ref().map(|s| read(s, key).ok());
+                if ran[0] != ran[1] || (file.is_some() && ran[0] != file) {
+                    return Err(InvalidKey::new(
+                        format!("uncertain.\"{key}\""),
+                        key.clone(),
+                        "the study sets this key itself in every run (the sampled unbalance is drawn in [sampling], a design's values in [designs]): it cannot also be uncertain",
+                    ));
+                }
+            }
+            let (kind, n) = (design.spec.kind, design.spec.n);
+            validate(spec, &runs[0], |scene| {
+                scene.validate().map_err(|e| scene_error_key(e, kind, n))?;
+                self.file
+                    .metrics
+                    .check_horizon(&scene.speed)
+                    .map_err(|e| scene_error_key(e, kind, n))
+            })?;
+        }
+        Ok(())
+    }
+}
+
 fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> InvalidKey {
     match e {
         SceneError::Invalid {

@@ -40,6 +40,14 @@ pub fn sample_simulation(
         super::super::couple::apply(&mut scene.rotor, at, &planes);
     }
     sample.weights = draw_weights(plan, design, sample_id, &mut scene);
+    if !sample.uncertain.is_empty() {
+        // Validated up front at both ends of every key's support; a draw
+        // that still does not read back fails its run with the reason.
+        match super::super::uncertain::apply(&scene, &sample.uncertain) {
+            Ok(varied) => scene = varied,
+            Err(reason) => sample.uncertain_refused = Some(reason),
+        }
+    }
     let simulation = Simulation {
         scene,
         start: plan.file.scene.start,
@@ -66,7 +74,12 @@ pub fn run_design_sample(
         .as_ref()
         .is_some_and(|c| c.enabled);
     let clock = Instant::now();
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| simulation.run(false)));
+    let result = match &sample.uncertain_refused {
+        Some(reason) => Ok(Err(reason.clone())),
+        None => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            simulation.run(false).map_err(|e| e.to_string())
+        })),
+    };
     let metrics = match result {
         Ok(Ok(r)) => r.metrics,
         Ok(Err(e)) => failed(format!("invalid scene: {e}")),
@@ -109,6 +122,7 @@ pub fn run_design_sample(
         wall_time_s: clock.elapsed().as_secs_f64(),
         weights: sample.weights,
         couple: sample.couple,
+        uncertain: sample.uncertain,
     }
 }
 
