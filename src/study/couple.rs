@@ -19,7 +19,7 @@
 
 use super::design::Design;
 use super::distribution::{DirectionSpec, Scale, UnbalanceSpec, draw_value};
-use super::stream::{Purpose, Sequence, draws};
+use super::stream::{Purpose, RunStreams};
 use crate::invalid_key::InvalidKey;
 use crate::model::rotor::RotorModel;
 use crate::model::rotor::two_support::PointUnbalance;
@@ -168,7 +168,7 @@ pub fn validate(
 /// (U_s, θ_s) drawn for it.
 pub fn draw(
     spec: &CoupleSpec,
-    (seed, shared, sequence): (u64, Option<u32>, Sequence),
+    streams: &RunStreams,
     design: &Design,
     sample: u64,
     static_part: (f64, f64),
@@ -186,7 +186,7 @@ pub fn draw(
         .unbalance
         .as_ref()
         .expect("validated: unbalance or follows_static");
-    let mut rng = draws(seed, shared, sample, Purpose::Couple, sequence);
+    let mut rng = streams.draws(sample, Purpose::Couple);
     let value = draw_value(&spec_u.distribution, &mut rng);
     let (unbalance, fraction) = match spec_u.scale() {
         Scale::Capacity => (value * design.capacity, value),

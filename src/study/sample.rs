@@ -11,7 +11,7 @@ use super::config::StudyPlan;
 use super::design::Design;
 pub use super::distribution::draw_value;
 use super::distribution::{DirectionSpec, InitialSpec, Scale};
-use super::stream::{Draws, draws};
+use super::stream::{Draws, Matrix, RunStreams};
 pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
 use super::uncertain::UncertainValue;
@@ -48,11 +48,16 @@ pub struct Sample {
 
 /// Draw the sample of run (design, sample index).
 pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
+    draw_sample_in(plan, design, sample, Matrix::A)
+}
+
+/// Draw the sample of run (design, sample index) from the set of draws
+/// `matrix` names for each input (a sensitivity analysis's A, B and AB_i;
+/// a study's own runs are [`Matrix::A`]).
+pub fn draw_sample_in(plan: &StudyPlan, design: &Design, sample: u64, matrix: Matrix) -> Sample {
     let s = &plan.file.sampling;
-    let seed = plan.file.seed;
-    let shared = shared(plan, design);
-    let sequence = s.sequence;
-    let mut rng = draws(seed, shared, sample, Purpose::Unbalance, sequence);
+    let streams = run_streams(plan, design, matrix);
+    let mut rng = streams.draws(sample, Purpose::Unbalance);
     let value = draw_value(&s.unbalance.distribution, &mut rng);
     let (unbalance, fraction) = match s.unbalance.scale() {
         Scale::Capacity => (value * design.capacity, value),
@@ -67,7 +72,7 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
     let initial_angles = std::iter::once(design)
         .chain(&design.plane_designs)
         .flat_map(|d| {
-            let mut rng = draws(seed, shared, sample, Purpose::Initial, sequence);
+            let mut rng = streams.draws(sample, Purpose::Initial);
             initial_angles(&s.initial, d, &mut rng, unbalance, direction)
         })
         .collect();
@@ -78,26 +83,26 @@ pub fn draw_sample(plan: &StudyPlan, design: &Design, sample: u64) -> Sample {
         initial_angles,
         weights: None,
         couple: s.couple.as_ref().map(|spec| {
-            super::couple::draw(
-                spec,
-                (seed, shared, sequence),
-                design,
-                sample,
-                (unbalance, direction),
-            )
+            super::couple::draw(spec, &streams, design, sample, (unbalance, direction))
         }),
-        uncertain: super::uncertain::draw(&plan.file.uncertain, (seed, shared, sequence), sample),
+        uncertain: super::uncertain::draw(&plan.file.uncertain, &streams, sample),
         uncertain_refused: None,
     }
 }
 
-/// The design index of a run's streams: none when every design meets the
-/// same draws (common random numbers, the default).
-fn shared(plan: &StudyPlan, design: &Design) -> Option<u32> {
-    if plan.file.sampling.common_random_numbers {
-        None
-    } else {
-        Some(design.id)
+/// The streams of a design's runs: the study's seed and sequence, and the
+/// design index only when designs do not share their draws (common random
+/// numbers, the default).
+pub fn run_streams(plan: &StudyPlan, design: &Design, matrix: Matrix) -> RunStreams {
+    RunStreams {
+        seed: plan.file.seed,
+        shared: if plan.file.sampling.common_random_numbers {
+            None
+        } else {
+            Some(design.id)
+        },
+        sequence: plan.file.sampling.sequence,
+        matrix,
     }
 }
 
@@ -108,13 +113,13 @@ pub fn draw_weights(
     plan: &StudyPlan,
     design: &Design,
     sample: u64,
+    matrix: Matrix,
     scene: &mut Scene,
 ) -> Option<SampledWeights> {
     let t = plan.file.sampling.tolerances.as_ref()?;
-    let shared = shared(plan, design);
     Some(super::tolerance::apply(
         t,
-        (plan.file.seed, shared, plan.file.sampling.sequence),
+        &run_streams(plan, design, matrix),
         design,
         sample,
         scene,

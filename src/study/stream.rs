@@ -24,7 +24,7 @@ pub fn splitmix64(mut z: u64) -> u64 {
 }
 
 /// Purposes of streams, so that independent draws never share a stream.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u64)]
 pub enum Purpose {
     /// Unbalance magnitude and direction.
@@ -60,6 +60,86 @@ pub fn stream(seed: u64, design: Option<u32>, sample: u64, purpose: Purpose) -> 
     h = splitmix64(h ^ sample);
     h = splitmix64(h ^ purpose as u64);
     Xoshiro256PlusPlus::seed_from_u64(h)
+}
+
+/// An input of a run as a sensitivity analysis sees it: one purpose's
+/// stream, or one uncertain scene key's (by [`key_hash`] of its name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Input {
+    /// Every draw of one purpose (the unbalance's size and direction, the
+    /// start angles, one tolerance, the couple part).
+    Stream(Purpose),
+    /// One uncertain scene key.
+    Key(u64),
+}
+
+/// Which of two independent sets of draws a run takes (the matrices A and B
+/// of Saltelli's pick-freeze design): a study's own runs are A.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Matrix {
+    /// Every input from the study's own streams.
+    #[default]
+    A,
+    /// Every input from the second, independent set.
+    B,
+    /// A, but this one input from B (the matrix AB_i).
+    AWithFromB(Input),
+}
+
+/// Mixed into the seed of the second set of draws (B): "SALTELLI".
+const SECOND_SET: u64 = 0x5341_4C54_454C_4C49;
+
+/// The streams of one run: the study's seed, the design index its streams
+/// share (`None` under common random numbers), the sequence, and which set
+/// each input draws from.
+#[derive(Debug, Clone, Copy)]
+pub struct RunStreams {
+    /// The study's seed.
+    pub seed: u64,
+    /// The design index of the streams; `None` when every design meets the
+    /// same draws.
+    pub shared: Option<u32>,
+    /// Pseudo-random or Sobol.
+    pub sequence: Sequence,
+    /// Which set of draws each input takes.
+    pub matrix: Matrix,
+}
+
+impl RunStreams {
+    /// The draws of `purpose` for sample `sample`.
+    pub fn draws(&self, sample: u64, purpose: Purpose) -> Draws {
+        let seed = self.seed_of(Input::Stream(purpose));
+        draws(seed, self.shared, sample, purpose, self.sequence)
+    }
+
+    /// The draws of one uncertain key (its name's [`key_hash`]): the key is
+    /// mixed into the seed, so that every key has a stream (and a Sobol
+    /// scramble) of its own and adding a key changes no other draw.
+    pub fn key_draws(&self, key: u64, sample: u64) -> Draws {
+        let seed = splitmix64(self.seed_of(Input::Key(key)) ^ key);
+        draws(seed, self.shared, sample, Purpose::Uncertain, self.sequence)
+    }
+
+    fn seed_of(&self, input: Input) -> u64 {
+        let second = match self.matrix {
+            Matrix::A => false,
+            Matrix::B => true,
+            Matrix::AWithFromB(i) => i == input,
+        };
+        if second {
+            splitmix64(self.seed ^ SECOND_SET)
+        } else {
+            self.seed
+        }
+    }
+}
+
+/// FNV-1a of a key's name: a fixed hash (std's is randomised per process),
+/// so that a key's stream is the same in every run of every build.
+pub fn key_hash(key: &str) -> u64 {
+    key.bytes().fold(0xCBF2_9CE4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3)
+    })
 }
 
 /// Where a study's sampled inputs come from (`[sampling] sequence`).

@@ -30,7 +30,7 @@
 //! at a prescribed speed; other studies are refused when validated.
 
 use super::design::Design;
-use super::stream::{Purpose, Sequence, draws};
+use super::stream::{Purpose, RunStreams};
 use crate::invalid_key::InvalidKey;
 use crate::model::balancer::Geometry;
 use crate::model::cargo::Cargo;
@@ -266,13 +266,12 @@ fn truncated<R: rand::Rng + ?Sized>(rng: &mut R, limit: f64) -> f64 {
 /// and put them into `scene` as explicit cargoes (every plane; the plan's
 /// scene holds the nominal design). Returns what was drawn.
 ///
-/// `seed` and `shared` (the design index of the streams, `None` under common
-/// random numbers) are the run's, passed rather than the plan (as for the
-/// couple part) because the study file that holds the tolerances imports
-/// this file; [`super::sample::draw_weights`] reads them from the plan.
+/// The run's streams are passed rather than the plan (as for the couple
+/// part) because the study file that holds the tolerances imports this
+/// file; [`super::sample::draw_weights`] reads them from the plan.
 pub fn apply(
     t: &Tolerances,
-    (seed, shared, sequence): (u64, Option<u32>, Sequence),
+    streams: &RunStreams,
     design: &Design,
     sample: u64,
     scene: &mut Scene,
@@ -285,8 +284,8 @@ pub fn apply(
         0 => design,
         p => design.plane_designs.get(p - 1).unwrap_or(design),
     };
-    let mut mass_rng = draws(seed, shared, sample, Purpose::MassTolerance, sequence);
-    let mut radius_rng = draws(seed, shared, sample, Purpose::RadiusTolerance, sequence);
+    let mut mass_rng = streams.draws(sample, Purpose::MassTolerance);
+    let mut radius_rng = streams.draws(sample, Purpose::RadiusTolerance);
     let mut cargo: Vec<Cargo> = Vec::with_capacity(nominal.len());
     for c in nominal {
         let mut c = match &t.radius {
@@ -323,13 +322,7 @@ pub fn apply(
         cargo.push(c);
     }
     if let Some(tol) = &t.eccentricity {
-        let mut rng = draws(
-            seed,
-            shared,
-            sample,
-            Purpose::EccentricityTolerance,
-            sequence,
-        );
+        let mut rng = streams.draws(sample, Purpose::EccentricityTolerance);
         let (dx, dy) = (
             tol.sigma * truncated(&mut rng, tol.limit),
             tol.sigma * truncated(&mut rng, tol.limit),

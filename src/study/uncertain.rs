@@ -16,7 +16,7 @@
 //! be overwritten per run by the study (the sampled unbalance), and both
 //! ends of its distribution must pass the scene's checks.
 
-use super::stream::{Draws, Purpose, Sequence, draws, splitmix64};
+use super::stream::{RunStreams, key_hash};
 use crate::invalid_key::InvalidKey;
 use crate::model::validate::shown;
 use rand::RngExt;
@@ -181,40 +181,11 @@ pub struct UncertainValue {
     pub value: f64,
 }
 
-/// The stream of one key's draws: the study's (seed, shared design, sample)
-/// under [`Purpose::Uncertain`], with the key's name mixed into the seed so
-/// that every key has a stream (and a Sobol scramble) of its own.
-pub fn key_draws(
-    (seed, shared, sequence): (u64, Option<u32>, Sequence),
-    key: &str,
-    sample: u64,
-) -> Draws {
-    draws(
-        splitmix64(seed ^ name_hash(key)),
-        shared,
-        sample,
-        Purpose::Uncertain,
-        sequence,
-    )
-}
-
-/// FNV-1a of a key's bytes: a fixed hash (std's is randomised per process)
-/// so that a key's stream is the same in every run of every build.
-fn name_hash(key: &str) -> u64 {
-    key.bytes().fold(0xCBF2_9CE4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3)
-    })
-}
-
 /// Every key's value for one run, in the spec's (sorted) key order.
-pub fn draw(
-    spec: &UncertainSpec,
-    streams: (u64, Option<u32>, Sequence),
-    sample: u64,
-) -> Vec<UncertainValue> {
+pub fn draw(spec: &UncertainSpec, streams: &RunStreams, sample: u64) -> Vec<UncertainValue> {
     spec.iter()
         .map(|(key, d)| {
-            let u: f64 = key_draws(streams, key, sample).random();
+            let u: f64 = streams.key_draws(key_hash(key), sample).random();
             UncertainValue {
                 key: Arc::from(key.as_str()),
                 value: d.quantile(u),
@@ -341,6 +312,7 @@ pub fn validate<T: Serialize + DeserializeOwned>(
 
 #[cfg(test)]
 mod tests {
+    use super::super::stream::Sequence;
     use super::*;
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -459,9 +431,15 @@ mod tests {
         let mut two = one.clone();
         two.insert("effects.a".into(), u.clone());
         for sequence in [Sequence::Random, Sequence::Sobol] {
+            let streams = RunStreams {
+                seed: 7,
+                shared: None,
+                sequence,
+                matrix: Default::default(),
+            };
             for sample in 0..16 {
-                let a = draw(&one, (7, None, sequence), sample);
-                let b = draw(&two, (7, None, sequence), sample);
+                let a = draw(&one, &streams, sample);
+                let b = draw(&two, &streams, sample);
                 let k = b.iter().find(|v| &*v.key == "rotor.k").unwrap();
                 assert_eq!(a[0].value.to_bits(), k.value.to_bits());
                 assert_ne!(b[0].value, b[1].value);

@@ -3,6 +3,7 @@
 //! optimiser's candidates are).
 
 use super::*;
+use crate::study::stream::Matrix;
 
 /// Execute one run of the plan. Never panics: a failed run is a row with a reason.
 pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
@@ -19,7 +20,18 @@ pub fn sample_simulation(
     design: &Design,
     sample_id: u64,
 ) -> (Sample, Simulation) {
-    let mut sample = draw_sample(plan, design, sample_id);
+    sample_simulation_in(plan, design, sample_id, Matrix::A)
+}
+
+/// As [`sample_simulation`], each input drawn from the set `matrix` names
+/// (a sensitivity analysis's pick-freeze runs).
+pub fn sample_simulation_in(
+    plan: &StudyPlan,
+    design: &Design,
+    sample_id: u64,
+    matrix: Matrix,
+) -> (Sample, Simulation) {
+    let mut sample = draw_sample_in(plan, design, sample_id, matrix);
     let mut scene = plan.scene(design, sample.unbalance, sample.direction);
     // Without designs of their own, the design sits in every balancer plane,
     // and so do its start angles (the sampled unbalance is placed in every
@@ -39,7 +51,7 @@ pub fn sample_simulation(
             .and_then(|c| c.at.map(|p| p.0));
         super::super::couple::apply(&mut scene.rotor, at, &planes);
     }
-    sample.weights = draw_weights(plan, design, sample_id, &mut scene);
+    sample.weights = draw_weights(plan, design, sample_id, matrix, &mut scene);
     if !sample.uncertain.is_empty() {
         // Validated up front at both ends of every key's support; a draw
         // that still does not read back fails its run with the reason.
@@ -66,7 +78,18 @@ pub fn run_design_sample(
     sample_id: u64,
     run_id: u64,
 ) -> RunRecord {
-    let (sample, simulation) = sample_simulation(plan, design, sample_id);
+    run_design_sample_in(plan, design, sample_id, run_id, Matrix::A)
+}
+
+/// As [`run_design_sample`], each input drawn from the set `matrix` names.
+pub fn run_design_sample_in(
+    plan: &StudyPlan,
+    design: &Design,
+    sample_id: u64,
+    run_id: u64,
+    matrix: Matrix,
+) -> RunRecord {
+    let (sample, simulation) = sample_simulation_in(plan, design, sample_id, matrix);
     let contact = simulation
         .scene
         .effects

@@ -15,7 +15,7 @@ use super::lock::{FolderLock, LockError};
 use super::racing::{Departure, Race, only_running, races};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
-use super::sample::{Sample, draw_sample, draw_weights};
+use super::sample::{Sample, draw_sample_in, draw_weights};
 use crate::metrics::{Outcome, RunMetrics};
 use crate::simulation::Simulation;
 use polars::prelude::{ChunkCompareIneq, DataFrame, PolarsError, PolarsResult};
@@ -28,7 +28,9 @@ use std::time::{Duration, Instant};
 mod assemble;
 mod executor;
 
-pub use assemble::{run_design_sample, run_one, sample_simulation};
+pub use assemble::{
+    run_design_sample, run_design_sample_in, run_one, sample_simulation, sample_simulation_in,
+};
 use executor::{chunk_pieces, earlier_table_pieces, execute};
 
 /// The k-th of N disjoint slices of a study (k counted from 1).
