@@ -60,6 +60,38 @@ impl SettlingClock {
     }
 }
 
+/// What a run recorded of its timing (columns of runs.parquet).
+#[derive(Debug, Clone, Copy)]
+pub struct RunTimes {
+    /// `settled`.
+    pub settled: Option<bool>,
+    /// `settling_revs`.
+    pub settling_revs: Option<f64>,
+    /// `censoring_revs`.
+    pub censoring_revs: Option<f64>,
+    /// `operating_time_s`.
+    pub operating_time_s: Option<f64>,
+}
+
+/// One run's settling as the statistics count it: settled at its time, or
+/// censored (at `censoring_revs`, else the horizon), on `clock`.
+pub fn settling_observation(run: RunTimes, horizon: f64, clock: SettlingClock) -> Observation {
+    let offset = match clock {
+        SettlingClock::FromStart => 0.0,
+        SettlingClock::FromOperatingSpeed(rev) => run.operating_time_s.map_or(0.0, |t| t / rev),
+    };
+    match (run.settled, run.settling_revs) {
+        (Some(true), Some(t)) => Observation {
+            time: (t - offset).max(0.0),
+            settled: true,
+        },
+        _ => Observation {
+            time: (run.censoring_revs.unwrap_or(horizon) - offset).max(0.0),
+            settled: false,
+        },
+    }
+}
+
 /// Every design's runs from a runs table holding the columns of
 /// [`super::runs_file::SUMMARY_COLUMNS`], in design order (designs without
 /// runs are left out).
@@ -96,20 +128,16 @@ pub fn design_runs(
             });
         }
         let d = out.last_mut().expect("pushed above");
-        let offset = match clock {
-            SettlingClock::FromStart => 0.0,
-            SettlingClock::FromOperatingSpeed(rev) => operating.get(i).map_or(0.0, |t| t / rev),
-        };
-        let observation = match (settled.get(i), revs.get(i)) {
-            (Some(true), Some(t)) => Observation {
-                time: (t - offset).max(0.0),
-                settled: true,
+        let observation = settling_observation(
+            RunTimes {
+                settled: settled.get(i),
+                settling_revs: revs.get(i),
+                censoring_revs: censoring.get(i),
+                operating_time_s: operating.get(i),
             },
-            _ => Observation {
-                time: (censoring.get(i).unwrap_or(horizon) - offset).max(0.0),
-                settled: false,
-            },
-        };
+            horizon,
+            clock,
+        );
         let simulated = outcome
             .get(i)
             .and_then(Outcome::parse)

@@ -67,4 +67,5 @@ mod tilt_inertia;
 mod tolerances;
 mod toy_effect;
 mod tradeoff;
+mod uncertain_keys;
 mod user_docs;
