@@ -24,7 +24,7 @@ CRATE_LAYERS = [
     {"stats", "design", "integrate", "build_info", "input_file", "invalid_key", "output_file", "number_text", "pair"},
     {"model"},
     {"metrics"},
-    {"simulation", "scene_file"},
+    {"simulation", "scene_file", "uncertain"},
     {"study"},
     {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report"},
 ]
@@ -39,7 +39,7 @@ STUDY_LAYERS = [
     # design's measured runs, files.
     {"stream", "truncated", "distribution", "design", "measured_runs", "io", "lock", "runs_file", "summary_columns", "results_table"},
     # The parts of the study file that check, draw or measure on their own.
-    {"couple", "tolerance", "uncertain", "plane_designs", "criterion", "optimize_spec"},
+    {"couple", "tolerance", "plane_designs", "criterion", "optimize_spec"},
     # The study file and its resolved plan.
     {"config"},
     # One run or one design, from a plan.
@@ -47,7 +47,7 @@ STUDY_LAYERS = [
     # Statistics over many runs.
     {"adaptive", "aggregate", "compare_designs", "decision", "racing"},
     # The runner and the verbs on top of it.
-    {"run", "merge", "study_folder", "sweep", "stability_map"},
+    {"run", "merge", "study_folder", "sweep", "stability_map", "sensitivity", "stepped_bands"},
 ]
 
 CODE_NOISE = re.compile(

@@ -14,7 +14,8 @@
 //!   output and step observers.
 //! - [`metrics`]: what a run means — settling time, residual vibration,
 //!   outcome — defined once.
-//! - [`simulation`]: one run at a chosen fidelity.
+//! - [`simulation`]: one run at a chosen fidelity; [`uncertain`]: scene keys
+//!   nobody measured exactly, as distributions written into a run's scene.
 //! - [`study`]: many runs on all cores, statistics with polars, Parquet.
 //! - Analyses on top: [`optimize`], [`claims`], [`tradeoff`], [`check`], [`plot`],
 //!   sharing one set of statistics ([`stats`]).
@@ -49,3 +50,4 @@ pub mod simulation;
 pub mod stats;
 pub mod study;
 pub mod tradeoff;
+pub mod uncertain;

@@ -42,6 +42,10 @@ pub struct SceneFile {
     /// Metric definitions.
     #[serde(default)]
     pub metrics: MetricOptions,
+    /// Keys of this scene nobody measured exactly, each with a distribution
+    /// (`study stepped --draws`): see [`crate::uncertain`].
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub uncertain: crate::uncertain::UncertainSpec,
 }
 
 /// How a single run starts.
@@ -124,6 +128,23 @@ impl SceneFile {
             source,
         };
         scene.validate().map_err(invalid)?;
+        crate::uncertain::validate(&self.uncertain, &scene, |s| {
+            s.validate().map_err(|e| match e {
+                SceneError::Invalid {
+                    field,
+                    value,
+                    reason,
+                } => crate::invalid_key::InvalidKey::new(field, value, reason),
+                other => crate::invalid_key::InvalidKey::new("scene", "", other.to_string()),
+            })
+        })
+        .map_err(|e| {
+            invalid(SceneError::Invalid {
+                field: e.key,
+                value: e.value,
+                reason: e.reason,
+            })
+        })?;
         let cargo = scene.cargoes().map_err(invalid)?;
         let n = cargo.len();
         let initial_angles: Vec<f64> = match &self.start.angles_deg {

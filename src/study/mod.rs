@@ -7,7 +7,6 @@
 //! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
 //! - [`sample`]: the draws of one run (unbalance, direction, start angles).
 //! - [`tolerance`]: manufacturing tolerances of the weights, sampled per run.
-//! - [`uncertain`]: scene keys given a distribution (`[uncertain]`), drawn per sample.
 //! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`run`]: the executor (rayon, chunked writes, resume, shards).
 //! - [`record`]: one row of `runs.parquet`.
@@ -27,6 +26,7 @@
 //! - [`io`]: Parquet with provenance, atomic writes.
 //! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
 //! - [`stability_map`]: linear stability over (speed, unbalance).
+//! - [`stepped_bands`]: a stepped sweep over draws of a scene's uncertain keys: bands and onsets.
 
 pub mod adaptive;
 pub mod aggregate;
@@ -54,11 +54,11 @@ pub mod run;
 pub mod runs_file;
 pub mod sample;
 pub mod stability_map;
+pub mod stepped_bands;
 pub mod stream;
 pub mod study_folder;
 pub mod summary_columns;
 pub mod sweep;
 pub mod tolerance;
 pub mod truncated;
-pub mod uncertain;
 pub mod verdict;

@@ -3,8 +3,8 @@
 
 use super::couple::{SampledCouple, plane_unbalances};
 use super::tolerance::SampledWeights;
-use super::uncertain::{COLUMN_PREFIX, UncertainValue};
 use crate::metrics::{Outcome, RunMetrics};
+use crate::uncertain::{COLUMN_PREFIX, UncertainValue};
 use polars::prelude::*;
 use std::sync::Arc;
 

@@ -11,13 +11,13 @@ use super::config::StudyPlan;
 use super::design::Design;
 pub use super::distribution::draw_value;
 use super::distribution::{DirectionSpec, InitialSpec, Scale};
-use super::stream::{Draws, Matrix, RunStreams};
+use super::stream::{Draws, Matrix, RunStreams, key_hash};
 pub use super::stream::{Purpose, splitmix64, stream};
 use super::tolerance::SampledWeights;
-use super::uncertain::UncertainValue;
 use crate::design::geometry::{half_angle, pressed_angles};
 use crate::model::scene::Scene;
 use crate::model::start::balanced_fan;
+use crate::uncertain::UncertainValue;
 use rand::RngExt;
 use rand_distr::{Distribution as _, Exp1};
 use std::f64::consts::PI;
@@ -85,7 +85,9 @@ pub fn draw_sample_in(plan: &StudyPlan, design: &Design, sample: u64, matrix: Ma
         couple: s.couple.as_ref().map(|spec| {
             super::couple::draw(spec, &streams, design, sample, (unbalance, direction))
         }),
-        uncertain: super::uncertain::draw(&plan.file.uncertain, &streams, sample),
+        uncertain: crate::uncertain::draw(&plan.file.uncertain, |key| {
+            streams.key_draws(key_hash(key), sample).random()
+        }),
         uncertain_refused: None,
     }
 }

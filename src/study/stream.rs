@@ -49,6 +49,9 @@ pub enum Purpose {
     /// An uncertain scene key (`super::uncertain`; the key's name is mixed
     /// into the seed, so each key has a stream of its own).
     Uncertain = 10,
+    /// Bootstrap resampling of a sensitivity analysis's indices
+    /// (`super::sensitivity`).
+    Sensitivity = 11,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for

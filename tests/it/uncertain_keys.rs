@@ -5,7 +5,7 @@
 use autobal::study::config::{StudyFile, StudyPlan};
 use autobal::study::record::{RunRecord, to_dataframe};
 use autobal::study::run::{run_one, sample_simulation};
-use autobal::study::uncertain::{apply, read};
+use autobal::uncertain::{apply, read};
 use polars::prelude::*;
 use std::process::Command;
 

@@ -198,6 +198,11 @@ pub fn bench_runs(text: &str) -> Result<usize, String> {
     whole_in(text, "runs", 1, MAX_BENCH_RUNS)
 }
 
+/// `--draws`: how many draws of a scene's uncertain keys (0: none).
+pub fn draws(text: &str) -> Result<u32, String> {
+    whole_in(text, "draws of the uncertain keys", 0, 100_000).map(|n| n as u32)
+}
+
 /// A significance level in (0, 0.5] (`study compare`).
 pub fn significance(text: &str) -> Result<f64, String> {
     let v: f64 = text

@@ -38,13 +38,27 @@ pub struct SteppedArgs {
     /// Write one row per step to this Parquet file.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Replace the --out file if it exists.
-    #[arg(long, requires = "out")]
+    /// Replace the --out (and --draws-out) file if it exists.
+    #[arg(long)]
     overwrite: bool,
     /// Print the steps as JSON instead of a table.
     #[arg(long)]
     json: bool,
+    /// Sweep this many draws of the scene's `[uncertain]` keys and print the
+    /// median and the 5–95 % band of each step (default 32 when the scene
+    /// has uncertain keys); `--draws 0` sweeps the nominal scene only.
+    #[arg(long, value_parser = crate::limits::draws)]
+    draws: Option<u32>,
+    /// Seed of the draws.
+    #[arg(long, default_value_t = autobal::study::config::DEFAULT_SEED)]
+    seed: u64,
+    /// Write every draw's steps (mean bearing peak, ratio, onset, key values) to this Parquet file.
+    #[arg(long)]
+    draws_out: Option<PathBuf>,
 }
+
+/// Draws of the uncertain keys when a scene has them and --draws is not given.
+const DEFAULT_DRAWS: u32 = 32;
 
 /// Most steps one sweep may take (each a whole dwell's integration).
 const MAX_STEPS: f64 = 100_000.0;
@@ -73,11 +87,36 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
             2,
         ));
     }
-    if let Some(path) = &args.out {
-        prepare("--out", path, WhenExists::from_overwrite(args.overwrite))?;
+    if args.overwrite && args.out.is_none() && args.draws_out.is_none() {
+        return Err(UserError(
+            "--overwrite: replaces an output file; give --out (or --draws-out)".into(),
+            2,
+        ));
     }
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
+    let draws = match (args.draws, file.uncertain.is_empty()) {
+        (Some(n), true) if n > 0 => {
+            return Err(UserError(
+                format!("--draws {n}: {shown} has no [uncertain] keys to draw"),
+                2,
+            ));
+        }
+        (Some(n), _) => n,
+        (None, true) => 0,
+        (None, false) => DEFAULT_DRAWS,
+    };
+    if args.draws_out.is_some() && draws == 0 {
+        return Err(UserError(
+            "--draws-out: needs draws of the scene's [uncertain] keys (--draws N)".into(),
+            2,
+        ));
+    }
+    for (flag, path) in [("--out", &args.out), ("--draws-out", &args.draws_out)] {
+        if let Some(path) = path {
+            prepare(flag, path, WhenExists::from_overwrite(args.overwrite))?;
+        }
+    }
     let simulation = file.simulation(&shown)?;
     let to_rad = PI / 30.0;
     let speeds = stepped_speeds(
@@ -86,6 +125,21 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
         args.step_rpm * to_rad,
         !args.up_only,
     );
+    if draws > 0 {
+        let outputs = crate::stepped_bands_cmd::Outputs {
+            bands: args.out.as_deref(),
+            draws: args.draws_out.as_deref(),
+            scene: &args.scene,
+        };
+        let sweep = (speeds.as_slice(), args.dwell);
+        return crate::stepped_bands_cmd::run(
+            &file,
+            &simulation,
+            sweep,
+            (draws, args.seed),
+            outputs,
+        );
+    }
     let (points, failure) = match simulation.stepped_sweep(&speeds, args.dwell) {
         Ok(points) => (points, None),
         Err(SteppedError::Scene(e)) if matches!(&e, autobal::model::scene::SceneError::Invalid { field, .. } if field == "dwell") =>

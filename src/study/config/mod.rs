@@ -50,7 +50,7 @@ pub struct StudyFile {
     /// per sample (`"effects.rolling_resistance.coefficient" = { distribution
     /// = "log_uniform", min = 3e-4, max = 3e-3 }`).
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
-    pub uncertain: super::uncertain::UncertainSpec,
+    pub uncertain: crate::uncertain::UncertainSpec,
     /// Integrator settings.
     #[serde(default)]
     pub solver: SolverSettings,

@@ -624,7 +624,7 @@ impl StudyPlan {
     /// the scene and by nothing the study draws per run, and both ends of
     /// its distribution valid (scene checks and the metrics' horizon).
     fn check_uncertain(&self) -> Result<(), InvalidKey> {
-        use super::super::uncertain::{read, validate};
+        use crate::uncertain::{read, validate};
         let spec = &self.file.uncertain;
         if let (Some(_), Some(key)) = (
             self.file

@@ -55,7 +55,7 @@ pub fn sample_simulation_in(
     if !sample.uncertain.is_empty() {
         // Validated up front at both ends of every key's support; a draw
         // that still does not read back fails its run with the reason.
-        match super::super::uncertain::apply(&scene, &sample.uncertain) {
+        match crate::uncertain::apply(&scene, &sample.uncertain) {
             Ok(varied) => scene = varied,
             Err(reason) => sample.uncertain_refused = Some(reason),
         }

@@ -16,10 +16,8 @@
 //! be overwritten per run by the study (the sampled unbalance), and both
 //! ends of its distribution must pass the scene's checks.
 
-use super::stream::{RunStreams, key_hash};
 use crate::invalid_key::InvalidKey;
 use crate::model::validate::shown;
-use rand::RngExt;
 use schemars::JsonSchema;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -181,11 +179,12 @@ pub struct UncertainValue {
     pub value: f64,
 }
 
-/// Every key's value for one run, in the spec's (sorted) key order.
-pub fn draw(spec: &UncertainSpec, streams: &RunStreams, sample: u64) -> Vec<UncertainValue> {
+/// Every key's value for one run, in the spec's (sorted) key order, from
+/// `uniform(key)`: the key's own uniform draw in [0, 1).
+pub fn draw(spec: &UncertainSpec, mut uniform: impl FnMut(&str) -> f64) -> Vec<UncertainValue> {
     spec.iter()
         .map(|(key, d)| {
-            let u: f64 = streams.key_draws(key_hash(key), sample).random();
+            let u = uniform(key);
             UncertainValue {
                 key: Arc::from(key.as_str()),
                 value: d.quantile(u),
@@ -312,7 +311,6 @@ pub fn validate<T: Serialize + DeserializeOwned>(
 
 #[cfg(test)]
 mod tests {
-    use super::super::stream::Sequence;
     use super::*;
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -419,31 +417,6 @@ mod tests {
         ];
         for (d, key) in bad {
             assert_eq!(d.check().unwrap_err().key, key, "{d:?}");
-        }
-    }
-
-    /// Each key's draws come from a stream of its own: adding a key leaves
-    /// another's values bit for bit.
-    #[test]
-    fn adding_a_key_changes_no_other_draw() {
-        let u = UncertainDistribution::Uniform { min: 0.0, max: 1.0 };
-        let one: UncertainSpec = [("rotor.k".to_string(), u.clone())].into();
-        let mut two = one.clone();
-        two.insert("effects.a".into(), u.clone());
-        for sequence in [Sequence::Random, Sequence::Sobol] {
-            let streams = RunStreams {
-                seed: 7,
-                shared: None,
-                sequence,
-                matrix: Default::default(),
-            };
-            for sample in 0..16 {
-                let a = draw(&one, &streams, sample);
-                let b = draw(&two, &streams, sample);
-                let k = b.iter().find(|v| &*v.key == "rotor.k").unwrap();
-                assert_eq!(a[0].value.to_bits(), k.value.to_bits());
-                assert_ne!(b[0].value, b[1].value);
-            }
         }
     }
 
