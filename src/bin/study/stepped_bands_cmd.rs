@@ -22,6 +22,18 @@ pub struct Outputs<'a> {
     pub draws: Option<&'a Path>,
     /// The scene file (for the files' provenance).
     pub scene: &'a Path,
+    /// Print every draw (its key values, onset and steps) as JSON instead of the table.
+    pub json: bool,
+}
+
+/// One draw as `--json` prints it.
+#[derive(serde::Serialize)]
+struct DrawJson<'a> {
+    draw: u32,
+    values: std::collections::BTreeMap<&'a str, f64>,
+    onset_rpm: Option<f64>,
+    failure: Option<&'a str>,
+    steps: &'a [autobal::simulation::stepped::StepPoint],
 }
 
 /// Sweep `draws` draws of the scene's uncertain keys and print the bands.
@@ -61,6 +73,20 @@ pub fn run(
             &provenance,
         )
         .map_err(|e| UserError::internal(format!("--draws-out {e}")))?;
+    }
+    if outputs.json {
+        let all: Vec<DrawJson> = sweeps
+            .iter()
+            .map(|s| DrawJson {
+                draw: s.draw,
+                values: s.values.iter().map(|v| (&*v.key, v.value)).collect(),
+                onset_rpm: autobal::study::stepped_bands::onset(&s.points).map(|w| w * 30.0 / PI),
+                failure: s.failure.as_deref(),
+                steps: &s.points,
+            })
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&all)?);
+        return Ok(());
     }
     print!("{}", table(&rows));
     let (found, none) = onsets(&sweeps);

@@ -130,6 +130,7 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
             bands: args.out.as_deref(),
             draws: args.draws_out.as_deref(),
             scene: &args.scene,
+            json: args.json,
         };
         let sweep = (speeds.as_slice(), args.dwell);
         return crate::stepped_bands_cmd::run(
