@@ -45,7 +45,7 @@ STUDY_LAYERS = [
     # One run or one design, from a plan.
     {"sample", "record", "failures", "diagnosis", "design_runs", "verdict", "plane_summary"},
     # Statistics over many runs.
-    {"adaptive", "aggregate", "compare_designs", "decision", "racing"},
+    {"adaptive", "aggregate", "compare_designs", "decision", "racing", "robustness"},
     # The runner and the verbs on top of it.
     {"run", "merge", "study_folder", "sweep", "stability_map", "sensitivity", "stepped_bands"},
 ]

@@ -5,8 +5,9 @@
 //! [`holm`]), censoring-aware settling statistics ([`survival`]: Kaplan–Meier,
 //! its median and restricted mean) and paired comparisons of designs that
 //! share their samples ([`paired`]: win shares, sign and signed-rank tests),
-//! the rank correlation of two rankings ([`kendall`]), and the spending of
-//! a level over repeated looks at growing data ([`spending`]).
+//! the rank correlation of two rankings ([`kendall`]), the spending of
+//! a level over repeated looks at growing data ([`spending`]), and
+//! variance-based sensitivity indices by pick-freeze ([`sobol_indices`]).
 //!
 //! Nothing here knows about rotors or studies; the analyses (`study`,
 //! `check`, `optimize`, `plot`, `tradeoff`) bring the data.
@@ -21,6 +22,7 @@ pub mod paired;
 pub mod paired_measures;
 pub mod proportion;
 pub mod quantile;
+pub mod sobol_indices;
 pub mod spending;
 pub mod survival;
 #[cfg(test)]

@@ -20,8 +20,10 @@
 //! - [`verdict`]: which design settles sooner: paired, censoring-aware, Holm-corrected.
 //! - [`compare_designs`]: two designs of one or two results folders (`study compare`).
 //! - [`summary_columns`]: typed access to `summary.parquet`'s columns.
+//! - [`robustness`]: whether #1 stays #1 in every third of each uncertain key's range.
 //! - [`decision`]: which design to build, or why none, typed, as `summary.parquet` records it.
 //! - [`merge`]: combining shard outputs.
+//! - [`sensitivity`]: Sobol indices of the measures over every sampled input (`study sensitivity`).
 //! - [`study_folder`]: the study's folder as another verb's destination (tradeoff, optimize).
 //! - [`io`]: Parquet with provenance, atomic writes.
 //! - [`sweep`]: one scene over a grid of speeds, with criterion and linear stability.
@@ -50,9 +52,11 @@ pub mod plane_summary;
 pub mod racing;
 pub mod record;
 pub mod results_table;
+pub mod robustness;
 pub mod run;
 pub mod runs_file;
 pub mod sample;
+pub mod sensitivity;
 pub mod stability_map;
 pub mod stepped_bands;
 pub mod stream;

@@ -55,6 +55,7 @@ mod rigid_drum;
 mod rolling_resistance;
 mod sample_bounds;
 mod schema;
+mod sensitivity;
 mod sommerfeld;
 mod stepped_sweep;
 mod structured_newton;

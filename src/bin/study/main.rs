@@ -21,6 +21,7 @@ mod progress;
 mod ranking;
 mod report_cmd;
 mod run_cmd;
+mod sensitivity_cmd;
 mod simulate_cmd;
 mod stepped_bands_cmd;
 mod stepped_cmd;
@@ -74,8 +75,8 @@ enum Command {
     #[command(after_help = tradeoff_cmd::EXAMPLES)]
     Tradeoff(tradeoff_cmd::TradeoffArgs),
     /// Which sampled input (unbalance, start, tolerances, uncertain keys) explains each design's spread: Sobol indices.
-    //TMP    #[command(after_help = sensitivity_cmd::EXAMPLES)]
-    //TMP    Sensitivity(sensitivity_cmd::SensitivityArgs),
+    #[command(after_help = sensitivity_cmd::EXAMPLES)]
+    Sensitivity(sensitivity_cmd::SensitivityArgs),
     /// Compare a fresh run of a study with its baseline: KS, Fisher and Mood tests, Holm; exit 1 on a regression.
     #[command(after_help = check_cmd::CHECK_EXAMPLES)]
     Check(check_cmd::CheckArgs),
@@ -165,7 +166,7 @@ fn main() -> ExitCode {
         Command::Claims(args) => claims_cmd::run(&args),
         Command::Compare(args) => compare_cmd::run(&args),
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
-        //TMP        Command::Sensitivity(args) => sensitivity_cmd::run(&args),
+        Command::Sensitivity(args) => sensitivity_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
         Command::Report(args) => report_cmd::run(&args),

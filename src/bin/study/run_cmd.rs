@@ -3,7 +3,7 @@
 use crate::UserError;
 use crate::output::{text_width, wrap};
 use crate::progress::RunProgress;
-use crate::ranking::ranked_table;
+use crate::ranking::{ranked_table, robustness_lines};
 use autobal::study::config::load;
 use autobal::study::criterion::Criterion;
 use autobal::study::failures::failure_advice;
@@ -121,6 +121,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
             if let Some(line) = race_line(&output) {
                 print!("{}", wrap(&(line + "\n"), text_width()));
             }
+            print!("{}", robustness_lines(&plan, &output.dir, summary)?);
         }
         None => println!(
             "shard {} done: {} runs in {} (merge the shards with `study merge`)",
@@ -165,10 +166,13 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
     if let Some(line) = race_line(&output) {
         print!("{}", wrap(&(line + "\n"), text_width()));
     }
-    eprintln!("merged {} runs into {}", output.runs, output.dir.display());
     // The shards' failed runs are never absorbed either: the study text
     // stored beside the merged files names the settings.
     let plan = load(&output.dir.join("study.toml"))?;
+    if let Some(summary) = &output.summary {
+        print!("{}", robustness_lines(&plan, &output.dir, summary)?);
+    }
+    eprintln!("merged {} runs into {}", output.runs, output.dir.display());
     fail_on_unfinished_runs(&plan, &output.dir)
 }
 

@@ -1,0 +1,94 @@
+//! The lines after the ranking of a study with uncertain keys: whether #1
+//! stays #1 in each third of every key's range, and which key explains
+//! most of #1's settling time.
+
+use crate::UserError;
+use autobal::study::config::StudyPlan;
+use autobal::study::decision::StudyDecision;
+use autobal::study::io::read_parquet;
+use autobal::study::robustness::{PARTS, robustness};
+use autobal::study::sensitivity::{FILE as SENSITIVITY_FILE, Measure, read_totals};
+use polars::prelude::DataFrame;
+use std::path::Path;
+
+/// The robustness lines of the study in `dir` (empty without uncertain keys).
+pub fn robustness_lines(
+    plan: &StudyPlan,
+    dir: &Path,
+    summary: &DataFrame,
+) -> Result<String, UserError> {
+    if plan.file.uncertain.is_empty() {
+        return Ok(String::new());
+    }
+    let internal = |e: polars::prelude::PolarsError| UserError::internal(e.to_string());
+    let decision = StudyDecision::from_summary(summary).map_err(internal)?;
+    let Some(&crown) = decision.leading(1).first() else {
+        return Ok(String::new());
+    };
+    let runs = read_parquet(&dir.join("runs.parquet")).map_err(internal)?;
+    let Some(r) = robustness(plan, &runs, crown).map_err(internal)? else {
+        return Ok(String::new());
+    };
+    let keys = plan.file.uncertain.len();
+    let mut out = format!(
+        "uncertain physics: #1 (design {crown}) is also best in {} of the {} thirds of its {keys} uncertain key(s)' ranges (the runs whose drawn value lies in the lowest, middle or highest third, ranked on their own)",
+        r.kept(),
+        r.parts.len(),
+    );
+    let lost: Vec<String> = r
+        .parts
+        .iter()
+        .filter(|p| p.winner != crown)
+        .map(|p| {
+            format!(
+                "where {} is {} ({}–{}), design {} is best ({} against #1's {}, {} runs of #1)",
+                p.key,
+                ["low", "middle", "high"]
+                    .get(p.part)
+                    .copied()
+                    .unwrap_or("in another part"),
+                autobal::number_text::significant(p.range.0, 3),
+                autobal::number_text::significant(p.range.1, 3),
+                p.winner,
+                value(p.winner_value),
+                value(p.crown_value),
+                p.runs
+            )
+        })
+        .collect();
+    if lost.is_empty() {
+        out += ": the decision does not hang on them";
+    } else {
+        out += &format!("; {}", lost.join("; "));
+    }
+    out += ".\n";
+    match read_totals(plan, dir, crown, Measure::RestrictedSettling) {
+        Some(totals) => {
+            let (input, total, (lo, hi)) = &totals[0];
+            let c = |x: f64| x.clamp(0.0, 1.0);
+            out += &format!(
+                "{input} has the largest total index on #1's settling time capped at the horizon: S_T = {:.2} [{:.2}, {:.2}] ({SENSITIVITY_FILE}; the share of its variance the input accounts for, interactions included).\n",
+                c(*total),
+                c(*lo),
+                c(*hi)
+            );
+        }
+        None => {
+            if let Some(top) = r.explained.first() {
+                out += &format!(
+                    "of the uncertain keys, {} explains most of #1's settling time capped at the horizon: {:.0} % of its variance (first-order, from {} equal-count bins of the study's runs, less what noise alone puts between them); `study sensitivity` gives every input's total index.\n",
+                    top.key,
+                    100.0 * top.share,
+                    autobal::study::robustness::BINS
+                );
+            }
+        }
+    }
+    debug_assert_eq!(PARTS, 3, "the lines name three parts");
+    Ok(crate::output::wrap(&out, crate::output::text_width()))
+}
+
+/// A criterion value as printed.
+fn value(v: Option<f64>) -> String {
+    v.map_or("–".into(), |x| autobal::number_text::significant(x, 4))
+}

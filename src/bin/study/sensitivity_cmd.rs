@@ -1,0 +1,231 @@
+//! `study sensitivity`: which sampled input explains the spread of each
+//! design's settling time, residual and settled share (Sobol indices).
+
+use crate::UserError;
+use crate::output::{dropped_note, fitted_table, say, say_err, text_width};
+use autobal::output_file::WhenExists;
+use autobal::study::config::load;
+use autobal::study::sensitivity::{
+    FILE, Measure, SensitivityRow, SensitivitySettings, estimate, inputs, run_pick_freeze,
+    runs_needed, write,
+};
+use autobal::study::stream::{SOBOL_MAX_SAMPLES, Sequence};
+use autobal::study::study_folder::claim;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Examples shown under `study sensitivity --help`.
+pub const EXAMPLES: &str = "Examples:
+  study sensitivity studies/bristol_uncertain.toml
+  study sensitivity studies/three_balls.toml --rows 128 --designs 0,7
+  study sensitivity studies/tolerances.toml --random   # plain random draws, to compare";
+
+/// Most runs one analysis may make (as a study: about 80 bytes each in memory).
+const MAX_RUNS: u64 = 10_000_000;
+
+/// Arguments of `study sensitivity`.
+#[derive(Args)]
+pub struct SensitivityArgs {
+    /// Study file.
+    study: PathBuf,
+    /// Rows N of each pick-freeze matrix: N·(k + 2) runs per design for k
+    /// inputs (a power of two, as the Sobol sequence is even only over 2^m points).
+    #[arg(long, default_value_t = 64)]
+    rows: u32,
+    /// Only these designs (the ids of the ranking's `id` column), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    designs: Vec<u32>,
+    /// Draw the matrices pseudo-randomly instead of from the scrambled Sobol
+    /// sequence (wider intervals at the same cost: for comparison).
+    #[arg(long)]
+    random: bool,
+    /// Worker threads (default: all cores, or RAYON_NUM_THREADS).
+    #[arg(long, value_parser = crate::limits::threads)]
+    threads: Option<usize>,
+    /// Replace the study folder's sensitivity.parquet if it exists.
+    #[arg(long)]
+    overwrite: bool,
+}
+
+/// Run `study sensitivity`.
+pub fn run(args: &SensitivityArgs) -> Result<(), UserError> {
+    let mut plan = load(&args.study)?;
+    let sequence = if args.random {
+        Sequence::Random
+    } else {
+        Sequence::Sobol
+    };
+    check_rows(args.rows, sequence)?;
+    if !args.designs.is_empty() {
+        if let Some(id) = args
+            .designs
+            .iter()
+            .find(|id| **id as usize >= plan.designs.len())
+        {
+            return Err(UserError(
+                format!(
+                    "--designs {id}: the study has designs 0..={} only",
+                    plan.designs.len() - 1
+                ),
+                2,
+            ));
+        }
+        plan.designs.retain(|d| args.designs.contains(&d.id));
+    }
+    let settings = SensitivitySettings {
+        rows: args.rows,
+        sequence,
+        threads: crate::limits::capped_threads(args.threads),
+    };
+    let inputs = inputs(&plan);
+    if inputs.is_empty() {
+        return Err(UserError(
+            "the study samples nothing (fixed unbalance and direction, a balanced start, no tolerances, no [uncertain] keys): there is no variance to apportion".into(),
+            2,
+        ));
+    }
+    let total = runs_needed(&plan, &settings);
+    if total > MAX_RUNS {
+        return Err(UserError(
+            format!(
+                "--rows {}: {total} runs, more than the {MAX_RUNS} one analysis may make; use fewer rows or --designs",
+                args.rows
+            ),
+            2,
+        ));
+    }
+    let _folder = claim(
+        &plan,
+        "sensitivity",
+        &[FILE],
+        WhenExists::from_overwrite(args.overwrite),
+    )?;
+    say_err(&format!(
+        "cost: N·(k + 2) = {}·({} + 2) = {} runs per design, {total} runs for {} design(s); inputs: {}",
+        args.rows,
+        inputs.len(),
+        total / plan.designs.len() as u64,
+        plan.designs.len(),
+        inputs
+            .iter()
+            .map(|i| i.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    let step = (total / 10).max(1);
+    let runs = run_pick_freeze(&plan, &settings, &|done| {
+        if done % step == 0 {
+            eprintln!("{done}/{total} runs");
+        }
+    });
+    let rows = estimate(&plan, &settings, &runs);
+    let path = write(&plan, &rows).map_err(|e| UserError::internal(e.to_string()))?;
+    for design in &plan.designs {
+        print_design(
+            design.id,
+            &autobal::study::plane_designs::describe(design),
+            &rows,
+        );
+    }
+    say(&format!(
+        "(S_T: the total index, the share of the measure's variance that goes when the input is known, interactions included; S_1: the first-order index, the input alone; [95 % bootstrap interval]; shares shown within [0, 1], estimates beyond are noise and sensitivity.parquet keeps them; settling ≤ τ: the settling time capped at the horizon τ = {} rev, as the restricted mean counts it; {} draws)",
+        autobal::study::design_runs::settling_horizon(&plan),
+        if args.random {
+            "pseudo-random"
+        } else {
+            "scrambled Sobol"
+        }
+    ));
+    say_err(&format!("wrote {}", path.display()));
+    Ok(())
+}
+
+/// The rows N allowed for the sequence.
+fn check_rows(rows: u32, sequence: Sequence) -> Result<(), UserError> {
+    let fine = match sequence {
+        Sequence::Sobol => rows.is_power_of_two() && (4..=SOBOL_MAX_SAMPLES).contains(&rows),
+        Sequence::Random => (4..=SOBOL_MAX_SAMPLES).contains(&rows),
+    };
+    if fine {
+        Ok(())
+    } else {
+        Err(UserError(
+            format!(
+                "--rows {rows}: a power of two from 4 to {SOBOL_MAX_SAMPLES} (e.g. 64): the Sobol sequence is even only over 2^m points, and the bootstrap needs a few rows"
+            ),
+            2,
+        ))
+    }
+}
+
+/// One design's table: S_T of each measure, then S_1 (dropped first when narrow).
+fn print_design(id: u32, describe: &str, rows: &[SensitivityRow]) {
+    let mine: Vec<&SensitivityRow> = rows.iter().filter(|r| r.design_id == id).collect();
+    let of = |input: &str, m: Measure| mine.iter().find(|r| r.input == input && r.measure == m);
+    let cell = |r: Option<&&SensitivityRow>, total: bool| match r.and_then(|r| r.index.as_ref()) {
+        Some(i) if total => shown(i.total, i.total_ci),
+        Some(i) => shown(i.first, i.first_ci),
+        None => "–".into(),
+    };
+    let mut inputs: Vec<&str> = Vec::new();
+    for r in &mine {
+        if !inputs.contains(&r.input.as_str()) {
+            inputs.push(&r.input);
+        }
+    }
+    let table: Vec<Vec<String>> = inputs
+        .iter()
+        .map(|input| {
+            let mut row = vec![input.to_string()];
+            row.extend(Measure::ALL.map(|m| cell(of(input, m), true)));
+            row.extend(Measure::ALL.map(|m| cell(of(input, m), false)));
+            row
+        })
+        .collect();
+    let used = mine.first().map_or(0, |r| r.rows);
+    say(&format!("design {id} ({describe}), {used} rows:"));
+    let (text, dropped) = fitted_table(
+        &[
+            "input",
+            "S_T settling ≤ τ",
+            "S_T residual",
+            "S_T settled",
+            "S_1 settling ≤ τ",
+            "S_1 residual",
+            "S_1 settled",
+        ],
+        &table,
+        &[0, 0, 2, 3, 4, 5, 6],
+        text_width(),
+    );
+    print!("{text}{}", dropped_note(&dropped));
+    for m in Measure::ALL {
+        if let Some(note) = mine
+            .iter()
+            .find(|r| r.measure == m)
+            .and_then(|r| r.note.as_ref())
+        {
+            say(&format!("{}: no index ({note})", m.name()));
+        }
+    }
+    if let Some(top) = mine
+        .iter()
+        .filter(|r| r.measure == Measure::RestrictedSettling)
+        .filter_map(|r| Some((r, r.index.as_ref()?)))
+        .max_by(|a, b| a.1.total.total_cmp(&b.1.total))
+    {
+        say(&format!(
+            "largest total index on design {id}'s settling time: {}, S_T = {}",
+            top.0.input,
+            shown(top.1.total, top.1.total_ci)
+        ));
+    }
+}
+
+/// An index and its interval as printed: a share, so clipped to [0, 1]
+/// (beyond is the estimator's noise; sensitivity.parquet keeps the raw
+/// estimates).
+fn shown(value: f64, (lo, hi): (f64, f64)) -> String {
+    let c = |x: f64| x.clamp(0.0, 1.0);
+    format!("{:.2} [{:.2}, {:.2}]", c(value), c(lo), c(hi))
+}
