@@ -288,6 +288,17 @@ pub fn write(plan: &StudyPlan, rows: &[SensitivityRow]) -> PolarsResult<std::pat
     Ok(path)
 }
 
+/// One input's total index as sensitivity.parquet records it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputTotal {
+    /// The input's name.
+    pub input: String,
+    /// Its total index (raw estimate).
+    pub total: f64,
+    /// The index's 95 % bootstrap interval.
+    pub interval: (f64, f64),
+}
+
 /// Each input's total index on `measure` for `design`, largest first, from
 /// the sensitivity.parquet in `dir` when `study sensitivity` wrote one for
 /// this very study file (its recorded hash matches); `None` otherwise.
@@ -296,7 +307,7 @@ pub fn read_totals(
     dir: &std::path::Path,
     design: u32,
     measure: Measure,
-) -> Option<Vec<(String, f64, (f64, f64))>> {
+) -> Option<Vec<InputTotal>> {
     let path = dir.join(FILE);
     let recorded = super::io::read_metadata(&path).ok()?;
     let hash = recorded.iter().find(|(k, _)| k == "study_sha256")?;

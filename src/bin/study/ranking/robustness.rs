@@ -64,13 +64,14 @@ pub fn robustness_lines(
     out += ".\n";
     match read_totals(plan, dir, crown, Measure::RestrictedSettling) {
         Some(totals) => {
-            let (input, total, (lo, hi)) = &totals[0];
+            let top = &totals[0];
+            let (input, total, (lo, hi)) = (&top.input, top.total, top.interval);
             let c = |x: f64| x.clamp(0.0, 1.0);
             out += &format!(
                 "{input} has the largest total index on #1's settling time capped at the horizon: S_T = {:.2} [{:.2}, {:.2}] ({SENSITIVITY_FILE}; the share of its variance the input accounts for, interactions included).\n",
-                c(*total),
-                c(*lo),
-                c(*hi)
+                c(total),
+                c(lo),
+                c(hi)
             );
         }
         None => {
