@@ -324,17 +324,17 @@ pub fn read_totals(
     );
     let (d, m, input) = (d.u32().ok()?, m.str().ok()?, input.str().ok()?);
     let (t, lo, hi) = (t.f64().ok()?, lo.f64().ok()?, hi.f64().ok()?);
-    let mut out: Vec<(String, f64, (f64, f64))> = (0..df.height())
+    let mut out: Vec<InputTotal> = (0..df.height())
         .filter(|&i| d.get(i) == Some(design) && m.get(i) == Some(measure.name()))
         .filter_map(|i| {
-            Some((
-                input.get(i)?.to_string(),
-                t.get(i)?,
-                (lo.get(i)?, hi.get(i)?),
-            ))
+            Some(InputTotal {
+                input: input.get(i)?.to_string(),
+                total: t.get(i)?,
+                interval: (lo.get(i)?, hi.get(i)?),
+            })
         })
         .collect();
-    out.sort_by(|a, b| b.1.total_cmp(&a.1));
+    out.sort_by(|a, b| b.total.total_cmp(&a.total));
     (!out.is_empty()).then_some(out)
 }
 
