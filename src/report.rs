@@ -267,6 +267,9 @@ fn draw_figures(dir: &Path, leading: &[u32], scratch: &Path) -> Result<Vec<Figur
     if data.runs.iter().any(|r| r.stall_torque.is_some()) {
         which.push(StudyFigure::Passage);
     }
+    if !data.sensitivity.is_empty() {
+        which.push(StudyFigure::Sensitivity);
+    }
     // A figure the runs cannot give (nothing settled: no settling time to
     // draw) leaves a sentence in its place; the verdict is still worth sharing.
     let mut figures = Vec::new();
@@ -343,6 +346,10 @@ fn caption(figure: StudyFigure) -> String {
     match figure {
         StudyFigure::Passage => {
             "Passage through resonance: each run's final spin rate against the motor's stall torque."
+                .into()
+        }
+        StudyFigure::Sensitivity => {
+            "Which input matters: each input's total Sobol index on the settling time capped at the horizon, per design `study sensitivity` analysed, with its 95 % interval."
                 .into()
         }
         other => format!("{} (as `study plot study` draws it).", other.file_stem().replace('_', " ")),

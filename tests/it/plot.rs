@@ -375,6 +375,7 @@ fn study_figures_reject_bad_input() {
         runs: Vec::new(),
         designs: Vec::new(),
         operating_speed: None,
+        sensitivity: Vec::new(),
     };
     let out = dir.path().join("x.svg");
     assert!(matches!(
@@ -902,6 +903,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
         runs: runs.clone(),
         designs: vec![],
         operating_speed: None,
+        sensitivity: Vec::new(),
     };
     let dir = out_dir("passage");
     let path = dir.path.join("passage.svg");
@@ -918,6 +920,7 @@ fn passage_figure_needs_a_stall_torque_sweep_and_draws_held_runs_as_crosses() {
         runs,
         designs: autobal::plot::study::design_stats(&summary).unwrap(),
         operating_speed: Some(300.0),
+        sensitivity: Vec::new(),
     };
     StudyFigure::Passage.plot(&data, &path).unwrap();
     check_svg(

@@ -307,6 +307,7 @@ fn crowded_study(geometries: usize, drags: usize, samples: u32) -> StudyData {
         runs,
         designs,
         operating_speed: None,
+        sensitivity: Vec::new(),
     }
 }
 

@@ -80,8 +80,8 @@ struct StudyArgs {
     /// Image format of the figures.
     #[arg(long, value_enum, default_value = "svg")]
     format: FormatArg,
-    /// Write only this figure (default: all three, and `passage` when the
-    /// study sweeps the stall torque).
+    /// Write only this figure (default: all three, `passage` when the study
+    /// sweeps the stall torque, `sensitivity` when `study sensitivity` ran).
     #[arg(long, value_enum)]
     only: Option<StudyFigureArg>,
 }
@@ -92,6 +92,7 @@ enum StudyFigureArg {
     SettledFraction,
     SettlingVsUnbalance,
     Passage,
+    Sensitivity,
 }
 
 impl From<StudyFigureArg> for StudyFigure {
@@ -101,6 +102,7 @@ impl From<StudyFigureArg> for StudyFigure {
             StudyFigureArg::SettledFraction => StudyFigure::SettledFraction,
             StudyFigureArg::SettlingVsUnbalance => StudyFigure::SettlingVsUnbalance,
             StudyFigureArg::Passage => StudyFigure::Passage,
+            StudyFigureArg::Sensitivity => StudyFigure::Sensitivity,
         }
     }
 }
@@ -205,13 +207,18 @@ fn plot_one_study(a: &StudyArgs) -> Result<Vec<PathBuf>, UserError> {
     };
     let figures: Vec<StudyFigure> = match a.only {
         Some(f) => vec![f.into()],
-        // The passage figure only where the study sweeps the stall torque.
-        None if data.runs.iter().any(|r| r.stall_torque.is_some()) => {
+        None => {
             let mut all = StudyFigure::ALL.to_vec();
-            all.push(StudyFigure::Passage);
+            // The passage figure only where the study sweeps the stall
+            // torque, the indices only where `study sensitivity` ran.
+            if data.runs.iter().any(|r| r.stall_torque.is_some()) {
+                all.push(StudyFigure::Passage);
+            }
+            if !data.sensitivity.is_empty() {
+                all.push(StudyFigure::Sensitivity);
+            }
             all
         }
-        None => StudyFigure::ALL.to_vec(),
     };
     plot_study(&data, &a.out, format, &figures).map_err(write_error("--out", &a.out))
 }

@@ -6,11 +6,13 @@
 
 mod labels;
 pub mod passage;
+pub mod sensitivity;
 pub mod settled_fraction;
 pub mod settling_time;
 pub mod settling_vs_unbalance;
 
 pub use passage::plot_passage;
+pub use sensitivity::{TotalIndex, plot_sensitivity};
 pub use settled_fraction::plot_settled_fraction;
 pub use settling_time::plot_settling_times;
 pub use settling_vs_unbalance::plot_settling_vs_unbalance;
@@ -145,6 +147,37 @@ fn operating_speed(dir: &Path) -> Option<f64> {
     Some(plan.file.scene.speed.nominal_speed()).filter(|w| w.is_finite() && *w > 0.0)
 }
 
+/// The total indices on the capped settling time in `dir`'s
+/// sensitivity.parquet; none when the folder has no such file.
+fn total_indices(dir: &Path) -> Result<Vec<TotalIndex>, PlotError> {
+    let path = dir.join(crate::study::sensitivity::FILE);
+    if !path.is_file() {
+        return Ok(Vec::new());
+    }
+    let df = crate::study::io::read_parquet(&path).map_err(|e| PlotError::unreadable(&path, e))?;
+    let settling = crate::study::sensitivity::Measure::RestrictedSettling.name();
+    let (design, measure, input) = (
+        df.column("design_id")?.u32()?.clone(),
+        df.column("measure")?.str()?.clone(),
+        df.column("input")?.str()?.clone(),
+    );
+    let (t, lo, hi) = (
+        df.column("total_order")?.f64()?.clone(),
+        df.column("total_order_lo")?.f64()?.clone(),
+        df.column("total_order_hi")?.f64()?.clone(),
+    );
+    Ok((0..df.height())
+        .filter(|&i| measure.get(i) == Some(settling))
+        .filter_map(|i| {
+            Some(TotalIndex {
+                design_id: design.get(i)?,
+                input: input.get(i)?.to_string(),
+                total: (t.get(i)?, lo.get(i)?, hi.get(i)?),
+            })
+        })
+        .collect())
+}
+
 /// A study's runs and per-design statistics.
 #[derive(Debug, Clone)]
 pub struct StudyData {
@@ -157,6 +190,9 @@ pub struct StudyData {
     /// The speed law's operating speed (rad/s) from the folder's
     /// `study.toml`; `None` when it cannot be read.
     pub operating_speed: Option<f64>,
+    /// The total indices on the capped settling time from the folder's
+    /// sensitivity.parquet (`study sensitivity`); empty without one.
+    pub sensitivity: Vec<TotalIndex>,
 }
 
 impl StudyData {
@@ -185,6 +221,7 @@ impl StudyData {
             runs,
             designs,
             operating_speed: operating_speed(dir),
+            sensitivity: total_indices(dir)?,
         })
     }
 
@@ -252,6 +289,9 @@ pub enum StudyFigure {
     /// Final spin rate against the motor's stall torque (studies that sweep
     /// it; not in [`StudyFigure::ALL`]).
     Passage,
+    /// Each input's total Sobol index per design (folders where `study
+    /// sensitivity` wrote sensitivity.parquet; not in [`StudyFigure::ALL`]).
+    Sensitivity,
 }
 
 impl StudyFigure {
@@ -269,6 +309,7 @@ impl StudyFigure {
             StudyFigure::SettledFraction => "settled_fraction",
             StudyFigure::SettlingVsUnbalance => "settling_vs_unbalance",
             StudyFigure::Passage => "passage",
+            StudyFigure::Sensitivity => "sensitivity",
         }
     }
 
@@ -279,6 +320,7 @@ impl StudyFigure {
             StudyFigure::SettledFraction => plot_settled_fraction(data, path),
             StudyFigure::SettlingVsUnbalance => plot_settling_vs_unbalance(data, path),
             StudyFigure::Passage => plot_passage(data, path),
+            StudyFigure::Sensitivity => plot_sensitivity(data, path),
         }
     }
 }
@@ -294,6 +336,9 @@ pub fn plot_study(
     data.check()?;
     if figures.contains(&StudyFigure::Passage) {
         passage::passage_data(data)?;
+    }
+    if figures.contains(&StudyFigure::Sensitivity) {
+        sensitivity::sensitivity_data(data)?;
     }
     std::fs::create_dir_all(out_dir).map_err(|e| {
         PlotError::Io(std::io::Error::new(
