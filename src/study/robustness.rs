@@ -96,7 +96,8 @@ pub fn robustness(
             .filter_map(|(_, v)| *v)
             .collect();
         mine.sort_by(f64::total_cmp);
-        if mine.len() < PARTS {
+        // A key that did not vary over #1's runs cuts nothing.
+        if mine.len() < PARTS || mine.first() == mine.last() {
             continue;
         }
         let cuts: Vec<f64> = (1..PARTS).map(|p| mine[p * mine.len() / PARTS]).collect();
@@ -116,7 +117,10 @@ pub fn robustness(
                 .map(|v| v.is_some_and(|x| x >= lo && x < hi))
                 .collect();
             let within = runs.filter(&mask)?;
-            parts.push(part_winner(plan, &within, crown, key, part)?);
+            let winner = part_winner(plan, &within, crown, key, part)?;
+            if winner.runs > 0 {
+                parts.push(winner);
+            }
         }
         explained.push(Explained {
             key: key.clone(),

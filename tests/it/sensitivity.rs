@@ -10,8 +10,8 @@ use autobal::study::stream::Sequence;
 
 /// Two- and three-ball designs on the main job's rotor, with the rotor's
 /// inertia (unused at constant speed) and its damping uncertain.
-fn plan(sequence: &str) -> StudyPlan {
-    let text = format!(
+fn text(sequence: &str) -> String {
+    format!(
         r#"
 name = "sens"
 seed = 5
@@ -42,7 +42,11 @@ hold_revs = 20
 "rotor.inertia" = {{ distribution = "uniform", min = 0.01, max = 0.5 }}
 "rotor.bx" = {{ distribution = "log_uniform", min = 30, max = 300 }}
 "#
-    );
+    )
+}
+
+fn plan(sequence: &str) -> StudyPlan {
+    let text = text(sequence);
     StudyFile::parse(&text, "sens.toml")
         .unwrap()
         .plan(&text, "sens.toml")
@@ -118,4 +122,101 @@ fn a_dummy_input_gets_no_index_and_the_unbalance_does() {
         let u = unbalance.index.as_ref().unwrap();
         assert!(u.total_ci.0 > 0.3, "{u:?}");
     }
+}
+
+/// A study whose #1 loses where an uncertain key is low says so: design 0
+/// settles in 10 rev where the damping is in its lowest third and in 200
+/// rev elsewhere, design 1 in 60 rev everywhere; #1 overall is design 1,
+/// best in two of the three thirds, and design 0 wins the lowest.
+#[test]
+fn robustness_names_the_third_where_the_decision_turns() {
+    use autobal::metrics::Outcome;
+    use autobal::study::robustness::robustness;
+    use autobal::uncertain::UncertainValue;
+    let p = plan("random");
+    let mut runs = Vec::new();
+    for design in 0..2u32 {
+        for sample in 0..60u32 {
+            let bx = 30.0 + 270.0 * (f64::from(sample) + 0.5) / 60.0;
+            let revs = match (design, bx < 120.0) {
+                (0, true) => 10.0,
+                (0, false) => 200.0,
+                _ => 60.0,
+            };
+            let id = u64::from(design * 60 + sample);
+            let mut r = crate::study_summary::record(id, Outcome::Settled, Some(revs), 0.01);
+            r.design_id = design;
+            r.sample_id = sample;
+            r.metrics.censoring_revs = Some(280.0);
+            r.uncertain = ["rotor.bx", "rotor.inertia"]
+                .map(|key| UncertainValue {
+                    key: key.into(),
+                    value: if key == "rotor.bx" { bx } else { 0.1 },
+                })
+                .to_vec();
+            runs.push(r);
+        }
+    }
+    let df = autobal::study::record::to_dataframe(&runs).unwrap();
+    let r = robustness(&p, &df, 1).unwrap().unwrap();
+    let bx: Vec<_> = r.parts.iter().filter(|p| p.key == "rotor.bx").collect();
+    assert_eq!(bx.iter().map(|p| p.winner).collect::<Vec<_>>(), [0, 1, 1]);
+    assert_eq!(bx[0].winner_value, Some(10.0));
+    assert_eq!(bx[0].crown_value, Some(60.0));
+    assert!(bx[0].range.1 < 120.0 && bx[1].range.0 >= 120.0, "{bx:?}");
+    // A key that did not vary cuts nothing and is not counted.
+    assert!(r.parts.iter().all(|p| p.key == "rotor.bx"));
+    assert_eq!(r.kept(), 2);
+    // The damping explains design 1's settling not at all (it is constant).
+    assert!(r.explained.iter().all(|e| e.share == 0.0));
+}
+
+/// From the command line: the cost first, sensitivity.parquet written into
+/// the study's folder (never replaced without --overwrite), rows that are
+/// not a power of two and unknown designs refused with exit 2.
+#[test]
+fn the_cli_writes_the_indices_and_refuses_bad_flags() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let study = text("sobol").replace(
+        "seed = 5",
+        &format!("seed = 5\noutput = \"{}\"", dir.path().display()),
+    );
+    let file = dir.path().join("sens.toml");
+    std::fs::write(&file, study).unwrap();
+    let study = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .arg("sensitivity")
+            .arg(&file)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    for bad in [&["--rows", "12"][..], &["--designs", "7"][..]] {
+        let out = study(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(bad[0]),
+            "{bad:?}"
+        );
+    }
+    assert!(!dir.path().join("sens").exists());
+    let out = study(&["--rows", "8", "--designs", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("cost: N·(k + 2) = 8·(4 + 2) = 48 runs per design"),
+        "{stderr}"
+    );
+    let written = dir.path().join("sens/sensitivity.parquet");
+    let df = autobal::study::io::read_parquet(&written).unwrap();
+    assert_eq!(df.height(), 3 * 4);
+    assert_eq!(
+        study(&["--rows", "8", "--designs", "1"]).status.code(),
+        Some(2)
+    );
 }

@@ -34,7 +34,7 @@ unbalance = { distribution = "fixed", value = 0.5, relative_to = "capacity" }
         .unwrap()
 }
 
-fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> RunRecord {
+pub(crate) fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel: f64) -> RunRecord {
     RunRecord {
         run_id: id,
         design_id: 0,
