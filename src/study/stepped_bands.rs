@@ -34,6 +34,33 @@ pub struct DrawSweep {
     pub failure: Option<String>,
 }
 
+/// The scene of `simulation` under draw `i` of `spec` (stream `i` of
+/// `seed`, every key its own): the keys' values and the simulation, or why
+/// the drawn scene cannot be used.
+pub fn drawn_simulation(
+    simulation: &Simulation,
+    spec: &UncertainSpec,
+    seed: u64,
+    i: u32,
+) -> (Vec<UncertainValue>, Result<Simulation, String>) {
+    let streams = RunStreams {
+        seed,
+        shared: None,
+        sequence: Sequence::Random,
+        matrix: Matrix::A,
+    };
+    let values = draw(spec, |key| {
+        streams
+            .key_draws(key_hash(key), u64::from(i))
+            .random::<f64>()
+    });
+    let drawn = apply(&simulation.scene, &values).map(|scene| Simulation {
+        scene,
+        ..simulation.clone()
+    });
+    (values, drawn)
+}
+
 /// Run the sweep once per draw of `spec` (draw i from stream i of `seed`),
 /// in parallel; the results do not depend on the thread count.
 pub fn sweep_draws(
@@ -43,28 +70,11 @@ pub fn sweep_draws(
     draws: u32,
     seed: u64,
 ) -> Vec<DrawSweep> {
-    let streams = RunStreams {
-        seed,
-        shared: None,
-        sequence: Sequence::Random,
-        matrix: Matrix::A,
-    };
     (0..draws)
         .into_par_iter()
         .map(|i| {
-            let values = draw(spec, |key| {
-                streams
-                    .key_draws(key_hash(key), u64::from(i))
-                    .random::<f64>()
-            });
-            let outcome = apply(&simulation.scene, &values).map(|scene| {
-                let sim = Simulation {
-                    scene,
-                    ..simulation.clone()
-                };
-                sim.stepped_sweep(speeds, dwell)
-            });
-            let (points, failure) = match outcome {
+            let (values, drawn) = drawn_simulation(simulation, spec, seed, i);
+            let (points, failure) = match drawn.map(|sim| sim.stepped_sweep(speeds, dwell)) {
                 Ok(Ok(points)) => (points, None),
                 Ok(Err(SteppedError::Failed { done, why, .. })) => (done, Some(why)),
                 Ok(Err(SteppedError::Scene(e))) => (Vec::new(), Some(e.to_string())),

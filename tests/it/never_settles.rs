@@ -19,7 +19,10 @@ const SAMPLES: u32 = 3;
 fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study() {
     let (mut runs, mut certified) = (0usize, 0usize);
     let (mut worst_residual, mut full_calls, mut early_calls) = (0.0f64, 0u64, 0u64);
+    // The uncertain study's calls, guarded apart (see LATE_STUDY).
+    let (mut late_full, mut late_early) = (0u64, 0u64);
     for path in &shipped_studies() {
+        let late = path.file_stem().is_some_and(|s| s == LATE_STUDY);
         let full = shipped_plan_edited(path, SAMPLES, |f| f.metrics.certified_not_settled = false);
         let early = shipped_plan_edited(path, SAMPLES, |f| f.metrics.certified_not_settled = true);
         for id in 0..full.total_runs() {
@@ -63,14 +66,24 @@ fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study
             }
             // Radau5 may cross a stuck tail in a step or two: never dearer.
             assert!(b.rhs_calls <= a.rhs_calls, "{what}: certified but dearer");
-            full_calls += a.rhs_calls;
-            early_calls += b.rhs_calls;
+            if late {
+                late_full += a.rhs_calls;
+                late_early += b.rhs_calls;
+            } else {
+                full_calls += a.rhs_calls;
+                early_calls += b.rhs_calls;
+            }
         }
     }
+    let late_share = late_early as f64 / late_full.max(1) as f64;
     eprintln!(
-        "{certified} of {runs} runs certified not to settle, at {:.3} of the full runs' RHS calls; \
-         largest residual change {worst_residual:.2e}",
+        "{certified} of {runs} runs certified not to settle, at {:.3} of the full runs' RHS calls \
+         ({LATE_STUDY}: {late_share:.3}); largest residual change {worst_residual:.2e}",
         early_calls as f64 / full_calls.max(1) as f64
+    );
+    assert!(
+        late_share <= 1.02 * LATE_CALL_SHARE,
+        "{LATE_STUDY}'s certified runs at {late_share:.3} of the full runs' RHS calls"
     );
     // Not vacuous: gravity_horizontal's locked pendulums are certified.
     assert!(certified >= 1, "no run certified");
@@ -84,5 +97,15 @@ fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study
 }
 
 /// The certified runs' RHS calls over the same runs' in full, measured when
-/// the guard was written (28 of the 360 runs, 2026-11-26).
+/// the guard was written (28 of the 360 runs, 2026-11-26), over every
+/// shipped study but [`LATE_STUDY`].
 const MEASURED_CALL_SHARE: f64 = 0.383;
+
+/// A shipped study whose certified runs end late, guarded apart so that
+/// its share does not hide a regression of the others': its balls, held by
+/// rolling resistance in a dead band on an off-centre race, are certified
+/// only near the horizon (measured 2026-11-29).
+const LATE_STUDY: &str = "three_balls_uncertain";
+
+/// [`LATE_STUDY`]'s certified runs' RHS calls over the same runs' in full.
+const LATE_CALL_SHARE: f64 = 0.949;

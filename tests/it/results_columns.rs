@@ -15,6 +15,10 @@ fn repo() -> PathBuf {
 
 /// A column name with a trailing plane index replaced by `{p}`.
 fn pattern(name: &str) -> String {
+    if name.starts_with("scene.") {
+        // One column per uncertain key of the study.
+        return "scene.{key}".to_string();
+    }
     match name.rsplit_once("_plane") {
         Some((head, tail)) if !tail.is_empty() && tail.bytes().all(|b| b.is_ascii_digit()) => {
             format!("{head}_plane{{p}}")

@@ -241,3 +241,45 @@ fn the_cli_refuses_a_bad_key_with_exit_2_and_writes_nothing() {
     assert!(stderr.contains("uncertain.\"rotor.kz\""), "{stderr}");
     assert!(!out.exists());
 }
+
+/// A scene file's `[uncertain]` keys: `study simulate --draws N` runs each
+/// draw, `--json` gives every draw's values within their distributions, and
+/// `--draws` on a scene without such keys is refused with exit 2.
+#[test]
+fn simulate_draws_the_scene_files_keys() {
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let run = |file: &str, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .arg("simulate")
+            .arg(scene.join(file))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run("three_balls.toml", &["--draws", "2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no [uncertain] keys"));
+    let out = run("bristol_uncertain.toml", &["--draws", "3", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let draws: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let draws = draws.as_array().unwrap();
+    assert_eq!(draws.len(), 3);
+    for d in draws {
+        let mu = d["values"]["effects.rolling_resistance.coefficient"]
+            .as_f64()
+            .unwrap();
+        let angle = d["values"]["effects.race_eccentricity.angle_deg"]
+            .as_f64()
+            .unwrap();
+        assert!(
+            (3e-4..=3e-3).contains(&mu) && (0.0..=360.0).contains(&angle),
+            "{d}"
+        );
+        assert!(d["metrics"]["residual_rel"].as_f64().unwrap() > 0.0, "{d}");
+    }
+    assert_ne!(draws[0]["values"], draws[1]["values"]);
+}

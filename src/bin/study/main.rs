@@ -23,6 +23,7 @@ mod report_cmd;
 mod run_cmd;
 mod sensitivity_cmd;
 mod simulate_cmd;
+mod simulate_draws_cmd;
 mod stepped_bands_cmd;
 mod stepped_cmd;
 mod sweep_cmd;

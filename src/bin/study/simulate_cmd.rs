@@ -32,6 +32,13 @@ pub struct SimulateArgs {
     /// Replace the --series file if it exists.
     #[arg(long, requires = "series")]
     overwrite: bool,
+    /// Run the scene once per draw of its `[uncertain]` keys and print the
+    /// spread of settling and residual (--json: every draw).
+    #[arg(long, value_parser = crate::limits::draws, conflicts_with = "series")]
+    draws: Option<u32>,
+    /// Seed of the draws.
+    #[arg(long, default_value_t = autobal::study::config::DEFAULT_SEED)]
+    seed: u64,
 }
 
 /// Run `study simulate`.
@@ -39,6 +46,24 @@ pub fn run(args: &SimulateArgs) -> Result<(), UserError> {
     let shown = args.scene.display().to_string();
     let file = SceneFile::read(&args.scene)?;
     let simulation = file.simulation(&shown)?;
+    match args.draws {
+        Some(n) if n > 0 && file.uncertain.is_empty() => {
+            return Err(UserError(
+                format!("--draws {n}: {shown} has no [uncertain] keys to draw"),
+                2,
+            ));
+        }
+        Some(n) if n > 0 => {
+            return crate::simulate_draws_cmd::run(&file, &simulation, (n, args.seed), args.json);
+        }
+        _ => {}
+    }
+    if !file.uncertain.is_empty() && !args.json {
+        crate::output::say_err(&format!(
+            "(the nominal values of the scene's {} uncertain key(s); --draws N runs their spread)",
+            file.uncertain.len()
+        ));
+    }
     if let Some(path) = &args.series {
         prepare("--series", path, WhenExists::from_overwrite(args.overwrite))?;
     }
