@@ -4,7 +4,7 @@
 
 use crate::UserError;
 use crate::plot_cmd::plot_error;
-use crate::ranking::ranking;
+use crate::ranking::{ranking, robustness_findings};
 use autobal::output_file::{WhenExists, prepare};
 use autobal::report::{Report, question, study_figures};
 use autobal::study::decision::StudyDecision;
@@ -124,13 +124,17 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
             .map(str::to_string)
             .collect()
     };
+    // A study with uncertain keys: whether #1 survives them, as `study run` says.
+    let plan = autobal::study::config::load(&args.dir.join("study.toml"))?;
+    let mut findings = lines(&parts.findings);
+    findings.extend(robustness_findings(&plan, &args.dir, &summary)?);
     let report = Report {
         title,
         question: question(&study_text),
         header: parts.header,
         rows: parts.rows,
         legend: lines(&parts.legend),
-        findings: lines(&parts.findings),
+        findings,
         preformatted: parts.passage,
         figures,
         provenance: vec![

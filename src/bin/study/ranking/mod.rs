@@ -14,7 +14,7 @@ mod findings;
 mod notes;
 mod robustness;
 
-pub use robustness::robustness_lines;
+pub use robustness::{robustness_findings, robustness_lines};
 
 use findings::{disagreement_line, recommendation_line, verdict_line};
 use notes::{contact_line, dead_band_line, merged_line, passage_table};

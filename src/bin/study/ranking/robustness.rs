@@ -11,23 +11,41 @@ use autobal::study::sensitivity::{FILE as SENSITIVITY_FILE, Measure, read_totals
 use polars::prelude::DataFrame;
 use std::path::Path;
 
-/// The robustness lines of the study in `dir` (empty without uncertain keys).
+/// The robustness lines of the study in `dir`, wrapped to the terminal
+/// (empty without uncertain keys).
 pub fn robustness_lines(
     plan: &StudyPlan,
     dir: &Path,
     summary: &DataFrame,
 ) -> Result<String, UserError> {
+    let text = robustness_findings(plan, dir, summary)?.join("\n");
+    if text.is_empty() {
+        return Ok(text);
+    }
+    Ok(crate::output::wrap(
+        &(text + "\n"),
+        crate::output::text_width(),
+    ))
+}
+
+/// The robustness findings of the study in `dir`, one sentence each (the
+/// report lists them with the verdicts).
+pub fn robustness_findings(
+    plan: &StudyPlan,
+    dir: &Path,
+    summary: &DataFrame,
+) -> Result<Vec<String>, UserError> {
     if plan.file.uncertain.is_empty() {
-        return Ok(String::new());
+        return Ok(Vec::new());
     }
     let internal = |e: polars::prelude::PolarsError| UserError::internal(e.to_string());
     let decision = StudyDecision::from_summary(summary).map_err(internal)?;
     let Some(&crown) = decision.leading(1).first() else {
-        return Ok(String::new());
+        return Ok(Vec::new());
     };
     let runs = read_parquet(&dir.join("runs.parquet")).map_err(internal)?;
     let Some(r) = robustness(plan, &runs, crown).map_err(internal)? else {
-        return Ok(String::new());
+        return Ok(Vec::new());
     };
     let keys = plan.file.uncertain.len();
     let mut out = format!(
@@ -61,32 +79,33 @@ pub fn robustness_lines(
     } else {
         out += &format!("; {}", lost.join("; "));
     }
-    out += ".\n";
+    out += ".";
+    let mut findings = vec![out];
     match read_totals(plan, dir, crown, Measure::RestrictedSettling) {
         Some(totals) => {
             let top = &totals[0];
             let (input, total, (lo, hi)) = (&top.input, top.total, top.interval);
             let c = |x: f64| x.clamp(0.0, 1.0);
-            out += &format!(
-                "{input} has the largest total index on #1's settling time capped at the horizon: S_T = {:.2} [{:.2}, {:.2}] ({SENSITIVITY_FILE}; the share of its variance the input accounts for, interactions included).\n",
+            findings.push(format!(
+                "{input} has the largest total index on #1's settling time capped at the horizon: S_T = {:.2} [{:.2}, {:.2}] ({SENSITIVITY_FILE}; the share of its variance the input accounts for, interactions included).",
                 c(total),
                 c(lo),
                 c(hi)
-            );
+            ));
         }
         None => {
             if let Some(top) = r.explained.first() {
-                out += &format!(
-                    "of the uncertain keys, {} explains most of #1's settling time capped at the horizon: {:.0} % of its variance (first-order, from {} equal-count bins of the study's runs, less what noise alone puts between them); `study sensitivity` gives every input's total index.\n",
+                findings.push(format!(
+                    "of the uncertain keys, {} explains most of #1's settling time capped at the horizon: {:.0} % of its variance (first-order, from {} equal-count bins of the study's runs, less what noise alone puts between them); `study sensitivity` gives every input's total index.",
                     top.key,
                     100.0 * top.share,
                     autobal::study::robustness::BINS
-                );
+                ));
             }
         }
     }
     debug_assert_eq!(PARTS, 3, "the lines name three parts");
-    Ok(crate::output::wrap(&out, crate::output::text_width()))
+    Ok(findings)
 }
 
 /// A criterion value as printed.
