@@ -6,11 +6,16 @@
 use autobal::study::criterion::Criterion;
 use clap::builder::{PossibleValue, TypedValueParser};
 
-/// `--rank-by`: parsed by [`crate::run_cmd::parse_criterion`], completed
+/// `--rank-by`: parsed by [`parse_criterion`], completed
 /// to the criterion names (hidden from `--help`, whose text lists the forms
 /// with their parameters).
 #[derive(Clone, Copy)]
 pub struct CriterionParser;
+
+/// `--rank-by` as clap parses it (every verb that takes it).
+fn parse_criterion(text: &str) -> Result<Criterion, String> {
+    Criterion::parse(text)
+}
 
 /// The criterion forms a shell offers, with what each ranks by.
 const CRITERIA: [(&str, &str); 7] = [
@@ -42,7 +47,7 @@ impl TypedValueParser for CriterionParser {
         value: &std::ffi::OsStr,
     ) -> Result<Criterion, clap::Error> {
         // The same parser and messages as before completion knew the values.
-        crate::run_cmd::parse_criterion.parse_ref(cmd, arg, value)
+        parse_criterion.parse_ref(cmd, arg, value)
     }
 
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {

@@ -107,11 +107,14 @@ impl RunProgress {
     }
 }
 
-/// A rate of runs as people read it: "581 runs/s", or below one run a
-/// second "12.3 s/run" (a slow study would otherwise show "0 runs/s").
+/// A rate of runs as people read it: "581 runs/s", "1.3 runs/s" (a tenth
+/// below ten, so that 1.29 is not read as 1), or below one run a second
+/// "12.3 s/run" (a slow study would otherwise show "0 runs/s").
 pub fn rate_text(runs_per_second: f64) -> String {
-    if runs_per_second >= 0.95 {
+    if runs_per_second >= 9.95 {
         format!("{runs_per_second:.0} runs/s")
+    } else if runs_per_second >= 0.95 {
+        format!("{runs_per_second:.1} runs/s")
     } else if runs_per_second > 0.0 && runs_per_second.is_finite() {
         format!("{:.1} s/run", 1.0 / runs_per_second)
     } else {
@@ -241,7 +244,9 @@ mod tests {
     #[test]
     fn a_rate_below_one_run_a_second_is_given_in_seconds_per_run() {
         assert_eq!(rate_text(581.6), "582 runs/s");
-        assert_eq!(rate_text(1.0), "1 runs/s");
+        assert_eq!(rate_text(1.0), "1.0 runs/s");
+        assert_eq!(rate_text(1.29), "1.3 runs/s");
+        assert_eq!(rate_text(9.96), "10 runs/s");
         assert_eq!(rate_text(1.0 / 12.3), "12.3 s/run");
         assert_eq!(rate_text(0.0), "– s/run");
     }

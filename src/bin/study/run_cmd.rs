@@ -59,11 +59,6 @@ pub struct RunArgs {
     rank_by: Option<Criterion>,
 }
 
-/// `--rank-by` as clap parses it.
-pub fn parse_criterion(text: &str) -> Result<Criterion, String> {
-    Criterion::parse(text)
-}
-
 /// Arguments of `study merge`.
 #[derive(Args)]
 pub struct MergeArgs {
