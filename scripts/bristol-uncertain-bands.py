@@ -15,6 +15,7 @@ Usage: python3 scripts/bristol-uncertain-bands.py [STUDY_BINARY] [DRAWS]
 (after `cargo build`; about 1 minute per 32 draws on two cores).
 """
 
+import importlib.util
 import json
 import subprocess
 import sys
@@ -25,16 +26,11 @@ ROOT = Path(__file__).resolve().parent.parent
 STUDY = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "target/debug/study")
 DRAWS = sys.argv[2] if len(sys.argv) > 2 else "32"
 SCENE = (ROOT / "scenes/bristol_uncertain.toml").read_text()
-M, JT_MINUS_JP = 1.28, 1.256e-2  # kg, kg m^2 (Table 1)
-# Table 2: washers -> (eccentricity mm, misalignment rad, epsilon leads chi by deg)
-TABLE2 = {
-    0: (0.0, 6.1e-5, 0.0),
-    1: (1.0e-2, 4.8e-5, 282.0),
-    2: (1.9e-2, 5.1e-5, 247.0),
-    3: (2.9e-2, 6.8e-5, 224.0),
-    4: (3.9e-2, 9.2e-5, 211.0),
-}
-PAPER_FIG12 = {0: 1.4, 1: 0.95, 2: 0.45, 3: 0.16, 4: 0.36}
+# Table 2 and the paper's Fig. 12 ratios, from the rig-cases script (one copy).
+_CASES = importlib.util.spec_from_file_location("cases", ROOT / "scripts/bristol-rig-cases.py")
+cases = importlib.util.module_from_spec(_CASES)
+_CASES.loader.exec_module(cases)
+M, JT_MINUS_JP, TABLE2, PAPER_FIG12 = cases.M, cases.JT_MINUS_JP, cases.TABLE2, cases.PAPER_FIG12
 PAPER_ONSET = 3000
 
 

@@ -26,15 +26,7 @@ pub fn run(
     (draws, seed): (u32, u64),
     json: bool,
 ) -> Result<(), UserError> {
-    say_err(&format!(
-        "{draws} draws of {} uncertain key(s) ({}), seed {seed}",
-        file.uncertain.len(),
-        file.uncertain
-            .keys()
-            .cloned()
-            .collect::<Vec<_>>()
-            .join(", ")
-    ));
+    say_err(&crate::stepped_bands_cmd::draws_header(file, draws, seed));
     let runs: Vec<DrawJson> = (0..draws)
         .into_par_iter()
         .map(|i| {

@@ -36,6 +36,19 @@ struct DrawJson<'a> {
     steps: &'a [autobal::simulation::stepped::StepPoint],
 }
 
+/// What a verb over the scene's uncertain draws says before it runs.
+pub fn draws_header(file: &SceneFile, draws: u32, seed: u64) -> String {
+    format!(
+        "{draws} draws of {} uncertain key(s) ({}), seed {seed}",
+        file.uncertain.len(),
+        file.uncertain
+            .keys()
+            .cloned()
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
 /// Sweep `draws` draws of the scene's uncertain keys and print the bands.
 pub fn run(
     file: &SceneFile,
@@ -45,13 +58,8 @@ pub fn run(
     outputs: Outputs<'_>,
 ) -> Result<(), UserError> {
     say_err(&format!(
-        "{draws} draws of {} uncertain key(s) ({}), seed {seed}: {draws} sweeps",
-        file.uncertain.len(),
-        file.uncertain
-            .keys()
-            .cloned()
-            .collect::<Vec<_>>()
-            .join(", ")
+        "{}: {draws} sweeps",
+        draws_header(file, draws, seed)
     ));
     let sweeps = sweep_draws(simulation, &file.uncertain, sweep, draws, seed);
     let rows = bands(&sweeps);
