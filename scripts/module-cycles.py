@@ -26,7 +26,7 @@ CRATE_LAYERS = [
     {"metrics"},
     {"simulation", "scene_file", "uncertain"},
     {"study"},
-    {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report"},
+    {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report", "calibrate"},
 ]
 MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",

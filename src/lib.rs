@@ -30,6 +30,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod build_info;
+pub mod calibrate;
 pub mod check;
 pub mod claims;
 pub mod design;

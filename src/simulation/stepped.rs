@@ -113,6 +113,18 @@ impl Simulation {
         speeds: &[(Direction, f64)],
         dwell: f64,
     ) -> Result<Vec<StepPoint>, SteppedError> {
+        self.stepped_sweep_windowed(speeds, dwell, None)
+    }
+
+    /// The stepped sweep with each step read over the last `window`
+    /// seconds of its dwell (whole revolutions, at least one; `None`: one),
+    /// as a rig reads its vibration over a time window.
+    pub fn stepped_sweep_windowed(
+        &self,
+        speeds: &[(Direction, f64)],
+        dwell: f64,
+        window: Option<f64>,
+    ) -> Result<Vec<StepPoint>, SteppedError> {
         let slowest = speeds.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
         if !(dwell.is_finite() && dwell * slowest >= 2.0 * PI) {
             return Err(SceneError::Invalid {
@@ -152,14 +164,18 @@ impl Simulation {
                 omega,
                 why,
             };
-            // Up to the last revolution (none when the dwell is exactly one).
-            let (t_settled, y_settled, measure_with) = if dwell > rev {
+            // The revolutions read: the window's, whole, within the dwell.
+            let read_revs = window.map_or(1.0, |w| (w / rev - 1e-9).ceil().max(1.0));
+            let read_revs = read_revs.min((dwell / rev + 1e-9).floor().max(1.0));
+            let settle_for = dwell - read_revs * rev;
+            // Up to the revolutions read (none when the dwell is exactly them).
+            let (t_settled, y_settled, measure_with) = if settle_for > 0.0 {
                 let settle = solve(
                     method,
                     &system,
                     t0,
                     &y0,
-                    t0 + dwell - rev,
+                    t0 + settle_for,
                     &options,
                     &mut NoObserver,
                 );
@@ -174,7 +190,7 @@ impl Simulation {
             let watch = system.watch_maps().to_vec();
             let bearings = system.rotor().bearing_maps();
             let maps: Vec<_> = watch.iter().chain(&bearings).copied().collect();
-            let revolution = integrate_revolution(
+            let mut revolution = integrate_revolution(
                 measure_with,
                 &system,
                 &system,
@@ -185,6 +201,22 @@ impl Simulation {
                 &maps,
             )
             .ok_or_else(|| fail("the measured revolution failed".into(), &points))?;
+            for _ in 1..read_revs as usize {
+                let next = integrate_revolution(
+                    measure_with,
+                    &system,
+                    &system,
+                    (revolution.t, &revolution.y),
+                    omega,
+                    self.metrics.samples_per_rev,
+                    &options,
+                    &maps,
+                )
+                .ok_or_else(|| fail("a measured revolution failed".into(), &points))?;
+                revolution.radii.extend(next.radii);
+                revolution.t = next.t;
+                revolution.y = next.y;
+            }
             let whirl =
                 revolution.orbit_of(|r| r[..watch.len()].iter().copied().fold(0.0, f64::max));
             let orbits: Vec<Orbit> = (watch.len()..maps.len())

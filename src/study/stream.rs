@@ -52,6 +52,9 @@ pub enum Purpose {
     /// Bootstrap resampling of a sensitivity analysis's indices
     /// (`super::sensitivity`).
     Sensitivity = 11,
+    /// Draws of a rig's unknowns and synthetic measurement noise
+    /// (`crate::calibrate`).
+    Calibration = 12,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for

@@ -5,6 +5,7 @@ mod auto_method;
 mod bad_input;
 mod bad_input_two;
 mod bench;
+mod calibration;
 mod certified_hold;
 mod check;
 mod claims;

@@ -4,6 +4,7 @@
 
 mod bench;
 mod bench_cmd;
+mod calibrate_cmd;
 mod check_cmd;
 mod claims_cmd;
 mod compare_cmd;
@@ -78,6 +79,9 @@ enum Command {
     /// Which sampled input (unbalance, start, tolerances, uncertain keys) explains each design's spread: Sobol indices.
     #[command(after_help = sensitivity_cmd::EXAMPLES)]
     Sensitivity(sensitivity_cmd::SensitivityArgs),
+    /// Fit a rig's unknowns to its measured points: intervals, and predictions of the points held out.
+    #[command(after_help = calibrate_cmd::EXAMPLES)]
+    Calibrate(calibrate_cmd::CalibrateArgs),
     /// Compare a fresh run of a study with its baseline: KS, Fisher and Mood tests, Holm; exit 1 on a regression.
     #[command(after_help = check_cmd::CHECK_EXAMPLES)]
     Check(check_cmd::CheckArgs),
@@ -168,6 +172,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare_cmd::run(&args),
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Sensitivity(args) => sensitivity_cmd::run(&args),
+        Command::Calibrate(args) => calibrate_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
         Command::Report(args) => report_cmd::run(&args),
