@@ -90,7 +90,10 @@ fn synthetic_rig_is_recovered_and_its_intervals_cover_the_truth() {
     }
     // Drag: a log-uniform prior over a factor 25; the interval a factor < 3.
     let share = (hi[0] / lo[0]).ln() / (pmax[0] / pmin[0]).ln();
-    assert!(share < 0.35, "drag interval is {share:.2} of the prior\n{stdout}");
+    assert!(
+        share < 0.35,
+        "drag interval is {share:.2} of the prior\n{stdout}"
+    );
     let cov = frame(&out_dir, "coverage.parquet");
     assert_eq!(cov.height(), 20);
     for (key, _) in KEYS {
@@ -104,7 +107,10 @@ fn synthetic_rig_is_recovered_and_its_intervals_cover_the_truth() {
             .count();
         assert!(covered >= 18, "{key}: covered {covered} of 20\n{stdout}");
     }
-    assert!(stdout.contains("Synthetic check, 20 repetitions"), "{stdout}");
+    assert!(
+        stdout.contains("Synthetic check, 20 repetitions"),
+        "{stdout}"
+    );
 }
 
 /// The shipped rig file holds exactly the data `--synthetic` generates at
@@ -121,7 +127,11 @@ fn shipped_synthetic_data_is_the_tools_own_and_threads_do_not_matter() {
     synthetic.extend(cheap);
     for args in [from_file, synthetic] {
         let out = calibrate(&args);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     for name in ["calibration.parquet", "points.parquet", "draws.parquet"] {
         assert!(
@@ -172,11 +182,7 @@ fn bad_rig_files_are_refused_naming_the_key() {
         let rig = dir.path().join("rig.toml");
         std::fs::write(&rig, body).unwrap();
         let out_dir = dir.path().join("never");
-        let out = calibrate(&[
-            rig.to_str().unwrap(),
-            "--out",
-            out_dir.to_str().unwrap(),
-        ]);
+        let out = calibrate(&[rig.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{what}: {err}");
         assert!(err.contains(key), "{what}: {err}");
@@ -187,5 +193,7 @@ fn bad_rig_files_are_refused_naming_the_key() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--synthetic"));
     let out = calibrate(&[RIG, "--synthetic", "balancer.drag=10"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("effects.rolling_resistance.coefficient"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("effects.rolling_resistance.coefficient")
+    );
 }

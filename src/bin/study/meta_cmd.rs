@@ -32,6 +32,7 @@ taplo (Even Better TOML) at one (docs/study-file.md, docs/scene-file.md).";
 #[derive(Args)]
 pub struct SchemaArgs {
     /// Which file: a study (`study run`) or a scene (`study simulate`).
+    #[arg(hide_possible_values = true)]
     file: SchemaFile,
 }
 
@@ -65,6 +66,7 @@ pub fn schema(args: &SchemaArgs) -> Result<(), UserError> {
 #[derive(Args)]
 pub struct CompletionsArgs {
     /// The shell: bash, zsh, fish, powershell or elvish.
+    #[arg(hide_possible_values = true)]
     shell: Shell,
 }
 
