@@ -173,7 +173,8 @@ impl RigProblem {
             .take(settings.restarts.max(1))
             .map(|&i| draws[i].u.clone())
             .collect();
-        let objective = |u: &[f64]| loss(points, measured, &self.predict(&self.values_at(u)));
+        let objective =
+            |u: &[f64]| loss(points, measured, &self.predict_fitted(&self.values_at(u)));
         let ends = restarts(&objective, &starts, settings.budget);
         let best = ends
             .iter()

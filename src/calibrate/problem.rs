@@ -124,9 +124,25 @@ impl RigProblem {
     /// Every point's prediction with the unknowns at `values` (one run or
     /// sweep per case, the cases in parallel).
     pub fn predict(&self, values: &[f64]) -> Arc<Vec<Prediction>> {
-        let memo_key: Vec<u64> = values.iter().map(|v| v.to_bits()).collect();
-        if let Some(hit) = self.memo.lock().expect("memo lock").get(&memo_key) {
-            return Arc::clone(hit);
+        self.predict_cases(values, false)
+    }
+
+    /// The fitted points' predictions only (the cases with no fitted point
+    /// are not run: their points read "not run"), for the fit's search.
+    pub fn predict_fitted(&self, values: &[f64]) -> Arc<Vec<Prediction>> {
+        self.predict_cases(values, true)
+    }
+
+    fn predict_cases(&self, values: &[f64], fitted_only: bool) -> Arc<Vec<Prediction>> {
+        let bits: Vec<u64> = values.iter().map(|v| v.to_bits()).collect();
+        let full_key = [bits.as_slice(), &[0]].concat();
+        let memo_key = [bits.as_slice(), &[u64::from(fitted_only)]].concat();
+        {
+            let memo = self.memo.lock().expect("memo lock");
+            // A full prediction serves a fitted-only request as well.
+            if let Some(hit) = memo.get(&full_key).or_else(|| memo.get(&memo_key)) {
+                return Arc::clone(hit);
+            }
         }
         let set: Vec<UncertainValue> = self
             .keys()
@@ -137,9 +153,21 @@ impl RigProblem {
                 value,
             })
             .collect();
+        let fitted = |i: usize| {
+            let name = &self.rig.cases[i].name;
+            self.rig
+                .points
+                .iter()
+                .any(|p| p.role == super::rig_file::Use::Fit && &p.case == name)
+        };
         let per_case: Vec<Result<Observed, String>> = (0..self.rig.cases.len())
             .into_par_iter()
-            .map(|i| self.case_scene(i, &set).and_then(|sim| self.observe(&sim)))
+            .map(|i| {
+                if fitted_only && !fitted(i) {
+                    return Err("not run: the case has no fitted point".into());
+                }
+                self.case_scene(i, &set).and_then(|sim| self.observe(&sim))
+            })
             .collect();
         let predictions: Vec<Prediction> = self
             .rig
@@ -194,7 +222,7 @@ impl RigProblem {
                     down,
                 );
                 let steps = sim
-                    .stepped_sweep_windowed(&speeds, dwell, window)
+                    .stepped_sweep_windowed(&speeds, dwell, window, None)
                     .map_err(|e| e.to_string())?;
                 Ok(Observed::Stepped {
                     steps,

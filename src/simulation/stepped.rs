@@ -87,6 +87,43 @@ pub struct StepPoint {
     pub angles_deg: Vec<f64>,
 }
 
+/// Every sample a stepped sweep read, in time order: the windows at the
+/// end of each dwell (what a rig's recorder keeps).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SweepSeries {
+    /// The step's index in the sweep.
+    pub step: Vec<u32>,
+    /// Run-up or run-down.
+    pub direction: Vec<Direction>,
+    /// The step's speed (rad/s).
+    pub omega: Vec<f64>,
+    /// Time since the sweep began (s).
+    pub t: Vec<f64>,
+    /// The largest watched plane's radial displacement (m).
+    pub whirl: Vec<f64>,
+    /// Each bearing's radial displacement (m).
+    pub bearings: Vec<Vec<f64>>,
+}
+
+impl SweepSeries {
+    /// As a table: `step`, `direction`, `rpm`, `t`, `whirl` and `bearing_<b>` per bearing.
+    pub fn to_dataframe(&self) -> PolarsResult<DataFrame> {
+        let mut df = df!(
+            "step" => self.step.clone(),
+            "direction" => self.direction.iter().map(|d| d.name()).collect::<Vec<_>>(),
+            "rpm" => self.omega.iter().map(|w| w * 30.0 / PI).collect::<Vec<f64>>(),
+            "t" => self.t.clone(),
+            "whirl" => self.whirl.clone(),
+        )?;
+        let bearings = self.bearings.first().map_or(0, Vec::len);
+        for b in 0..bearings {
+            let column: Vec<f64> = self.bearings.iter().map(|r| r[b]).collect();
+            df.with_column(Column::new(format!("bearing_{b}").into(), column))?;
+        }
+        Ok(df)
+    }
+}
+
 /// Why a stepped sweep could not go on.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SteppedError {
@@ -113,17 +150,19 @@ impl Simulation {
         speeds: &[(Direction, f64)],
         dwell: f64,
     ) -> Result<Vec<StepPoint>, SteppedError> {
-        self.stepped_sweep_windowed(speeds, dwell, None)
+        self.stepped_sweep_windowed(speeds, dwell, None, None)
     }
 
     /// The stepped sweep with each step read over the last `window`
     /// seconds of its dwell (whole revolutions, at least one; `None`: one),
-    /// as a rig reads its vibration over a time window.
+    /// as a rig reads its vibration over a time window; with `series`, every
+    /// sample read is kept there, as a rig's recorder keeps them.
     pub fn stepped_sweep_windowed(
         &self,
         speeds: &[(Direction, f64)],
         dwell: f64,
         window: Option<f64>,
+        mut series: Option<&mut SweepSeries>,
     ) -> Result<Vec<StepPoint>, SteppedError> {
         let slowest = speeds.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
         if !(dwell.is_finite() && dwell * slowest >= 2.0 * PI) {
@@ -201,7 +240,9 @@ impl Simulation {
                 &maps,
             )
             .ok_or_else(|| fail("the measured revolution failed".into(), &points))?;
+            let mut starts = vec![(t_settled, revolution.radii.len())];
             for _ in 1..read_revs as usize {
+                starts.push((revolution.t, 0));
                 let next = integrate_revolution(
                     measure_with,
                     &system,
@@ -213,12 +254,31 @@ impl Simulation {
                     &maps,
                 )
                 .ok_or_else(|| fail("a measured revolution failed".into(), &points))?;
+                if let Some(last) = starts.last_mut() {
+                    last.1 = next.radii.len();
+                }
                 revolution.radii.extend(next.radii);
                 revolution.t = next.t;
                 revolution.y = next.y;
             }
-            let whirl =
-                revolution.orbit_of(|r| r[..watch.len()].iter().copied().fold(0.0, f64::max));
+            let whirl_of = |r: &[f64]| r[..watch.len()].iter().copied().fold(0.0, f64::max);
+            if let Some(series) = series.as_deref_mut() {
+                let times = starts
+                    .iter()
+                    .flat_map(|&(t, n)| (1..=n).map(move |k| t + rev * k as f64 / n as f64));
+                // Time since the sweep began (each dwell's own clock starts
+                // where its spin angle does).
+                let since_start = dwell * points.len() as f64 - t0;
+                for (t, r) in times.zip(&revolution.radii) {
+                    series.step.push(points.len() as u32);
+                    series.direction.push(direction);
+                    series.omega.push(omega);
+                    series.t.push(t + since_start);
+                    series.whirl.push(whirl_of(r));
+                    series.bearings.push(r[watch.len()..].to_vec());
+                }
+            }
+            let whirl = revolution.orbit_of(whirl_of);
             let orbits: Vec<Orbit> = (watch.len()..maps.len())
                 .map(|m| revolution.orbit(m))
                 .collect();

@@ -66,7 +66,7 @@ pub fn drawn_simulation(
 pub fn sweep_draws(
     simulation: &Simulation,
     spec: &UncertainSpec,
-    (speeds, dwell): (&[(Direction, f64)], f64),
+    (speeds, dwell, window): (&[(Direction, f64)], f64, Option<f64>),
     draws: u32,
     seed: u64,
 ) -> Vec<DrawSweep> {
@@ -74,12 +74,13 @@ pub fn sweep_draws(
         .into_par_iter()
         .map(|i| {
             let (values, drawn) = drawn_simulation(simulation, spec, seed, i);
-            let (points, failure) = match drawn.map(|sim| sim.stepped_sweep(speeds, dwell)) {
-                Ok(Ok(points)) => (points, None),
-                Ok(Err(SteppedError::Failed { done, why, .. })) => (done, Some(why)),
-                Ok(Err(SteppedError::Scene(e))) => (Vec::new(), Some(e.to_string())),
-                Err(why) => (Vec::new(), Some(why)),
-            };
+            let (points, failure) =
+                match drawn.map(|sim| sim.stepped_sweep_windowed(speeds, dwell, window, None)) {
+                    Ok(Ok(points)) => (points, None),
+                    Ok(Err(SteppedError::Failed { done, why, .. })) => (done, Some(why)),
+                    Ok(Err(SteppedError::Scene(e))) => (Vec::new(), Some(e.to_string())),
+                    Err(why) => (Vec::new(), Some(why)),
+                };
             DrawSweep {
                 draw: i,
                 values,

@@ -96,3 +96,135 @@ fn a_dwell_shorter_than_a_revolution_is_refused_naming_the_flag() {
         "{err}"
     );
 }
+
+/// A reading window holds whole revolutions at the dwell's end: its peak is
+/// the largest sample recorded in it, its samples are in time order inside
+/// the dwell, a one-revolution window is the default reading, and the dwell
+/// itself (the state at its end) does not depend on how it is read.
+#[test]
+fn a_reading_window_is_the_recorded_samples_at_the_dwells_end() {
+    use autobal::simulation::stepped::SweepSeries;
+    let sim = three_balls();
+    let omega = 4.0;
+    let rev = 2.0 * std::f64::consts::PI / omega;
+    let speeds = [(Direction::Up, omega), (Direction::Up, omega * 1.5)];
+    let dwell = 12.0 * rev;
+    let mut series = SweepSeries::default();
+    let read = sim
+        .stepped_sweep_windowed(&speeds, dwell, Some(3.0 * rev), Some(&mut series))
+        .expect("runs");
+    // One revolution at the faster speed: less than one at the slower, and
+    // a window holds at least one whole revolution.
+    let fast_rev = 2.0 * std::f64::consts::PI / (omega * 1.5);
+    let last_rev = sim
+        .stepped_sweep_windowed(&speeds, dwell, Some(fast_rev), None)
+        .expect("runs");
+    assert_eq!(last_rev, sim.stepped_sweep(&speeds, dwell).expect("runs"));
+    for (step, p) in read.iter().enumerate() {
+        let rows: Vec<usize> = (0..series.t.len())
+            .filter(|&i| series.step[i] as usize == step)
+            .collect();
+        let w_rev = 2.0 * std::f64::consts::PI / p.omega;
+        let t0 = step as f64 * dwell;
+        let (first, last) = (series.t[rows[0]], series.t[*rows.last().unwrap()]);
+        let revs = (3.0 * rev / w_rev - 1e-9).ceil();
+        let begins = t0 + dwell - revs * w_rev;
+        assert!(
+            first > begins && first < begins + 0.1 * w_rev,
+            "{first} vs {begins}"
+        );
+        assert!(
+            (last - (t0 + dwell)).abs() < 1e-9,
+            "{last} vs {}",
+            t0 + dwell
+        );
+        assert!(rows.windows(2).all(|w| series.t[w[1]] > series.t[w[0]]));
+        let peak = rows.iter().map(|&i| series.whirl[i]).fold(0.0, f64::max);
+        assert_eq!(peak, p.whirl_peak);
+        // The three-revolution peak holds the last revolution's.
+        assert!(p.whirl_peak >= last_rev[step].whirl_peak);
+        for (x, y) in p.angles_deg.iter().zip(&last_rev[step].angles_deg) {
+            assert!((x - y).abs() < 1e-6, "{x} vs {y}");
+        }
+    }
+}
+
+/// `study stepped` warns where a scene makes the protocol matter or its
+/// weights unlike solid balls, writes the recording with --series, and
+/// refuses flags that cannot take effect, naming them.
+#[test]
+fn the_stepped_verb_warns_records_and_refuses_by_flag() {
+    use std::process::Command;
+    let study = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .arg("stepped")
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let series = dir.path().join("series.parquet");
+    let out = study(&[
+        "scenes/three_balls.toml",
+        "--rpm",
+        "38..40",
+        "--step-rpm",
+        "1",
+        "--dwell",
+        "5",
+        "--window",
+        "2",
+        "--series",
+        series.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("[[cargo]] weights are point masses"), "{err}");
+    let df = autobal::study::io::read_parquet(&series).unwrap();
+    assert_eq!(
+        df.get_column_names()
+            .iter()
+            .map(|c| c.as_str())
+            .collect::<Vec<_>>(),
+        ["step", "direction", "rpm", "t", "whirl"]
+    );
+    let out = study(&[
+        "scenes/bristol_uncertain.toml",
+        "--rpm",
+        "4000..4100",
+        "--step-rpm",
+        "100",
+        "--dwell",
+        "0.1",
+        "--draws",
+        "1",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("with rolling resistance"), "{err}");
+    for (flags, named) in [
+        (&["--window", "6"][..], "--window"),
+        (&["--threads", "2"][..], "--threads"),
+    ] {
+        let mut args = vec!["scenes/three_balls.toml", "--rpm", "38..40", "--step-rpm", "1", "--dwell", "5"];
+        args.extend(flags);
+        let out = study(&args);
+        assert_eq!(out.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&out.stderr).contains(named));
+    }
+    let out = study(&[
+        "scenes/bristol_uncertain.toml",
+        "--rpm",
+        "4000..4100",
+        "--step-rpm",
+        "100",
+        "--dwell",
+        "0.1",
+        "--series",
+        dir.path().join("s2.parquet").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--series"));
+    assert!(!dir.path().join("s2.parquet").exists());
+}

@@ -53,7 +53,7 @@ pub fn draws_header(file: &SceneFile, draws: u32, seed: u64) -> String {
 pub fn run(
     file: &SceneFile,
     simulation: &Simulation,
-    sweep: (&[(Direction, f64)], f64),
+    sweep: (&[(Direction, f64)], f64, Option<f64>),
     (draws, seed): (u32, u64),
     outputs: Outputs<'_>,
 ) -> Result<(), UserError> {

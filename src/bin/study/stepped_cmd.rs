@@ -4,7 +4,9 @@
 use crate::UserError;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
-use autobal::simulation::stepped::{StepPoint, SteppedError, stepped_speeds, to_dataframe};
+use autobal::simulation::stepped::{
+    StepPoint, SteppedError, SweepSeries, stepped_speeds, to_dataframe,
+};
 use autobal::study::io::{Provenance, write_parquet};
 use clap::Args;
 use std::f64::consts::PI;
@@ -32,9 +34,19 @@ pub struct SteppedArgs {
     /// revolution of each dwell is the one measured.
     #[arg(long, value_parser = crate::limits::dwell_seconds)]
     dwell: f64,
+    /// Seconds at the end of each dwell over which the vibration is read
+    /// (whole revolutions; default the last revolution), as a rig reads it.
+    #[arg(long, value_parser = crate::limits::dwell_seconds)]
+    window: Option<f64>,
     /// Run up only (by default the run-down from hi back to lo follows).
     #[arg(long)]
     up_only: bool,
+    /// Write every sample read (each dwell's window) to this Parquet file: a rig's recording.
+    #[arg(long)]
+    series: Option<PathBuf>,
+    /// Worker threads for --draws (the results do not depend on it).
+    #[arg(long, value_parser = crate::limits::threads)]
+    threads: Option<usize>,
     /// Write one row per step to this Parquet file.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -112,12 +124,43 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
             2,
         ));
     }
-    for (flag, path) in [("--out", &args.out), ("--draws-out", &args.draws_out)] {
+    if let Some(w) = args.window
+        && w > args.dwell
+    {
+        return Err(UserError(
+            format!(
+                "--window {w}: longer than the dwell ({} s) it is read from",
+                args.dwell
+            ),
+            2,
+        ));
+    }
+    if args.series.is_some() && draws > 0 {
+        return Err(UserError(
+            "--series: records one sweep; give --draws 0 to sweep the nominal scene".into(),
+            2,
+        ));
+    }
+    if args.threads.is_some() && draws == 0 {
+        return Err(UserError(
+            "--threads: runs the draws in parallel; one sweep is one thread (give --draws N)"
+                .into(),
+            2,
+        ));
+    }
+    for (flag, path) in [
+        ("--out", &args.out),
+        ("--draws-out", &args.draws_out),
+        ("--series", &args.series),
+    ] {
         if let Some(path) = path {
             prepare(flag, path, WhenExists::from_overwrite(args.overwrite))?;
         }
     }
     let simulation = file.simulation(&shown)?;
+    for line in protocol_warnings(&file) {
+        eprintln!("warning: {line}");
+    }
     let to_rad = PI / 30.0;
     let speeds = stepped_speeds(
         lo * to_rad,
@@ -132,16 +175,19 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
             scene: &args.scene,
             json: args.json,
         };
-        let sweep = (speeds.as_slice(), args.dwell);
-        return crate::stepped_bands_cmd::run(
-            &file,
-            &simulation,
-            sweep,
-            (draws, args.seed),
-            outputs,
-        );
+        let sweep = (speeds.as_slice(), args.dwell, args.window);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(crate::limits::capped_threads(args.threads).unwrap_or(0))
+            .build()
+            .map_err(|e| UserError::internal(e.to_string()))?;
+        return pool.install(|| {
+            crate::stepped_bands_cmd::run(&file, &simulation, sweep, (draws, args.seed), outputs)
+        });
     }
-    let (points, failure) = match simulation.stepped_sweep(&speeds, args.dwell) {
+    let mut series = args.series.as_ref().map(|_| SweepSeries::default());
+    let swept =
+        simulation.stepped_sweep_windowed(&speeds, args.dwell, args.window, series.as_mut());
+    let (points, failure) = match swept {
         Ok(points) => (points, None),
         Err(SteppedError::Scene(e)) if matches!(&e, autobal::model::scene::SceneError::Invalid { field, .. } if field == "dwell") =>
         {
@@ -165,6 +211,15 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
         let mut df = to_dataframe(&points).map_err(|e| UserError::internal(e.to_string()))?;
         write_parquet(path, &mut df, &provenance)
             .map_err(|e| UserError::internal(format!("--out {e}")))?;
+    }
+    if let (Some(path), Some(series)) = (&args.series, &series) {
+        let text = autobal::input_file::read_text(&args.scene)?;
+        let provenance = Provenance::new(&text, 0, "stepped sweep series");
+        let mut df = series
+            .to_dataframe()
+            .map_err(|e| UserError::internal(e.to_string()))?;
+        write_parquet(path, &mut df, &provenance)
+            .map_err(|e| UserError::internal(format!("--series {e}")))?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&points)?);
@@ -225,6 +280,23 @@ fn describe(points: &[StepPoint]) -> String {
     }
     header.push("ε");
     let mut s = crate::output::text_table(&header, &rows);
-    s += "\nEach row: the last revolution of the dwell at that speed, the state carried from the step before. Whirl: the largest balancer (or load) plane's radial displacement; bearing peaks: each support's; over without: the mean of the peaks over the same mean without the balancer's unbalance (the rotor's own unbalance, weights' mass carried); ε: the unbalance left over U.\n";
+    s += "\nEach row: the dwell at that speed read over its last revolution (or --window), the state carried from the step before. Whirl: the largest balancer (or load) plane's radial displacement; bearing peaks: each support's; over without: the mean of the peaks over the same mean without the balancer's unbalance (the rotor's own unbalance, weights' mass carried); ε: the unbalance left over U.\n";
     s
+}
+
+/// What the scene makes of a rig's protocol that a user would not guess.
+fn protocol_warnings(file: &SceneFile) -> Vec<String> {
+    let mut out = Vec::new();
+    if file.effects.rolling_resistance.is_some() {
+        out.push(
+            "with rolling resistance the balls stop where the last step left them: the answer depends on --step-rpm, --dwell and --window (up to 2x on the Bristol rig, docs/validation.md); use the rig's own protocol".into(),
+        );
+    }
+    if file.cargo.len() >= 2 {
+        out.push(format!(
+            "the {} [[cargo]] weights are point masses with no contact: two can sit at the same angle and act as one, which solid balls cannot; give [balancer] (kind, n, rho, race_radius) for solid weights that touch",
+            file.cargo.len()
+        ));
+    }
+    out
 }
