@@ -207,7 +207,15 @@ fn the_stepped_verb_warns_records_and_refuses_by_flag() {
         (&["--window", "6"][..], "--window"),
         (&["--threads", "2"][..], "--threads"),
     ] {
-        let mut args = vec!["scenes/three_balls.toml", "--rpm", "38..40", "--step-rpm", "1", "--dwell", "5"];
+        let mut args = vec![
+            "scenes/three_balls.toml",
+            "--rpm",
+            "38..40",
+            "--step-rpm",
+            "1",
+            "--dwell",
+            "5",
+        ];
         args.extend(flags);
         let out = study(&args);
         assert_eq!(out.status.code(), Some(2));
