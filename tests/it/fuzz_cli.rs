@@ -257,6 +257,19 @@ fn path_base(verb: &[String], flag: &str) -> Option<(Vec<&'static str>, &'static
         ),
         (["simulate"], _) => (vec!["simulate", "scene.toml"], "csv"),
         (["compare"], _) => (vec!["compare", "results/corpus", "--designs", "0,0"], "svg"),
+        (["calibrate"], _) => (
+            vec![
+                "calibrate",
+                "rig.toml",
+                "--draws",
+                "4",
+                "--restarts",
+                "1",
+                "--budget",
+                "4",
+            ],
+            "d",
+        ),
         (["claims"], _) => (vec!["claims", "corpus.toml"], "md"),
         (["check"], _) => (vec!["check", "corpus.toml"], "parquet"),
         (["baseline"], _) => (vec!["baseline", "corpus.toml"], "d"),
@@ -363,6 +376,11 @@ fn every_path_flag_of_every_verb_refuses_folders_links_and_missing_or_read_only_
     let study = crate::bad_input::study(Path::new("results"));
     std::fs::write(dir.join("corpus.toml"), &study).unwrap();
     std::fs::write(dir.join("scene.toml"), crate::bad_input::scene()).unwrap();
+    std::fs::write(
+        dir.join("rig.toml"),
+        "name = \"fuzz\"\nscene = \"scene.toml\"\n[unknowns]\n\"rotor.bx\" = { distribution = \"uniform\", min = 0.05, max = 0.2 }\n[protocol]\nkind = \"run\"\n[[case]]\nname = \"one\"\n[[point]]\ncase = \"one\"\nquantity = \"residual\"\nvalue = 1e-3\nsd = 1e-4\n",
+    )
+    .unwrap();
     for setup in [
         vec!["run", "corpus.toml", "--quiet"],
         vec!["run", "corpus.toml", "--quiet", "--shard", "1/2"],
