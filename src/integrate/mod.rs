@@ -15,6 +15,8 @@
 
 pub mod controller;
 mod cost;
+#[cfg(test)]
+pub(crate) use cost::DEARER_BY;
 pub mod dop853;
 pub mod dp5;
 mod driver;

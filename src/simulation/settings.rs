@@ -45,9 +45,9 @@ pub struct SolverSettings {
     /// record the switch (`method` becomes e.g. "dp5→radau5").
     pub implicit_fallback: bool,
     /// After that hand-over, return to the explicit method for the rest of
-    /// the run when Radau5 makes more than 1.5 times the RHS calls per unit
-    /// time the explicit method made just before it (as on a contact law's
-    /// kink); `method` becomes e.g. "dp5→radau5→dp5".
+    /// the run when Radau5 makes more than 3 times the RHS calls per
+    /// simulated second the explicit method made over its last 16 steps (as
+    /// on a contact law's kink); `method` becomes e.g. "dp5→radau5→dp5".
     pub return_when_dearer: bool,
     /// Radau5 solves its full Newton systems instead of the reduced ones of
     /// a second-order system (the reference for the reduction's test; not a
@@ -255,5 +255,18 @@ impl Fidelity {
     /// analysis, integrating nothing: its runs are estimates.
     pub fn is_estimate(self) -> bool {
         matches!(self, Fidelity::Analytic | Fidelity::Linear)
+    }
+}
+
+#[cfg(test)]
+mod doc_tests {
+    /// The file key's documentation (doc comment, hence the JSON schema and
+    /// editors' hints) gives the margin the integrator uses.
+    #[test]
+    fn the_documented_return_margin_is_the_integrators() {
+        let schema =
+            serde_json::to_string(&schemars::schema_for!(super::SolverSettings)).expect("a schema");
+        let says = format!("more than {} times", crate::integrate::DEARER_BY);
+        assert!(schema.contains(&says), "the schema does not say {says:?}");
     }
 }
