@@ -339,6 +339,43 @@ fn disagreements(
     Ok(out)
 }
 
+/// Row i's part when the planes have designs of their own (`n_plane0`, …
+/// columns): "…, in each of 2 planes" when every plane's part is the same,
+/// else each plane's ("plane 0: …; plane 1: …"); `None` without those
+/// columns (or a summary written before they held the part's size).
+fn plane_parts(c: &SummaryColumns, i: usize) -> PolarsResult<Option<String>> {
+    let mut parts = Vec::new();
+    while c.0.column(&format!("n_plane{}", parts.len())).is_ok() {
+        let p = parts.len();
+        let col = |k: &str| c.f_or_none(&format!("{k}_plane{p}"));
+        let kind = c.s(&format!("kind_plane{p}"))?;
+        let n = c.u32s(&format!("n_plane{p}"))?;
+        let (rho, drag) = (col("rho")?, col("drag")?);
+        let (race, mass) = (col("race_radius")?, col("weight_mass")?);
+        match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
+            (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
+                parts.push(super::design::part_text(k, n, r, race, m, b));
+            }
+            _ => return Ok(None),
+        }
+    }
+    Ok(match parts.as_slice() {
+        [] => None,
+        [one] => Some(one.clone()),
+        [first, ..] if parts.iter().all(|p| p == first) => {
+            Some(format!("{first}, in each of {} planes", parts.len()))
+        }
+        _ => Some(
+            parts
+                .iter()
+                .enumerate()
+                .map(|(p, text)| format!("plane {p}: {text}"))
+                .collect::<Vec<_>>()
+                .join("; "),
+        ),
+    })
+}
+
 /// The recommendation: #1 with its part, cautions and edges, or none.
 fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Recommendation> {
     let Some(best) = ranked.first() else {
@@ -353,11 +390,14 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
     let (rho, drag) = (c.f("rho")?, c.f("drag")?);
     // Summaries written before these columns lack the part's dimensions.
     let (race, mass) = (c.f_or_none("race_radius")?, c.f_or_none("weight_mass")?);
-    let part = match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
-        (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
-            Some(super::design::part_text(k, n, r, race, m, b))
-        }
-        _ => None,
+    let part = match plane_parts(c, i)? {
+        Some(parts) => Some(parts),
+        None => match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
+            (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
+                Some(super::design::part_text(k, n, r, race, m, b))
+            }
+            _ => None,
+        },
     };
     let worse = c.f_or_none("worse_than_none_fraction")?[i].unwrap_or(0.0);
     let settled = c.f("settled_fraction")?[i].unwrap_or(0.0);
@@ -378,4 +418,45 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
         edges: edges(&grid, i),
         pareto: ranked.iter().filter(|d| d.pareto).map(|d| d.id).collect(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polars::prelude::df;
+
+    /// A summary row with two planes' designs: plane 1 given `n1` balls of ρ `rho1`.
+    fn two_planes(n1: u32, rho1: f64) -> DataFrame {
+        df!(
+            "kind_plane0" => ["ball"], "n_plane0" => [4u32], "rho_plane0" => [0.25],
+            "drag_plane0" => [10.0], "race_radius_plane0" => [0.035],
+            "weight_mass_plane0" => [0.02203],
+            "kind_plane1" => ["ball"], "n_plane1" => [n1], "rho_plane1" => [rho1],
+            "drag_plane1" => [10.0], "race_radius_plane1" => [0.035],
+            "weight_mass_plane1" => [if rho1 == 0.25 { 0.02203 } else { 0.0113 }],
+        )
+        .unwrap()
+    }
+
+    /// The recommendation names every plane's part where the planes
+    /// differ, says "in each of 2 planes" where they are the same, and
+    /// falls back to the one design's part without per-plane columns.
+    #[test]
+    fn the_part_names_each_planes_weights() {
+        let differ = plane_parts(&SummaryColumns(&two_planes(4, 0.2)), 0)
+            .unwrap()
+            .unwrap();
+        assert_eq!(
+            differ,
+            "plane 0: 4 balls of 17.5 mm diameter, 22.03 g each, in a race of radius 35 mm, drag 10 N·s/m per weight; \
+             plane 1: 4 balls of 14 mm diameter, 11.3 g each, in a race of radius 35 mm, drag 10 N·s/m per weight"
+        );
+        let same = plane_parts(&SummaryColumns(&two_planes(4, 0.25)), 0)
+            .unwrap()
+            .unwrap();
+        assert!(same.ends_with("per weight, in each of 2 planes"), "{same}");
+        assert!(!same.contains("plane 0"), "{same}");
+        let none = df!("n" => [4u32]).unwrap();
+        assert_eq!(plane_parts(&SummaryColumns(&none), 0).unwrap(), None);
+    }
 }

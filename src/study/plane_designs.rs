@@ -151,10 +151,22 @@ pub fn combinations(axes: &[PlaneAxes], planes: usize, base: &DesignSpec) -> Vec
     out
 }
 
+/// The per-plane design columns, before their `_plane{p}` suffix: enough
+/// to name each plane's part (count, size, mass, race, drag).
+const PLANE_COLUMNS: [&str; 7] = [
+    "kind",
+    "n",
+    "rho",
+    "drag",
+    "capacity",
+    "race_radius",
+    "weight_mass",
+];
+
 /// Names of the per-plane design columns of `planes` planes, as written.
 pub fn column_names(planes: usize) -> Vec<String> {
     (0..planes)
-        .flat_map(|p| ["kind", "n", "rho", "drag", "capacity"].map(|k| format!("{k}_plane{p}")))
+        .flat_map(|p| PLANE_COLUMNS.map(|k| format!("{k}_plane{p}")))
         .collect()
 }
 
@@ -182,19 +194,27 @@ pub fn append_columns(df: &mut DataFrame, designs: &[Design]) -> PolarsResult<()
         .map(|&id| design(id))
         .collect::<PolarsResult<_>>()?;
     // Plane 0 is the design's own spec; planes 1.. its plane designs.
-    type Plane = (String, u32, f64, f64, f64);
+    type Plane = (String, u32, f64, f64, f64, f64, f64);
     let plane_of = |d: &Design, p: usize| -> Plane {
-        if p == 0 {
-            let c = d.plane_zero_capacity;
-            (d.spec.kind.name().into(), d.spec.n, d.rho, d.spec.drag, c)
+        let (pd, capacity) = if p == 0 {
+            (d, d.plane_zero_capacity)
         } else {
-            let pd = &d.plane_designs[p - 1];
-            let s = &pd.spec;
-            (s.kind.name().into(), s.n, pd.rho, s.drag, pd.capacity)
-        }
+            (&d.plane_designs[p - 1], d.plane_designs[p - 1].capacity)
+        };
+        let s = &pd.spec;
+        let (race, mass) = (s.race_radius, pd.weight_mass);
+        (
+            s.kind.name().into(),
+            s.n,
+            pd.rho,
+            s.drag,
+            capacity,
+            race,
+            mass,
+        )
     };
     let names = column_names(planes + 1);
-    for (p, names) in names.chunks(5).enumerate() {
+    for (p, names) in names.chunks(PLANE_COLUMNS.len()).enumerate() {
         let values: Vec<Plane> = rows.iter().map(|d| plane_of(d, p)).collect();
         let columns = [
             Column::new(
@@ -216,6 +236,14 @@ pub fn append_columns(df: &mut DataFrame, designs: &[Design]) -> PolarsResult<()
             Column::new(
                 names[4].as_str().into(),
                 values.iter().map(|v| v.4).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                names[5].as_str().into(),
+                values.iter().map(|v| v.5).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                names[6].as_str().into(),
+                values.iter().map(|v| v.6).collect::<Vec<_>>(),
             ),
         ];
         for c in columns {
