@@ -642,3 +642,54 @@ fn the_ranking_speaks_in_an_engineers_terms() {
         assert!(!default.contains(jargon), "{jargon}: {default}");
     }
 }
+
+/// A design none of whose runs settled has a restricted mean equal to the
+/// horizon τ: the ranking prints it as a bound ("≥ τ, none settled"), not
+/// as an interval of zero width ("50.0 [50.0, 50.0]") that reads as precision.
+#[test]
+fn a_design_that_never_settles_prints_a_bound_not_a_zero_width_interval() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        r#"name = "ns"
+seed = 5
+output = "{}"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+kind = "ball"
+n = 3
+rho = 0.25
+race_radius = 0.05
+drag = [10.0, 1000.0]
+[sampling]
+samples = 20
+unbalance = {{ distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }}
+[summary]
+rank_by = "mean"
+[metrics]
+t_end_revs = 100
+"#,
+        dir.path().join("results").display()
+    );
+    let study = dir.path().join("ns.toml");
+    std::fs::write(&study, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", study.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("≥ 50.0, none settled"), "{stdout}");
+    assert!(!stdout.contains("[50.0, 50.0]"), "{stdout}");
+}

@@ -232,15 +232,19 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
                 (Some(m), _) => format!("{m:.1}"),
                 (None, _) => "beyond".to_string(),
             });
-            row.push(if criterion == Criterion::Mean {
-                format!(
+            // With no run settled every run counts at the horizon τ: the
+            // restricted mean is τ itself, a bound (the mean is at least
+            // that), and its interval has no width to show.
+            let none_settled = frac[i] == Some(0.0);
+            row.push(match (criterion == Criterion::Mean, none_settled) {
+                (_, true) => format!("≥ {}, none settled", num(rmst[i], 1)),
+                (true, false) => format!(
                     "{} [{}, {}]",
                     num(rmst[i], 1),
                     num(rmst_lo[i], 1),
                     num(rmst_hi[i], 1)
-                )
-            } else {
-                num(rmst[i], 1)
+                ),
+                (false, false) => num(rmst[i], 1),
             });
             row.push(p90[i].map_or("beyond".into(), |x| format!("{x:.1}")));
             row.push(res_abs95[i].map_or("–".into(), |r| format!("{:.2}", r * 1e6)));
