@@ -229,9 +229,10 @@ pub struct PairVerdict {
     pub criterion_favours: Option<Favours>,
     /// Holm-adjusted p-value of each measure, in the comparison's order.
     pub p_holm: Vec<f64>,
-    /// Measures other than the criterion on which B is better although A is
-    /// the criterion's choice.
-    pub disagreeing: Vec<Criterion>,
+    /// Measures other than the criterion that significantly favour a side
+    /// the criterion did not choose (the other side, or either side when
+    /// the criterion cannot tell them apart), with the side each favours.
+    pub disagreeing: Vec<(Criterion, Favours)>,
 }
 
 impl DesignComparison {
@@ -254,8 +255,10 @@ impl DesignComparison {
             favours(0)
         };
         let disagreeing = (1..measures.len())
-            .filter(|&k| criterion_favours == Some(Favours::A) && favours(k) == Some(Favours::B))
-            .map(|k| measures[k].criterion)
+            .filter_map(|k| {
+                let side = favours(k)?;
+                (criterion_favours != Some(side)).then_some((measures[k].criterion, side))
+            })
             .collect();
         PairVerdict {
             criterion_favours,
@@ -299,4 +302,64 @@ pub fn median_with_interval(km: &KaplanMeier) -> (Option<f64>, (Option<f64>, Opt
         km.median(),
         km.median_interval(super::verdict::LEVEL, Transform::LogLog),
     )
+}
+
+#[cfg(test)]
+mod verdict_tests {
+    use super::*;
+    use crate::stats::paired_measures::Difference;
+    use crate::study::verdict::MeasureComparison;
+
+    /// A measure where A's value is `a`, B's `b`, at raw p-value `p`.
+    fn measure(criterion: Criterion, a: f64, b: f64, p: f64) -> MeasureComparison {
+        MeasureComparison {
+            criterion,
+            difference: Some(Difference {
+                a,
+                b,
+                difference: a - b,
+                interval: (a - b - 1.0, a - b + 1.0),
+                p_value: p,
+                test: "paired_t",
+            }),
+            p_holm: p,
+        }
+    }
+
+    fn comparison(measures: Vec<MeasureComparison>) -> DesignComparison {
+        DesignComparison {
+            comparison: Comparison {
+                a: 0,
+                b: 1,
+                runs: (20, 20),
+                medians: (None, None),
+                paired: None,
+                unpaired: None,
+                residual_test: None,
+                residual_ratio: None,
+                measures,
+            },
+            pairing: Pairing::Paired,
+        }
+    }
+
+    /// Another measure that significantly favours a side is a finding
+    /// whichever side the criterion chose, or when it chose none: B better
+    /// on p90 while the criterion favours B is not one; A better on p90
+    /// while the criterion favours B, or cannot tell, is.
+    #[test]
+    fn other_measures_disagree_whichever_side_the_criterion_takes() {
+        let mean_b = measure(Criterion::Mean, 60.0, 40.0, 1e-6);
+        let mean_tie = measure(Criterion::Mean, 50.0, 50.5, 0.6);
+        let p90_a = measure(Criterion::P90, 40.0, 80.0, 1e-6);
+        let p90_b = measure(Criterion::P90, 90.0, 50.0, 1e-6);
+        let v = comparison(vec![mean_b.clone(), p90_a.clone()]).verdict(0.05);
+        assert_eq!(v.criterion_favours, Some(Favours::B));
+        assert_eq!(v.disagreeing, [(Criterion::P90, Favours::A)]);
+        let v = comparison(vec![mean_b, p90_b]).verdict(0.05);
+        assert!(v.disagreeing.is_empty());
+        let v = comparison(vec![mean_tie, p90_a]).verdict(0.05);
+        assert_eq!(v.criterion_favours, None);
+        assert_eq!(v.disagreeing, [(Criterion::P90, Favours::A)]);
+    }
 }

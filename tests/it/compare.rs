@@ -87,6 +87,24 @@ fn designs_of_one_study_are_paired_and_foreign_samples_are_not() {
         assert!(text.contains(line), "{line:?} in {text}");
     }
     assert!(text.contains("paired_t p"), "{text}");
+    // The sign test's difference is the median of the paired differences,
+    // and "∞" is explained only where one is printed.
+    assert!(
+        text.contains("median settling time: A")
+            && text.contains("median of the paired differences A − B"),
+        "{text}"
+    );
+    let infinite = text
+        .lines()
+        .any(|l| l.starts_with("paired difference") && l.contains('∞') && !l.contains("(∞:"));
+    assert!(!infinite, "{text}");
+    if !text
+        .lines()
+        .filter(|l| l.starts_with("paired difference"))
+        .any(|l| l.matches('∞').count() > 1)
+    {
+        assert!(!text.contains("(∞: B did not settle"), "{text}");
+    }
     // --rank-by switches the measure the verdict rests on.
     let out = compare(&[a_s, "--designs", "0,1", "--rank-by", "median"]);
     let text = String::from_utf8_lossy(&out.stdout);

@@ -182,11 +182,19 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 100.0 * pair.b_sooner as f64 / pair.n as f64,
                 100.0 * pair.ties as f64 / pair.n as f64
             ));
+            let (d, (lo, hi)) = (pair.median_difference, pair.median_difference_interval);
+            // "∞" is explained only where it is printed.
+            let infinite = [d, lo, hi].iter().any(|x| !x.is_finite());
             say(&format!(
-                "paired difference t_B − t_A: median {} rev [{}, {}] (∞: B did not settle in half the pairs or more); sign test p {}",
-                rev(pair.median_difference),
-                rev(pair.median_difference_interval.0),
-                rev(pair.median_difference_interval.1),
+                "paired difference t_B − t_A: median {} rev [{}, {}]{}; sign test p {}",
+                rev(d),
+                rev(lo),
+                rev(hi),
+                if infinite {
+                    " (∞: B did not settle in half the pairs or more)"
+                } else {
+                    ""
+                },
                 p_eq(pair.sign_test_p)
             ));
             if let (Some(w), Some((ratio, (lo, hi)))) = (&c.residual_test, c.residual_ratio) {
@@ -240,8 +248,15 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         } else {
             format!(" {unit}")
         };
+        // The sign test's difference is the median of the paired
+        // differences, not the difference of the two medians shown.
+        let what = if d.test == "sign" {
+            "median of the paired differences A − B"
+        } else {
+            "A − B"
+        };
         say(&format!(
-            "{}: A {} vs B {}, A − B {}{interval}{unit}, {} p {} (Holm over the {} measures: {})",
+            "{}: A {} vs B {}, {what} {}{interval}{unit}, {} p {} (Holm over the {} measures: {})",
             m.criterion.label(),
             show(d.a),
             show(d.b),
@@ -270,15 +285,30 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         ),
     };
     say(&format!("verdict: {verdict_text}"));
-    if !verdict.disagreeing.is_empty() {
+    for side in [Favours::A, Favours::B] {
+        let on: Vec<String> = verdict
+            .disagreeing
+            .iter()
+            .filter(|(_, s)| *s == side)
+            .map(|(m, _)| m.label())
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        let name = if side == Favours::A { "A" } else { "B" };
         say(&format!(
-            "but B is significantly better on the {}: the measures disagree",
-            verdict
-                .disagreeing
-                .iter()
-                .map(|m| m.label())
-                .collect::<Vec<_>>()
-                .join(" and the ")
+            "{} {name} is significantly better on the {}{}",
+            if verdict.criterion_favours.is_some() {
+                "but"
+            } else {
+                "yet"
+            },
+            on.join(" and the "),
+            if verdict.criterion_favours.is_some() {
+                ": the measures disagree"
+            } else {
+                ""
+            }
         ));
     }
     if let Some(path) = &args.plot {
