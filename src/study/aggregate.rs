@@ -228,6 +228,16 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         // worst run (negative: they overlapped).
         let contact = mine.column("contact")?.bool()?.clone();
         rows.contact.push(contact.all());
+        // How it was modelled, as the runs record it: "rigid", "penalty",
+        // both joined when runs differ, null where no run modelled contact.
+        let models: std::collections::BTreeSet<String> = mine
+            .column("contact_model")
+            .ok()
+            .and_then(|c| c.str().ok().cloned())
+            .map(|c| c.iter().flatten().map(str::to_string).collect())
+            .unwrap_or_default();
+        rows.contact_model
+            .push((!models.is_empty()).then(|| models.into_iter().collect::<Vec<_>>().join("/")));
         let min_gap = mine.column("min_gap_rad")?.f64()?.min();
         rows.min_gap.push(min_gap);
         // The deepest overlap as a share of the touching angle 2α: what the
@@ -334,6 +344,7 @@ struct SummaryColumns {
     budget_exceeded: Vec<u64>,
     merged: Vec<u64>,
     contact: Vec<bool>,
+    contact_model: Vec<Option<String>>,
     min_gap: Vec<Option<f64>>,
     max_overlap: Vec<Option<f64>>,
     stall_torque: Vec<Option<f64>>,
@@ -477,6 +488,7 @@ impl SummaryColumns {
             Column::new("budget_exceeded".into(), self.budget_exceeded),
             Column::new("merged".into(), self.merged),
             Column::new("contact".into(), self.contact),
+            Column::new("contact_model".into(), self.contact_model),
             Column::new("min_gap_rad".into(), self.min_gap),
             Column::new("max_overlap_fraction".into(), self.max_overlap),
             Column::new("stall_torque".into(), self.stall_torque),

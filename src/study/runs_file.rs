@@ -220,8 +220,13 @@ fn window_rows(pieces: &[Piece], from: u64, to: u64) -> PolarsResult<Option<Data
 /// several planes).
 pub const PLANE_SUMMARY_COLUMNS: [&str; 2] = ["plane_settling_revs", "plane_residual_abs"];
 
+/// Columns the summary reads when a file has them: how contact was
+/// modelled (files written before the column have none).
+pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 1] = ["contact_model"];
+
 /// The summary's projection of the file at `path`: [`SUMMARY_COLUMNS`], and
-/// [`PLANE_SUMMARY_COLUMNS`] where the file has them.
+/// [`PLANE_SUMMARY_COLUMNS`] and [`OPTIONAL_SUMMARY_COLUMNS`] where the file
+/// has them.
 fn summary_projection(path: &Path) -> PolarsResult<Vec<&'static str>> {
     let read = || -> PolarsResult<_> {
         Ok(if is_ipc(path) {
@@ -238,7 +243,12 @@ fn summary_projection(path: &Path) -> PolarsResult<Vec<&'static str>> {
         names.iter().copied(),
     )?;
     let mut columns = SUMMARY_COLUMNS.to_vec();
-    columns.extend(PLANE_SUMMARY_COLUMNS.iter().filter(|c| schema.contains(c)));
+    columns.extend(
+        PLANE_SUMMARY_COLUMNS
+            .iter()
+            .chain(&OPTIONAL_SUMMARY_COLUMNS)
+            .filter(|c| schema.contains(c)),
+    );
     Ok(columns)
 }
 

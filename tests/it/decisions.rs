@@ -691,5 +691,10 @@ t_end_revs = 100
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("≥ 50.0, none settled"), "{stdout}");
+    // The contact line names how contact was modelled.
+    assert!(
+        stdout.contains("contact between the weights: on (penalty contact)"),
+        "{stdout}"
+    );
     assert!(!stdout.contains("[50.0, 50.0]"), "{stdout}");
 }

@@ -73,11 +73,24 @@ pub(super) fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
         )
     });
     let off = contact.iter().filter(|c| *c == Some(false)).count();
+    // Summaries written before the column name no model.
+    let models: std::collections::BTreeSet<String> = summary
+        .column("contact_model")
+        .ok()
+        .and_then(|c| c.str().ok().cloned())
+        .map(|c| c.iter().flatten().map(str::to_string).collect())
+        .unwrap_or_default();
+    let model = if models.is_empty() {
+        String::new()
+    } else {
+        let names: Vec<String> = models.into_iter().collect();
+        format!(" ({} contact)", names.join(", "))
+    };
     Ok(if off == 0 {
-        format!("contact between the weights: on{closest}\n")
+        format!("contact between the weights: on{model}{closest}\n")
     } else {
         format!(
-            "contact between the weights: OFF in {} of {} designs (the study switched it off: weights may pass through each other){closest}\n",
+            "contact between the weights: OFF in {} of {} designs (the study switched it off: weights may pass through each other){model}{closest}\n",
             off,
             summary.height()
         )
