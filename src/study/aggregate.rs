@@ -122,6 +122,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.capacity.push(design.capacity);
         rows.race_radius.push(design.spec.race_radius);
         rows.weight_mass.push(design.weight_mass);
+        rows.roller_height.push(design.roller_length());
         rows.runs.push(runs_n);
         rows.left_race_after.push(left_race_after(design.id));
         rows.settled.push(settled_n);
@@ -304,6 +305,7 @@ struct SummaryColumns {
     capacity: Vec<f64>,
     race_radius: Vec<f64>,
     weight_mass: Vec<f64>,
+    roller_height: Vec<Option<f64>>,
     runs: Vec<u64>,
     settled: Vec<u64>,
     settled_fraction: Vec<f64>,
@@ -446,6 +448,7 @@ impl SummaryColumns {
             Column::new("capacity".into(), self.capacity),
             Column::new("race_radius".into(), self.race_radius),
             Column::new("weight_mass".into(), self.weight_mass),
+            Column::new("roller_height".into(), self.roller_height),
             Column::new("runs".into(), self.runs),
             Column::new("left_race_after".into(), self.left_race_after),
             Column::new("settled".into(), self.settled),

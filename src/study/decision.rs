@@ -352,9 +352,10 @@ fn plane_parts(c: &SummaryColumns, i: usize) -> PolarsResult<Option<String>> {
         let n = c.u32s(&format!("n_plane{p}"))?;
         let (rho, drag) = (col("rho")?, col("drag")?);
         let (race, mass) = (col("race_radius")?, col("weight_mass")?);
+        let length = col("roller_height")?;
         match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
             (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
-                parts.push(super::design::part_text(k, n, r, race, m, b));
+                parts.push(super::design::part_text(k, n, (r, race), m, b, length[i]));
             }
             _ => return Ok(None),
         }
@@ -394,7 +395,8 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
         Some(parts) => Some(parts),
         None => match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
             (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
-                Some(super::design::part_text(k, n, r, race, m, b))
+                let length = c.f_or_none("roller_height")?[i];
+                Some(super::design::part_text(k, n, (r, race), m, b, length))
             }
             _ => None,
         },

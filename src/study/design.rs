@@ -42,6 +42,12 @@ pub struct Design {
 }
 
 impl Design {
+    /// A roller's length h (m), the part's other dimension; `None` for
+    /// balls and pendulums.
+    pub fn roller_length(&self) -> Option<f64> {
+        (self.spec.kind == crate::model::balancer::Kind::Roller).then_some(self.spec.roller_height)
+    }
+
     /// The study's speed law with this design's stall torque, if it has one.
     pub fn speed(&self, law: &SpeedLaw) -> SpeedLaw {
         match (self.stall_torque, law.clone()) {
@@ -119,16 +125,20 @@ pub const MAX_WEIGHTS: u32 = 256;
 pub fn part_text(
     kind: &str,
     n: u32,
-    rho: f64,
-    race_radius: f64,
+    (rho, race_radius): (f64, f64),
     weight_mass: f64,
     drag: f64,
+    roller_length: Option<f64>,
 ) -> String {
     let sig = |v: f64| crate::number_text::significant(v, 4);
     let diameter = sig(2.0 * rho * race_radius * 1e3);
-    let weights = match kind {
-        "roller" => format!("{n} rollers of {diameter} mm diameter"),
-        "pendulum" => format!("{n} pendulums with bobs of {diameter} mm"),
+    let weights = match (kind, roller_length) {
+        ("roller", Some(h)) => format!(
+            "{n} rollers of {diameter} mm diameter and {} mm length",
+            sig(h * 1e3)
+        ),
+        ("roller", None) => format!("{n} rollers of {diameter} mm diameter"),
+        ("pendulum", _) => format!("{n} pendulums with bobs of {diameter} mm"),
         _ => format!("{n} balls of {diameter} mm diameter"),
     };
     format!(
@@ -147,11 +157,12 @@ mod part_tests {
     fn a_design_reads_as_a_part_with_its_dimensions() {
         // Three steel balls, ρ = 0.3638 of a 50 mm race: 36.38 mm across.
         assert_eq!(
-            part_text("ball", 3, 0.3638, 0.05, 0.1973, 10.0),
+            part_text("ball", 3, (0.3638, 0.05), 0.1973, 10.0, None),
             "3 balls of 36.38 mm diameter, 197.3 g each, in a race of radius 50 mm, drag 10 N·s/m per weight"
         );
         assert!(
-            part_text("roller", 4, 0.25, 0.1, 0.5, 2.0).starts_with("4 rollers of 50 mm diameter")
+            part_text("roller", 4, (0.25, 0.1), 0.5, 2.0, Some(0.015))
+                .starts_with("4 rollers of 50 mm diameter and 15 mm length")
         );
     }
 }

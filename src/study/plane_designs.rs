@@ -153,7 +153,7 @@ pub fn combinations(axes: &[PlaneAxes], planes: usize, base: &DesignSpec) -> Vec
 
 /// The per-plane design columns, before their `_plane{p}` suffix: enough
 /// to name each plane's part (count, size, mass, race, drag).
-const PLANE_COLUMNS: [&str; 7] = [
+const PLANE_COLUMNS: [&str; 8] = [
     "kind",
     "n",
     "rho",
@@ -161,6 +161,7 @@ const PLANE_COLUMNS: [&str; 7] = [
     "capacity",
     "race_radius",
     "weight_mass",
+    "roller_height",
 ];
 
 /// Names of the per-plane design columns of `planes` planes, as written.
@@ -194,7 +195,7 @@ pub fn append_columns(df: &mut DataFrame, designs: &[Design]) -> PolarsResult<()
         .map(|&id| design(id))
         .collect::<PolarsResult<_>>()?;
     // Plane 0 is the design's own spec; planes 1.. its plane designs.
-    type Plane = (String, u32, f64, f64, f64, f64, f64);
+    type Plane = (String, u32, f64, f64, f64, f64, f64, Option<f64>);
     let plane_of = |d: &Design, p: usize| -> Plane {
         let (pd, capacity) = if p == 0 {
             (d, d.plane_zero_capacity)
@@ -211,6 +212,7 @@ pub fn append_columns(df: &mut DataFrame, designs: &[Design]) -> PolarsResult<()
             capacity,
             race,
             mass,
+            pd.roller_length(),
         )
     };
     let names = column_names(planes + 1);
@@ -244,6 +246,10 @@ pub fn append_columns(df: &mut DataFrame, designs: &[Design]) -> PolarsResult<()
             Column::new(
                 names[6].as_str().into(),
                 values.iter().map(|v| v.6).collect::<Vec<_>>(),
+            ),
+            Column::new(
+                names[7].as_str().into(),
+                values.iter().map(|v| v.7).collect::<Vec<_>>(),
             ),
         ];
         for c in columns {
