@@ -62,6 +62,8 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
     let criterion = plan.file.summary.rank_by;
     // The analytic and linear rungs predict settling; they integrate nothing.
     let estimated = plan.file.solver.fidelity.is_estimate();
+    // The planes every design's balancers fill (its own, or its spec in each).
+    let balancer_planes = plan.file.scene.rotor.as_rotor().planes() as u32;
     let verdicts = best_versus_rest(
         &by_design,
         criterion,
@@ -123,6 +125,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.race_radius.push(design.spec.race_radius);
         rows.weight_mass.push(design.weight_mass);
         rows.roller_height.push(design.roller_length());
+        rows.balancer_planes.push(balancer_planes);
         rows.runs.push(runs_n);
         rows.left_race_after.push(left_race_after(design.id));
         rows.settled.push(settled_n);
@@ -306,6 +309,7 @@ struct SummaryColumns {
     race_radius: Vec<f64>,
     weight_mass: Vec<f64>,
     roller_height: Vec<Option<f64>>,
+    balancer_planes: Vec<u32>,
     runs: Vec<u64>,
     settled: Vec<u64>,
     settled_fraction: Vec<f64>,
@@ -449,6 +453,7 @@ impl SummaryColumns {
             Column::new("race_radius".into(), self.race_radius),
             Column::new("weight_mass".into(), self.weight_mass),
             Column::new("roller_height".into(), self.roller_height),
+            Column::new("balancer_planes".into(), self.balancer_planes),
             Column::new("runs".into(), self.runs),
             Column::new("left_race_after".into(), self.left_race_after),
             Column::new("settled".into(), self.settled),

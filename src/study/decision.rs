@@ -396,7 +396,17 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
         None => match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
             (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
                 let length = c.f_or_none("roller_height")?[i];
-                Some(super::design::part_text(k, n, (r, race), m, b, length))
+                let part = super::design::part_text(k, n, (r, race), m, b, length);
+                // One design in every plane of a rotor with several.
+                let planes = match c.0.column("balancer_planes") {
+                    Ok(_) => c.u32s("balancer_planes")?[i].unwrap_or(1),
+                    Err(_) => 1,
+                };
+                Some(if planes > 1 {
+                    format!("{part}, in each of {planes} planes")
+                } else {
+                    part
+                })
             }
             _ => None,
         },

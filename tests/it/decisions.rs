@@ -698,3 +698,51 @@ t_end_revs = 100
     );
     assert!(!stdout.contains("[50.0, 50.0]"), "{stdout}");
 }
+
+/// A two-plane rotor with one design in both planes (the shipped drum, three
+/// samples a design): the recommendation says the part goes in each plane,
+/// and the summary records how many planes the rotor carries.
+#[test]
+fn one_design_in_two_planes_is_recommended_for_each_plane() {
+    let dir = tempfile::tempdir().unwrap();
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/drum.toml"))
+            .unwrap();
+    let text: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("samples = ") {
+                "samples = 3"
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let study = dir.path().join("drum.toml");
+    std::fs::write(&study, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .current_dir(dir.path())
+        .args(["run", "drum.toml", "--quiet", "--wide"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("per weight, in each of 2 planes"),
+        "{stdout}"
+    );
+    let summary = read_parquet(&dir.path().join("results/drum/summary.parquet")).unwrap();
+    let planes: Vec<Option<u32>> = summary
+        .column("balancer_planes")
+        .unwrap()
+        .u32()
+        .unwrap()
+        .iter()
+        .collect();
+    assert!(planes.iter().all(|p| *p == Some(2)), "{planes:?}");
+}
