@@ -419,6 +419,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
             p.planes.len() - 1
         )
     });
+    let censoring_note = censoring_note(&sum, &order, &ids)?;
     let any_failed = failed.iter().any(|&f| f > 0);
     let priority: Vec<u8> = header
         .iter()
@@ -439,9 +440,41 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
             + &estimate_note(&sum)?
             + &seconds_note
             + &rho_note
-            + &plane_note,
+            + &plane_note
+            + &censoring_note,
         findings,
         passage: passage_table(summary)?,
+    })
+}
+
+/// The designs whose restricted mean is mostly runs that never settled,
+/// each counted at the horizon τ (share (1 − settled) τ / mean over a half):
+/// such a mean grows with the horizon, not with the design, and the reader
+/// must know it (in rank order; empty when none).
+fn censoring_note(sum: &Summary, order: &[usize], ids: &[u32]) -> Result<String, UserError> {
+    let (frac, rmst) = (sum.f("settled_fraction")?, sum.f("settling_revs_rmst")?);
+    let tau = sum.f("settling_horizon_revs")?;
+    let mostly: Vec<String> = order
+        .iter()
+        .filter_map(|&i| {
+            let (f, m, t) = (frac[i]?, rmst[i]?, tau[i]?);
+            let share = (1.0 - f) * t / m;
+            (f > 0.0 && m > 0.0 && share > 0.5).then(|| {
+                format!(
+                    "id {}: {:.0} % of its {m:.1} rev",
+                    ids[i],
+                    100.0 * share.min(1.0)
+                )
+            })
+        })
+        .collect();
+    Ok(if mostly.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "(restricted means that are mostly runs that never settled, each counted at the horizon τ, so that they grow with the horizon rather than with the design: {})\n",
+            mostly.join(", ")
+        )
     })
 }
 
@@ -531,5 +564,41 @@ fn short(m: Criterion) -> &'static str {
         Criterion::Mean => "restricted mean",
         Criterion::P90 => "p90",
         _ => "residual p95/A_ref",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polars::prelude::df;
+
+    /// A mean that is mostly runs counted at τ is named with its share;
+    /// one that is mostly settled runs, or has none settled (printed as a
+    /// bound already), is not.
+    #[test]
+    fn a_mean_made_mostly_of_censored_runs_is_named() {
+        // id 7: 10 % settled near 10 rev, 90 % counted at τ = 1450:
+        // mean 0.1·10 + 0.9·1450 = 1306, of which 1305 (99.9 %) is τ.
+        let summary = df!(
+            "design_id" => [7u32, 8, 9],
+            "settled_fraction" => [0.1, 0.99, 0.0],
+            "settling_revs_rmst" => [1306.0, 80.0, 1450.0],
+            "settling_horizon_revs" => [1450.0, 1450.0, 1450.0],
+        )
+        .unwrap();
+        let note = censoring_note(&Summary(&summary), &[0, 1, 2], &[7, 8, 9]).unwrap_or_default();
+        assert!(note.contains("id 7: 100 % of its 1306.0 rev"), "{note}");
+        assert!(!note.contains("id 8") && !note.contains("id 9"), "{note}");
+        let settled = df!(
+            "design_id" => [8u32],
+            "settled_fraction" => [0.99],
+            "settling_revs_rmst" => [80.0],
+            "settling_horizon_revs" => [1450.0],
+        )
+        .unwrap();
+        assert_eq!(
+            censoring_note(&Summary(&settled), &[0], &[8]).unwrap_or_default(),
+            ""
+        );
     }
 }
