@@ -746,3 +746,60 @@ fn one_design_in_two_planes_is_recommended_for_each_plane() {
         .collect();
     assert!(planes.iter().all(|p| *p == Some(2)), "{planes:?}");
 }
+
+/// A raced study says that the designs that left rest on fewer runs, their
+/// flags included, and that the ranks below #1 are not the full study's.
+#[test]
+fn a_raced_ranking_says_its_lower_ranks_rest_on_fewer_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        r#"name = "nc"
+seed = 5
+output = "{}"
+[scene.rotor]
+mass = 10.0
+kx = 1.0e5
+ky = 1.0e5
+bx = 100.0
+by = 100.0
+[scene.speed]
+mode = "constant"
+omega = 300.0
+[designs]
+kind = "ball"
+n = [2, 3]
+rho = 0.25
+race_radius = 0.05
+drag = [10.0, 300.0]
+[sampling]
+samples = 20
+unbalance = {{ distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }}
+[summary]
+rank_by = "mean"
+[metrics]
+t_end_revs = 400
+"#,
+        dir.path().join("results").display()
+    );
+    let study = dir.path().join("nc.toml");
+    std::fs::write(&study, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["run", study.to_str().unwrap(), "--quiet", "--wide"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("left the race after that many samples"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("its flags (balances, the shortfalls)")
+            && stdout.contains("the ranks below #1 are not those the full study would give"),
+        "{stdout}"
+    );
+}

@@ -332,7 +332,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         });
     }
     let runs_note = if raced {
-        "(runs: a design with fewer runs than the others left the race after that many samples, once #1 was significantly better and no other measure favoured it; its statistics and its comparison with #1 use the runs it has, docs/statistics.md, \"Racing\")\n"
+        "(runs: a design with fewer runs than the others left the race after that many samples, once #1 was significantly better and no other measure favoured it; its statistics, its flags (balances, the shortfalls) and its comparison with #1 rest on the runs it has, so the ranks below #1 are not those the full study would give; docs/statistics.md, \"Racing\")\n"
     } else {
         ""
     };
