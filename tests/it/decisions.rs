@@ -681,7 +681,7 @@ t_end_revs = 100
     let study = dir.path().join("ns.toml");
     std::fs::write(&study, text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_study"))
-        .args(["run", study.to_str().unwrap(), "--quiet"])
+        .args(["run", study.to_str().unwrap(), "--quiet", "--wide"])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -691,6 +691,13 @@ t_end_revs = 100
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("≥ 50.0, none settled"), "{stdout}");
+    // The residual the findings compare is named as relative to A_ref.
+    assert!(
+        stdout.contains(
+            "p90 and residual p95/A_ref (the residual relative to each run's A_ref, not in µm)"
+        ),
+        "{stdout}"
+    );
     // The contact line names how contact was modelled.
     assert!(
         stdout.contains("contact between the weights: on (penalty contact)"),

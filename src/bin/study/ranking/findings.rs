@@ -108,7 +108,7 @@ pub(super) fn disagreement_line(decision: &StudyDecision) -> String {
     }
     if claims.is_empty() {
         format!(
-            "other measures: no design is significantly better than #1 on any of median, restricted mean, p90 and residual p95 (α = {})\n",
+            "other measures: no design is significantly better than #1 on any of median, restricted mean, p90 and residual p95/A_ref (the residual relative to each run's A_ref, not in µm) (α = {})\n",
             decision.alpha
         )
     } else {
