@@ -14,8 +14,9 @@
 //! measures the steady amplitude at each speed before stepping on.
 
 use super::Simulation;
+use crate::integrate::{Method, SolverOptions};
 use crate::integrate::{NoObserver, Status, solve};
-use crate::metrics::bearing_orbit::{Orbit, integrate_revolution};
+use crate::metrics::bearing_orbit::{Orbit, Revolution, integrate_revolution};
 use crate::metrics::reference::{a_ref, balancing_error, reference_unbalance};
 use crate::model::forced::{harmonic_response, plane_orbit_radius, unbalance_forcing};
 use crate::model::rotor::DofVec;
@@ -229,80 +230,110 @@ impl Simulation {
             let watch = system.watch_maps().to_vec();
             let bearings = system.rotor().bearing_maps();
             let maps: Vec<_> = watch.iter().chain(&bearings).copied().collect();
-            let mut revolution = integrate_revolution(
-                measure_with,
-                &system,
-                &system,
+            let revolution = read_revolutions(
+                (measure_with, &system, &options),
                 (t_settled, &y_settled),
                 omega,
-                self.metrics.samples_per_rev,
-                &options,
+                (read_revs as usize, self.metrics.samples_per_rev),
                 &maps,
             )
-            .ok_or_else(|| fail("the measured revolution failed".into(), &points))?;
-            let mut starts = vec![(t_settled, revolution.radii.len())];
-            for _ in 1..read_revs as usize {
-                starts.push((revolution.t, 0));
-                let next = integrate_revolution(
-                    measure_with,
-                    &system,
-                    &system,
-                    (revolution.t, &revolution.y),
-                    omega,
-                    self.metrics.samples_per_rev,
-                    &options,
-                    &maps,
-                )
-                .ok_or_else(|| fail("a measured revolution failed".into(), &points))?;
-                if let Some(last) = starts.last_mut() {
-                    last.1 = next.radii.len();
-                }
-                revolution.radii.extend(next.radii);
-                revolution.t = next.t;
-                revolution.y = next.y;
-            }
-            let whirl_of = |r: &[f64]| r[..watch.len()].iter().copied().fold(0.0, f64::max);
+            .ok_or_else(|| {
+                let which = if read_revs > 1.0 { "a" } else { "the" };
+                fail(format!("{which} measured revolution failed"), &points)
+            })?;
             if let Some(series) = series.as_deref_mut() {
-                let times = starts
-                    .iter()
-                    .flat_map(|&(t, n)| (1..=n).map(move |k| t + rev * k as f64 / n as f64));
                 // Time since the sweep began (each dwell's own clock starts
-                // where its spin angle does).
-                let since_start = dwell * points.len() as f64 - t0;
-                for (t, r) in times.zip(&revolution.radii) {
+                // where its spin angle does); the revolutions are contiguous.
+                let first = t_settled + dwell * points.len() as f64 - t0;
+                let per_rev = revolution.radii.len() as f64 / read_revs;
+                for (i, r) in revolution.radii.iter().enumerate() {
                     series.step.push(points.len() as u32);
                     series.direction.push(direction);
                     series.omega.push(omega);
-                    series.t.push(t + since_start);
-                    series.whirl.push(whirl_of(r));
+                    series.t.push(first + rev * (i as f64 + 1.0) / per_rev);
+                    series.whirl.push(largest(&r[..watch.len()]));
                     series.bearings.push(r[watch.len()..].to_vec());
                 }
             }
-            let whirl = revolution.orbit_of(whirl_of);
-            let orbits: Vec<Orbit> = (watch.len()..maps.len())
-                .map(|m| revolution.orbit(m))
-                .collect();
-            let lay = system.layout();
-            let psi = &revolution.y[lay.head()..lay.nq()];
-            points.push(StepPoint {
-                direction,
-                omega,
-                whirl_peak: whirl.peak,
-                whirl_rms: whirl.rms,
-                bearing_peak: (!orbits.is_empty()).then(|| orbits.iter().map(|o| o.peak).collect()),
-                bearing_rms: (!orbits.is_empty()).then(|| orbits.iter().map(|o| o.rms).collect()),
-                bearing_peak_without: (!bearings.is_empty())
-                    .then(|| without_balancer(&system, omega, &bearings)),
-                balancing_error: balancing_error(&system, psi, reference_unbalance(&system)),
-                angles_deg: psi
-                    .iter()
-                    .map(|p| p.rem_euclid(2.0 * PI).to_degrees())
-                    .collect(),
-            });
+            points.push(step_point(
+                &system,
+                (direction, omega),
+                &revolution,
+                watch.len(),
+                &bearings,
+            ));
             phi = omega * revolution.t;
             state = Some(revolution.y);
         }
         Ok(points)
+    }
+}
+
+/// The largest of some radii (0 for none).
+fn largest(radii: &[f64]) -> f64 {
+    radii.iter().copied().fold(0.0, f64::max)
+}
+
+/// `count` contiguous revolutions after `(t, y)`, their samples in one
+/// [`Revolution`] ending where the last does; `None` when one fails.
+fn read_revolutions(
+    (method, system, options): (Method, &RotorSystem, &SolverOptions),
+    (t, y): (f64, &[f64]),
+    omega: f64,
+    (count, samples_per_rev): (usize, u32),
+    maps: &[[DofVec; 2]],
+) -> Option<Revolution> {
+    let read = |t: f64, y: &[f64]| {
+        integrate_revolution(
+            method,
+            system,
+            system,
+            (t, y),
+            omega,
+            samples_per_rev,
+            options,
+            maps,
+        )
+    };
+    let mut all = read(t, y)?;
+    for _ in 1..count {
+        let next = read(all.t, &all.y)?;
+        all.radii.extend(next.radii);
+        (all.t, all.y) = (next.t, next.y);
+    }
+    Some(all)
+}
+
+/// What a step reads from its window: the whirl (the largest of the first
+/// `watched` radii), each bearing's orbit and the same without the
+/// balancer's unbalance, ε and the weights' angles at the window's end.
+fn step_point(
+    system: &RotorSystem,
+    (direction, omega): (Direction, f64),
+    revolution: &Revolution,
+    watched: usize,
+    bearings: &[[DofVec; 2]],
+) -> StepPoint {
+    let whirl = revolution.orbit_of(|r| largest(&r[..watched]));
+    let orbits: Vec<Orbit> = (watched..watched + bearings.len())
+        .map(|m| revolution.orbit(m))
+        .collect();
+    let lay = system.layout();
+    let psi = &revolution.y[lay.head()..lay.nq()];
+    StepPoint {
+        direction,
+        omega,
+        whirl_peak: whirl.peak,
+        whirl_rms: whirl.rms,
+        bearing_peak: (!orbits.is_empty()).then(|| orbits.iter().map(|o| o.peak).collect()),
+        bearing_rms: (!orbits.is_empty()).then(|| orbits.iter().map(|o| o.rms).collect()),
+        bearing_peak_without: (!bearings.is_empty())
+            .then(|| without_balancer(system, omega, bearings)),
+        balancing_error: balancing_error(system, psi, reference_unbalance(system)),
+        angles_deg: psi
+            .iter()
+            .map(|p| p.rem_euclid(2.0 * PI).to_degrees())
+            .collect(),
     }
 }
 

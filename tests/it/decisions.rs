@@ -643,14 +643,12 @@ fn the_ranking_speaks_in_an_engineers_terms() {
     }
 }
 
-/// A design none of whose runs settled has a restricted mean equal to the
-/// horizon τ: the ranking prints it as a bound ("≥ τ, none settled"), not
-/// as an interval of zero width ("50.0 [50.0, 50.0]") that reads as precision.
-#[test]
-fn a_design_that_never_settles_prints_a_bound_not_a_zero_width_interval() {
-    let dir = tempfile::tempdir().unwrap();
+/// `study run --quiet --wide` in `dir` on the main job's rotor with balls
+/// at ρ 0.25 (`designs`: the n and drag lines), 20 samples, ranked by the
+/// restricted mean, runs of `t_end_revs`.
+fn run_main_rotor(dir: &Path, designs: &str, t_end_revs: u32) -> Output {
     let text = format!(
-        r#"name = "ns"
+        r#"name = "main_rotor"
 seed = 5
 output = "{}"
 [scene.rotor]
@@ -664,26 +662,34 @@ mode = "constant"
 omega = 300.0
 [designs]
 kind = "ball"
-n = 3
 rho = 0.25
 race_radius = 0.05
-drag = [10.0, 1000.0]
+{designs}
 [sampling]
 samples = 20
 unbalance = {{ distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }}
 [summary]
 rank_by = "mean"
 [metrics]
-t_end_revs = 100
+t_end_revs = {t_end_revs}
 "#,
-        dir.path().join("results").display()
+        dir.join("results").display()
     );
-    let study = dir.path().join("ns.toml");
+    let study = dir.join("study.toml");
     std::fs::write(&study, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+    Command::new(env!("CARGO_BIN_EXE_study"))
         .args(["run", study.to_str().unwrap(), "--quiet", "--wide"])
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+/// A design none of whose runs settled has a restricted mean equal to the
+/// horizon τ: the ranking prints it as a bound ("≥ τ, none settled"), not
+/// as an interval of zero width ("50.0 [50.0, 50.0]") that reads as precision.
+#[test]
+fn a_design_that_never_settles_prints_a_bound_not_a_zero_width_interval() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_main_rotor(dir.path(), "n = 3\ndrag = [10.0, 1000.0]", 100);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
@@ -759,41 +765,7 @@ fn one_design_in_two_planes_is_recommended_for_each_plane() {
 #[test]
 fn a_raced_ranking_says_its_lower_ranks_rest_on_fewer_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let text = format!(
-        r#"name = "nc"
-seed = 5
-output = "{}"
-[scene.rotor]
-mass = 10.0
-kx = 1.0e5
-ky = 1.0e5
-bx = 100.0
-by = 100.0
-[scene.speed]
-mode = "constant"
-omega = 300.0
-[designs]
-kind = "ball"
-n = [2, 3]
-rho = 0.25
-race_radius = 0.05
-drag = [10.0, 300.0]
-[sampling]
-samples = 20
-unbalance = {{ distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }}
-[summary]
-rank_by = "mean"
-[metrics]
-t_end_revs = 400
-"#,
-        dir.path().join("results").display()
-    );
-    let study = dir.path().join("nc.toml");
-    std::fs::write(&study, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_study"))
-        .args(["run", study.to_str().unwrap(), "--quiet", "--wide"])
-        .output()
-        .unwrap();
+    let out = run_main_rotor(dir.path(), "n = [2, 3]\ndrag = [10.0, 300.0]", 400);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),

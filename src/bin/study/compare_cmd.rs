@@ -6,7 +6,7 @@ use crate::output::{p_value_text, say, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
 use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use autobal::study::compare_designs::{
-    Pairing, Side, common_scale, compare_sides, median_with_interval,
+    PairVerdict, Pairing, Side, common_scale, compare_sides, median_with_interval,
 };
 use autobal::study::criterion::Criterion;
 use autobal::study::plane_summary::PlaneStats;
@@ -57,6 +57,237 @@ fn p_eq(p: f64) -> String {
 
 /// Run `study compare`.
 pub fn run(args: &CompareArgs) -> Result<(), UserError> {
+    if let Some(path) = &args.plot {
+        check_figure_path("--plot", path)?;
+    }
+    let (dir_a, dir_b) = match args.folders.as_slice() {
+        [one] => (one, one),
+        [a, b] => (a, b),
+        _ => unreachable!("clap takes one or two folders"),
+    };
+    let (design_a, design_b) = match (&args.designs, args.folders.len()) {
+        (Some(d), _) if d.len() != 2 => {
+            return Err(UserError(
+                format!(
+                    "--designs: two design ids A,B are needed, {} given",
+                    d.len()
+                ),
+                2,
+            ));
+        }
+        (Some(d), _) => (Some(d[0]), Some(d[1])),
+        (None, 1) => {
+            return Err(UserError(
+                "one folder: say which two of its designs to compare with --designs A,B".into(),
+                2,
+            ));
+        }
+        (None, _) => (None, None),
+    };
+    let a = Side::load(dir_a, design_a)?;
+    let b = Side::load(dir_b, design_b)?;
+    let criterion = args.rank_by.unwrap_or(a.default_criterion);
+    let scale = common_scale(&a, &b);
+    let result = compare_sides(&a, &b, 0, criterion);
+    let c = &result.comparison;
+    let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |x| format!("{x:.d$}"));
+    let end = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+    let column = |side: &Side| -> Vec<String> {
+        let (settled, runs, (lo, hi)) = side.settled();
+        let km = side.kaplan_meier();
+        let (median, (m_lo, m_hi)) = km
+            .as_ref()
+            .map_or((None, (None, None)), median_with_interval);
+        let rmst = km.map(|k| k.restricted_mean(scale.tau));
+        let residual_values: Vec<f64> = side.runs.residual.iter().flatten().copied().collect();
+        let residual = autobal::stats::quantile::median(&residual_values);
+        let p90 = Criterion::P90.value(&side.runs, &scale);
+        let residual_p95 = Criterion::ResidualP95.value(&side.runs, &scale);
+        vec![
+            side.label.clone(),
+            format!("{runs}"),
+            format!(
+                "{:.3} [{lo:.2}, {hi:.2}]",
+                settled as f64 / runs.max(1) as f64
+            ),
+            match median {
+                Some(m) => format!("{m:.1} [{}, {}]", end(m_lo), end(m_hi)),
+                None => "beyond the run".into(),
+            },
+            rmst.map_or("–".into(), |r| {
+                // The same bounded interval as summary.parquet's.
+                let i = r.bounded_interval(0.95);
+                format!("{:.1} [{:.1}, {:.1}]", r.estimate, i.lower, i.upper)
+            }),
+            p90.map_or("beyond the run".into(), |x| format!("{x:.1}")),
+            f(residual, 4),
+            f(residual_p95, 4),
+            {
+                let mut abs: Vec<f64> = side.runs.residual_abs.iter().flatten().copied().collect();
+                abs.sort_by(f64::total_cmp);
+                autobal::stats::quantile::quantile_sorted(
+                    &abs,
+                    0.95,
+                    autobal::stats::quantile::Interpolation::Linear,
+                )
+                .map_or("–".into(), |r| format!("{:.2}", r * 1e6))
+            },
+            side.dir.display().to_string(),
+        ]
+    };
+    let (ca, cb) = (column(&a), column(&b));
+    let names = [
+        "design",
+        "runs",
+        "settled [95% CI]",
+        "t_s median [95% CI] (rev)",
+        "t_s mean to τ [95% CI] (rev)",
+        "t_s p90 (rev)",
+        "residual/A_ref, median",
+        "residual/A_ref, p95",
+        "residual p95 (µm)",
+        "folder",
+    ];
+    let mut rows: Vec<Vec<String>> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| vec![n.to_string(), ca[i].clone(), cb[i].clone()])
+        .collect();
+    // Before the folder row, which closes the table.
+    let folder = rows.pop();
+    rows.extend(plane_rows(&a, &b));
+    rows.extend(folder);
+    print!("{}", text_table(&["", "A", "B"], &rows));
+    say(&format!(
+        "(settling times counted {}; a run that did not settle counts as censored; restricted mean and p90 up to τ = {:.1} rev, the earlier horizon of the two)",
+        a.clock.describe(),
+        scale.tau
+    ));
+    let rev = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.1}")
+        } else {
+            "∞".into()
+        }
+    };
+    match (&c.paired, &result.pairing) {
+        (Some(pair), _) => {
+            say(&format!(
+                "paired on {} samples that met {}: A settles sooner in {:.0} % [{:.0}, {:.0}], B in {:.0} %, ties {:.0} %",
+                pair.n,
+                a.shared(),
+                100.0 * pair.a_sooner_share,
+                100.0 * pair.a_sooner_share_interval.0,
+                100.0 * pair.a_sooner_share_interval.1,
+                100.0 * pair.b_sooner as f64 / pair.n as f64,
+                100.0 * pair.ties as f64 / pair.n as f64
+            ));
+            let (d, (lo, hi)) = (pair.median_difference, pair.median_difference_interval);
+            // "∞" is explained only where it is printed.
+            let infinite = [d, lo, hi].iter().any(|x| !x.is_finite());
+            say(&format!(
+                "paired difference t_B − t_A: median {} rev [{}, {}]{}; sign test p {}",
+                rev(d),
+                rev(lo),
+                rev(hi),
+                if infinite {
+                    " (∞: B did not settle in half the pairs or more)"
+                } else {
+                    ""
+                },
+                p_eq(pair.sign_test_p)
+            ));
+            if let (Some(w), Some((ratio, (lo, hi)))) = (&c.residual_test, c.residual_ratio) {
+                say(&format!(
+                    "residual vibration: median ratio A/B {ratio:.3} [{lo:.3}, {hi:.3}], Wilcoxon signed-rank p {} ({} pairs)",
+                    p_eq(w.p_value),
+                    w.n
+                ));
+            }
+        }
+        (None, Pairing::Refused(why)) => {
+            say(&format!("not paired: {why}"));
+            match &c.unpaired {
+                Some(lr) => say(&format!(
+                    "log-rank test: χ² = {:.3}, p {} (A settled {:.0} times, {:.1} expected if both settle alike)",
+                    lr.chi_squared,
+                    p_eq(lr.p_value),
+                    lr.observed_a,
+                    lr.expected_a
+                )),
+                None => say("log-rank test: no run settled in either design"),
+            }
+        }
+        (None, Pairing::Paired) => say("nothing to compare: no runs"),
+    }
+    // Every measure of this one pair, Holm-adjusted over the measures; the
+    // verdict is the library's (DesignComparison::verdict).
+    let verdict = result.verdict(args.alpha);
+    for (m, p_holm) in c.measures.iter().zip(&verdict.p_holm) {
+        let Some(d) = m.difference else {
+            say(&format!("{}: nothing to compare", m.criterion.label()));
+            continue;
+        };
+        let unit = m.criterion.unit();
+        let scale_by = if unit == "%" { 100.0 } else { 1.0 };
+        let show = |x: f64| {
+            if x.is_finite() {
+                format!("{:.3}", scale_by * x)
+            } else {
+                "∞".into()
+            }
+        };
+        // The log-rank test gives no interval of the difference of medians.
+        let interval = if d.interval.0.is_finite() || d.interval.1.is_finite() {
+            format!(" [{}, {}]", show(d.interval.0), show(d.interval.1))
+        } else {
+            String::new()
+        };
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        // The sign test's difference is the median of the paired
+        // differences, not the difference of the two medians shown.
+        let what = if d.test == "sign" {
+            "median of the paired differences A − B"
+        } else {
+            "A − B"
+        };
+        say(&format!(
+            "{}: A {} vs B {}, {what} {}{interval}{unit}, {} p {} (Holm over the {} measures: {})",
+            m.criterion.label(),
+            show(d.a),
+            show(d.b),
+            show(d.difference),
+            d.test,
+            p_eq(d.p_value),
+            c.measures.len(),
+            p_value_text(*p_holm)
+        ));
+    }
+    let verdict_text = match verdict.criterion_favours {
+        Some(Favours::A) => format!(
+            "A is better than B on the {} (α = {})",
+            criterion.label(),
+            args.alpha
+        ),
+        Some(Favours::B) => format!(
+            "B is better than A on the {} (α = {})",
+            criterion.label(),
+            args.alpha
+        ),
+        None => format!(
+            "not distinguishable on the {} at α = {}",
+            criterion.label(),
+            args.alpha
+        ),
+    };
+    say(&format!("verdict: {verdict_text}"));
+    for line in disagreement_lines(&verdict) {
+        say(&line);
+    }
     if let Some(path) = &args.plot {
         check_figure_path("--plot", path)?;
     }
@@ -393,4 +624,35 @@ fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
         let UserError(message, code) = plot_error(e);
         UserError(format!("--plot {}: {message}", path.display()), code)
     })
+}
+
+/// The other measures that favour a side the criterion did not choose, one
+/// line per side ("but B is significantly better on …: the measures
+/// disagree"; "yet A is …" when the criterion chose neither).
+fn disagreement_lines(verdict: &PairVerdict) -> Vec<String> {
+    let mut lines = Vec::new();
+    for side in [Favours::A, Favours::B] {
+        let on: Vec<String> = verdict
+            .disagreeing
+            .iter()
+            .filter(|(_, s)| *s == side)
+            .map(|(m, _)| m.label())
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        let name = if side == Favours::A { "A" } else { "B" };
+        let chosen = verdict.criterion_favours.is_some();
+        lines.push(format!(
+            "{} {name} is significantly better on the {}{}",
+            if chosen { "but" } else { "yet" },
+            on.join(" and the "),
+            if chosen {
+                ": the measures disagree"
+            } else {
+                ""
+            }
+        ));
+    }
+    lines
 }

@@ -118,36 +118,7 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
         (None, true) => 0,
         (None, false) => DEFAULT_DRAWS,
     };
-    if args.draws_out.is_some() && draws == 0 {
-        return Err(UserError(
-            "--draws-out: needs draws of the scene's [uncertain] keys (--draws N)".into(),
-            2,
-        ));
-    }
-    if let Some(w) = args.window
-        && w > args.dwell
-    {
-        return Err(UserError(
-            format!(
-                "--window {w}: longer than the dwell ({} s) it is read from",
-                args.dwell
-            ),
-            2,
-        ));
-    }
-    if args.series.is_some() && draws > 0 {
-        return Err(UserError(
-            "--series: records one sweep; give --draws 0 to sweep the nominal scene".into(),
-            2,
-        ));
-    }
-    if args.threads.is_some() && draws == 0 {
-        return Err(UserError(
-            "--threads: runs the draws in parallel; one sweep is one thread (give --draws N)"
-                .into(),
-            2,
-        ));
-    }
+    check_draw_flags(args, draws)?;
     for (flag, path) in [
         ("--out", &args.out),
         ("--draws-out", &args.draws_out),
@@ -205,22 +176,7 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
             )),
         ),
     };
-    if let Some(path) = &args.out {
-        let text = autobal::input_file::read_text(&args.scene)?;
-        let provenance = Provenance::new(&text, 0, "stepped sweep");
-        let mut df = to_dataframe(&points).map_err(|e| UserError::internal(e.to_string()))?;
-        write_parquet(path, &mut df, &provenance)
-            .map_err(|e| UserError::internal(format!("--out {e}")))?;
-    }
-    if let (Some(path), Some(series)) = (&args.series, &series) {
-        let text = autobal::input_file::read_text(&args.scene)?;
-        let provenance = Provenance::new(&text, 0, "stepped sweep series");
-        let mut df = series
-            .to_dataframe()
-            .map_err(|e| UserError::internal(e.to_string()))?;
-        write_parquet(path, &mut df, &provenance)
-            .map_err(|e| UserError::internal(format!("--series {e}")))?;
-    }
+    write_nominal(args, &points, series.as_ref())?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&points)?);
     } else {
@@ -231,6 +187,69 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
         Some(why) => Err(UserError(why, 1)),
         None => Ok(()),
     }
+}
+
+/// The flags that depend on whether the scene's draws are swept: each one
+/// that cannot take effect is refused, naming it.
+fn check_draw_flags(args: &SteppedArgs, draws: u32) -> Result<(), UserError> {
+    if args.draws_out.is_some() && draws == 0 {
+        return Err(UserError(
+            "--draws-out: needs draws of the scene's [uncertain] keys (--draws N)".into(),
+            2,
+        ));
+    }
+    if let Some(w) = args.window
+        && w > args.dwell
+    {
+        return Err(UserError(
+            format!(
+                "--window {w}: longer than the dwell ({} s) it is read from",
+                args.dwell
+            ),
+            2,
+        ));
+    }
+    if args.series.is_some() && draws > 0 {
+        return Err(UserError(
+            "--series: records one sweep; give --draws 0 to sweep the nominal scene".into(),
+            2,
+        ));
+    }
+    if args.threads.is_some() && draws == 0 {
+        return Err(UserError(
+            "--threads: runs the draws in parallel; one sweep is one thread (give --draws N)"
+                .into(),
+            2,
+        ));
+    }
+    Ok(())
+}
+
+/// The nominal sweep's files: its steps (--out) and its samples (--series).
+fn write_nominal(
+    args: &SteppedArgs,
+    points: &[StepPoint],
+    series: Option<&SweepSeries>,
+) -> Result<(), UserError> {
+    if args.out.is_none() && args.series.is_none() {
+        return Ok(());
+    }
+    let text = autobal::input_file::read_text(&args.scene)?;
+    if let Some(path) = &args.out {
+        let provenance = Provenance::new(&text, 0, "stepped sweep");
+        let mut df = to_dataframe(points).map_err(|e| UserError::internal(e.to_string()))?;
+        write_parquet(path, &mut df, &provenance)
+            .map_err(|e| UserError::internal(format!("--out {e}")))?;
+    }
+    if let (Some(path), Some(series)) = (&args.series, series) {
+        let provenance = Provenance::new(&text, 0, "stepped sweep series");
+        let mut df = series
+            .to_dataframe()
+            .map_err(|e| UserError::internal(e.to_string()))?;
+        write_parquet(path, &mut df, &provenance)
+            .map_err(|e| UserError::internal(format!("--series {e}")))?;
+    }
+    Ok(())
 }
 
 /// The reason part of a scene error.
