@@ -9,7 +9,7 @@
 
 use super::config::StudyPlan;
 use super::criterion::Criterion;
-use super::diagnosis::{DesignFacts, dead_band, diagnose, settling_band};
+use super::diagnosis::{DesignFacts, dead_band, diagnose, floor_reach, settling_band};
 use super::measured_runs::DesignRuns;
 use super::record::{RunRecord, to_dataframe};
 use super::verdict::{
@@ -171,7 +171,9 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let a_ref = sorted_values(mine.column("a_ref")?.f64()?);
         let fraction = sorted_values(mine.column("unbalance_fraction")?.f64()?);
         let median_of = |v: &[f64]| quantile_sorted(v, 0.5, Interpolation::Linear);
+        let plane_a_refs = super::record::nullable_lists(&mine, "plane_a_ref")?;
         let facts = DesignFacts {
+            plane_a_ref_medians: plane_medians(plane_a_refs.as_deref()),
             a_ref_median: median_of(&a_ref).unwrap_or(f64::NAN),
             unbalance_fraction_median: median_of(&fraction).unwrap_or(f64::NAN),
             over_capacity_share: if fraction.is_empty() {
@@ -192,6 +194,11 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
             }
             _ => None,
         };
+        rows.unsettled_floor.push(
+            unsettled_a_refs(&mine, &outcomes, plane_a_refs.as_deref())?
+                .and_then(|a| floor_reach(plan, design, &a))
+                .map(|r| r.to_string()),
+        );
         rows.diagnosis_cause
             .push(diagnosis.as_ref().map(|d| d.cause.key().to_string()));
         rows.diagnosis.push(diagnosis.map(|d| d.to_string()));
@@ -298,6 +305,7 @@ struct SummaryColumns {
     over_capacity: Vec<f64>,
     diagnosis: Vec<Option<String>>,
     diagnosis_cause: Vec<Option<String>>,
+    unsettled_floor: Vec<Option<String>>,
     failed_counted: Vec<String>,
     kind: Vec<String>,
     n: Vec<u32>,
@@ -509,9 +517,52 @@ impl SummaryColumns {
             Column::new("over_capacity_share".into(), self.over_capacity),
             Column::new("diagnosis".into(), self.diagnosis),
             Column::new("diagnosis_cause".into(), self.diagnosis_cause),
+            Column::new("unsettled_floor".into(), self.unsettled_floor),
             Column::new("failed_runs_counted".into(), self.failed_counted),
         ];
         columns.extend(measures);
         DataFrame::new(height, columns)
     }
+}
+
+/// Each watched plane's median A_ref over a design's runs (empty when the
+/// runs carry one plane or none).
+fn plane_medians(lists: Option<&[Vec<Option<f64>>]>) -> Vec<f64> {
+    let Some(lists) = lists else {
+        return Vec::new();
+    };
+    let planes = lists.iter().map(Vec::len).max().unwrap_or(0);
+    if planes < 2 {
+        return Vec::new();
+    }
+    (0..planes)
+        .map(|p| {
+            let mut v: Vec<f64> = lists
+                .iter()
+                .filter_map(|l| l.get(p).copied().flatten())
+                .collect();
+            v.sort_by(f64::total_cmp);
+            quantile_sorted(&v, 0.5, Interpolation::Linear).unwrap_or(f64::NAN)
+        })
+        .collect()
+}
+
+/// A_ref per watched plane (or the rotor's alone) of each run of `mine`
+/// that ended censored or not settled; `None` when every run settled or failed.
+fn unsettled_a_refs(
+    mine: &DataFrame,
+    outcomes: &[Option<Outcome>],
+    plane_a_refs: Option<&[Vec<Option<f64>>]>,
+) -> PolarsResult<Option<Vec<Vec<f64>>>> {
+    let a_ref = mine.column("a_ref")?.f64()?;
+    let rows: Vec<Vec<f64>> = outcomes
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| matches!(o, Some(Outcome::Censored | Outcome::NotSettled)))
+        .filter_map(|(i, _)| match plane_a_refs.and_then(|l| l.get(i)) {
+            Some(l) if l.len() > 1 => l.iter().copied().collect::<Option<Vec<f64>>>(),
+            _ => a_ref.get(i).map(|a| vec![a]),
+        })
+        .collect();
+    Ok((!rows.is_empty()).then_some(rows))
 }

@@ -110,7 +110,7 @@ impl Side {
         let rows: Vec<usize> = (0..mine.height()).collect();
         let plane_stats = match super::plane_summary::PlaneRuns::read(&mine)? {
             Some(planes) => (0..planes.planes)
-                .map(|p| planes.stats(&rows, p, horizon, clock))
+                .map(|p| planes.stats(&rows, p, (horizon, plan.file.metrics.delta), clock))
                 .collect(),
             None => Vec::new(),
         };

@@ -126,6 +126,9 @@ pub enum Recommendation {
         part: Option<String>,
         /// How it falls short of a design that works (empty: it works).
         shortfalls: Vec<Shortfall>,
+        /// A floor at or above the own band of most of its runs that did not
+        /// settle (`unsettled_floor`): why it falls short, when one does.
+        unsettled_floor: Option<String>,
         /// The swept axes on whose end it sits.
         edges: Vec<Edge>,
         /// The Pareto set, #1 included, in rank order.
@@ -427,6 +430,7 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
         design: best.id,
         part,
         shortfalls: shortfalls(settled, worse),
+        unsettled_floor: c.s_or_none("unsettled_floor")?[i].clone(),
         edges: edges(&grid, i),
         pareto: ranked.iter().filter(|d| d.pareto).map(|d| d.id).collect(),
     })

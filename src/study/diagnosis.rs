@@ -26,12 +26,50 @@ pub struct DesignFacts {
     pub unbalance_fraction_median: f64,
     /// Share of runs whose sampled unbalance exceeded the capacity.
     pub over_capacity_share: f64,
+    /// Median A_ref of each balancer plane, on rotors with several watched
+    /// planes (empty otherwise): a run settles only when every plane is
+    /// inside its own band δ·A_ref of the plane.
+    pub plane_a_ref_medians: Vec<f64>,
 }
 
 /// The dead band μ_s·l of a design (m), with rolling resistance on.
 pub fn dead_band(plan: &StudyPlan, design: &Design) -> Option<f64> {
+    plane_dead_band(plan, design, 0)
+}
+
+/// The dead band μ_s·l of balancer plane `p`'s weights (m): planes with a
+/// design of their own have their own track radius.
+pub fn plane_dead_band(plan: &StudyPlan, design: &Design, p: usize) -> Option<f64> {
     let rr = plan.file.scene.effects.rolling_resistance.as_ref()?;
-    Some(rr.coefficient * rr.static_ratio * design.track_radius)
+    Some(rr.coefficient * rr.static_ratio * plane_track_radius(design, p))
+}
+
+/// The track radius of balancer plane `p`'s weights (m).
+fn plane_track_radius(design: &Design, p: usize) -> f64 {
+    match p.checked_sub(1) {
+        Some(i) => design
+            .plane_designs
+            .get(i)
+            .map_or(design.track_radius, |d| d.track_radius),
+        None => design.track_radius,
+    }
+}
+
+/// The bands the checks compare floors with: each balancer plane's own
+/// (median A_ref of the plane) on rotors with several, else the rotor's.
+fn bands(plan: &StudyPlan, facts: &DesignFacts) -> Vec<(Option<usize>, f64)> {
+    let planes = plan.file.scene.rotor.as_rotor().planes();
+    if facts.plane_a_ref_medians.len() > 1 {
+        facts
+            .plane_a_ref_medians
+            .iter()
+            .take(planes)
+            .enumerate()
+            .map(|(p, &a)| (Some(p), a))
+            .collect()
+    } else {
+        vec![(None, facts.a_ref_median)]
+    }
 }
 
 /// The settling band δ·A_ref (m) at a given A_ref.
@@ -88,6 +126,8 @@ pub enum Cause {
         band: f64,
         /// Median A_ref.
         a_ref: f64,
+        /// The balancer plane whose own band it reaches (rotors with several).
+        plane: Option<usize>,
     },
     /// An effect leaves a whirl no balancer removes, at least the band.
     WhirlFloor {
@@ -99,6 +139,8 @@ pub enum Cause {
         band: f64,
         /// Median A_ref.
         a_ref: f64,
+        /// The balancer plane whose own band it reaches (rotors with several).
+        plane: Option<usize>,
     },
     /// Half the runs or more drew an unbalance above the capacity.
     OverCapacity {
@@ -173,11 +215,13 @@ impl std::fmt::Display for Cause {
                 track_radius,
                 band,
                 a_ref,
+                plane,
             } => write!(
                 f,
-                "the dead band of rolling resistance μ_s·l = {:.3} µm (l = {:.2} mm the track radius) is as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): the weights stop anywhere inside it; lower μ_s, or judge against a band wider than the dead band",
+                "the dead band of rolling resistance μ_s·l = {:.3} µm (l = {:.2} mm the track radius) is as large as {} δ·A_ref = {:.3} µm (median A_ref {:.3} µm): the weights stop anywhere inside it; lower μ_s, or judge against a band wider than the dead band",
                 dead * 1e6,
                 track_radius * 1e3,
+                whose_band(plane),
                 band * 1e6,
                 a_ref * 1e6
             ),
@@ -186,10 +230,12 @@ impl std::fmt::Display for Cause {
                 what,
                 band,
                 a_ref,
+                plane,
             } => write!(
                 f,
-                "{what} = {:.3} µm, as large as the settling band δ·A_ref = {:.3} µm (median A_ref {:.3} µm): no balancer gets inside it; true the race, or judge against a band wider than the floor (metrics.delta above {:.3})",
+                "{what} = {:.3} µm, as large as {} δ·A_ref = {:.3} µm (median A_ref {:.3} µm): no balancer gets inside it; true the race, or judge against a band wider than the floor (metrics.delta above {:.3})",
                 floor * 1e6,
+                whose_band(plane),
                 band * 1e6,
                 a_ref * 1e6,
                 floor / a_ref
@@ -254,6 +300,109 @@ impl std::fmt::Display for Cause {
     }
 }
 
+/// A floor at or above the own band of most runs that did not settle:
+/// why a crowned design falls short when those runs' bands (in some plane)
+/// lie below a whirl no balancer removes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloorReach {
+    /// What makes the floor.
+    pub what: String,
+    /// Its size (m).
+    pub floor: f64,
+    /// The balancer plane whose own band it reaches (rotors with several).
+    pub plane: Option<usize>,
+    /// Runs that did not settle whose band it reaches.
+    pub runs: usize,
+    /// Runs that did not settle (censored or not settled; failures aside).
+    pub unsettled: usize,
+    /// The smallest and largest band it reaches (m).
+    pub bands: (f64, f64),
+}
+
+impl std::fmt::Display for FloorReach {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (has, bands) = if self.runs == 1 {
+            ("has", format!("{:.3} µm in that run", self.bands.0 * 1e6))
+        } else {
+            (
+                "have",
+                format!(
+                    "{:.3}–{:.3} µm in those runs",
+                    self.bands.0 * 1e6,
+                    self.bands.1 * 1e6
+                ),
+            )
+        };
+        write!(
+            f,
+            "{} of the {} runs that did not settle {has} {} δ·A_ref ({bands}) at or below a whirl no balancer removes, {:.3} µm: {}",
+            self.runs,
+            self.unsettled,
+            whose_band(self.plane),
+            self.floor * 1e6,
+            self.what,
+        )
+    }
+}
+
+/// The floor that reaches the own band (δ·A_ref, per balancer plane on
+/// rotors with several) of at least half the runs that did not settle,
+/// each given by its A_ref per watched plane (or the rotor's alone).
+pub fn floor_reach(
+    plan: &StudyPlan,
+    design: &Design,
+    unsettled_a_refs: &[Vec<f64>],
+) -> Option<FloorReach> {
+    let planes = plan.file.scene.rotor.as_rotor().planes();
+    let several = unsettled_a_refs.iter().any(|a| a.len() > 1);
+    let mut candidates: Vec<(String, f64, usize)> = Vec::new();
+    for p in 0..if several { planes } else { 1 } {
+        if let Some((floor, what)) = plan.file.scene.effects.whirl_floor() {
+            candidates.push((what.to_string(), floor, p));
+        }
+        if let Some(dead) = plane_dead_band(plan, design, p) {
+            candidates.push((
+                "the dead band of rolling resistance μ_s·l, inside which the weights stop anywhere"
+                    .into(),
+                dead,
+                p,
+            ));
+        }
+    }
+    candidates
+        .into_iter()
+        .filter_map(|(what, floor, p)| {
+            let reached: Vec<f64> = unsettled_a_refs
+                .iter()
+                .filter_map(|a| a.get(p))
+                .map(|&a| settling_band(plan, a))
+                .filter(|&band| floor >= band)
+                .collect();
+            let lo = reached.iter().copied().reduce(f64::min)?;
+            let hi = reached.iter().copied().reduce(f64::max)?;
+            Some(FloorReach {
+                what,
+                floor,
+                plane: several.then_some(p),
+                runs: reached.len(),
+                unsettled: unsettled_a_refs.len(),
+                bands: (lo, hi),
+            })
+        })
+        .filter(|r| 2 * r.runs >= r.unsettled)
+        // The first of equally reaching floors: the whirl floor before the dead band.
+        .min_by_key(|r| std::cmp::Reverse(r.runs))
+}
+
+/// "the settling band", or "plane p's own settling band" on a rotor whose
+/// planes each settle into their own.
+fn whose_band(plane: Option<usize>) -> String {
+    match plane {
+        Some(p) => format!("plane {p}'s own settling band"),
+        None => "the settling band".to_string(),
+    }
+}
+
 /// The whirl, relative to A_ref, that gravity leaves through the weights'
 /// swing, at U/C = `fraction`: an upper bound.
 ///
@@ -280,28 +429,33 @@ fn response_ratio(mass: f64, stiffness: f64, damping: f64, omega: f64) -> f64 {
 
 /// The first of the checks that applies.
 pub fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> Cause {
-    let band = settling_band(plan, facts.a_ref_median);
-    if let Some(dead) = dead_band(plan, design).filter(|&d| d >= band) {
-        return Cause::DeadBand {
-            dead,
-            track_radius: design.track_radius,
-            band,
-            a_ref: facts.a_ref_median,
-        };
+    let bands = bands(plan, facts);
+    for &(plane, a_ref) in &bands {
+        let band = settling_band(plan, a_ref);
+        let p = plane.unwrap_or(0);
+        if let Some(dead) = plane_dead_band(plan, design, p).filter(|&d| d >= band) {
+            return Cause::DeadBand {
+                dead,
+                track_radius: plane_track_radius(design, p),
+                band,
+                a_ref,
+                plane,
+            };
+        }
     }
-    if let Some((floor, what)) = plan
-        .file
-        .scene
-        .effects
-        .whirl_floor()
-        .filter(|&(f, _)| f >= band)
-    {
-        return Cause::WhirlFloor {
-            floor,
-            what,
-            band,
-            a_ref: facts.a_ref_median,
-        };
+    if let Some((floor, what)) = plan.file.scene.effects.whirl_floor() {
+        for &(plane, a_ref) in &bands {
+            let band = settling_band(plan, a_ref);
+            if floor >= band {
+                return Cause::WhirlFloor {
+                    floor,
+                    what,
+                    band,
+                    a_ref,
+                    plane,
+                };
+            }
+        }
     }
     if facts.over_capacity_share >= 0.5 {
         return Cause::OverCapacity {

@@ -1,8 +1,9 @@
 //! Per-plane statistics of `summary.parquet` for rotors with several
 //! watched planes (balancer planes, then the load's planes): per design and
 //! plane, the share of runs in which that plane settled into its own band
-//! δ·A_ref of the plane, the Kaplan–Meier median of when it did, and the
-//! 95th percentile of its absolute residual. Runs without per-plane values
+//! δ·A_ref of the plane, the Kaplan–Meier median of when it did, the
+//! 95th percentile of its absolute residual, that band at the plane's
+//! median A_ref and, with rolling resistance, its weights' dead band. Runs without per-plane values
 //! (failed runs) count as not settled and have no residual, as in the
 //! design-level statistics.
 
@@ -13,11 +14,13 @@ use crate::stats::survival::{KaplanMeier, Observation};
 use polars::prelude::*;
 
 /// Names of the per-plane summary columns of plane `p`, as written.
-pub fn column_names(p: usize) -> [String; 3] {
+pub fn column_names(p: usize) -> [String; 5] {
     [
         format!("settled_fraction_plane{p}"),
         format!("settling_revs_median_km_plane{p}"),
         format!("residual_abs_p95_plane{p}"),
+        format!("settling_band_m_plane{p}"),
+        format!("dead_band_m_plane{p}"),
     ]
 }
 
@@ -37,12 +40,15 @@ pub struct PlaneStats {
     pub settling_median_km: Option<f64>,
     /// 95th percentile of its absolute residual (m).
     pub residual_abs_p95: Option<f64>,
+    /// Its own settling band δ·A_ref at its median A_ref (m).
+    pub settling_band: Option<f64>,
 }
 
 /// The per-plane columns of a runs table (summary projection or whole).
 pub struct PlaneRuns {
     settling: Vec<Vec<Option<f64>>>,
     residual: Vec<Vec<Option<f64>>>,
+    a_ref: Vec<Vec<Option<f64>>>,
     censoring: Vec<Option<f64>>,
     operating: Vec<Option<f64>>,
     /// Watched planes.
@@ -62,6 +68,7 @@ impl PlaneRuns {
         }
         Ok(Some(PlaneRuns {
             residual: lists(runs, "plane_residual_abs")?,
+            a_ref: lists(runs, "plane_a_ref")?,
             settling,
             censoring: runs.column("censoring_revs")?.f64()?.iter().collect(),
             operating: runs.column("operating_time_s")?.f64()?.iter().collect(),
@@ -72,9 +79,20 @@ impl PlaneRuns {
     /// Plane p's statistics over the runs at `rows`, times counted by
     /// `clock`; a plane that did not settle is censored where its run was
     /// (or at `tau`).
-    pub fn stats(&self, rows: &[usize], p: usize, tau: f64, clock: SettlingClock) -> PlaneStats {
+    pub fn stats(
+        &self,
+        rows: &[usize],
+        p: usize,
+        (tau, delta): (f64, f64),
+        clock: SettlingClock,
+    ) -> PlaneStats {
         let mut observations = Vec::with_capacity(rows.len());
         let mut residuals = Vec::new();
+        let mut a_refs: Vec<f64> = rows
+            .iter()
+            .filter_map(|&i| self.a_ref.get(i)?.get(p).copied().flatten())
+            .collect();
+        a_refs.sort_by(f64::total_cmp);
         for &i in rows {
             let offset = match clock {
                 SettlingClock::FromStart => 0.0,
@@ -107,6 +125,7 @@ impl PlaneRuns {
             settled_fraction: (!rows.is_empty()).then(|| settled as f64 / rows.len() as f64),
             settling_median_km: KaplanMeier::fit(&observations).and_then(|km| km.median()),
             residual_abs_p95: quantile_sorted(&residuals, 0.95, Interpolation::Linear),
+            settling_band: quantile_sorted(&a_refs, 0.5, Interpolation::Linear).map(|a| delta * a),
         }
     }
 }
@@ -126,16 +145,24 @@ pub fn append_columns(
         return Ok(());
     };
     let design = runs.column("design_id")?.u32()?;
-    let mut columns: Vec<[Vec<Option<f64>>; 3]> = vec![Default::default(); planes.planes];
+    let mut columns: Vec<[Vec<Option<f64>>; 5]> = vec![Default::default(); planes.planes];
+    let balancer_planes = plan.file.scene.rotor.as_rotor().planes();
     for d in &plan.designs {
         let rows: Vec<usize> = (0..runs.height())
             .filter(|&i| design.get(i) == Some(d.id))
             .collect();
         for (p, out) in columns.iter_mut().enumerate() {
-            let s = planes.stats(&rows, p, tau, clock);
+            let s = planes.stats(&rows, p, (tau, plan.file.metrics.delta), clock);
             out[0].push(s.settled_fraction);
             out[1].push(s.settling_median_km);
             out[2].push(s.residual_abs_p95);
+            out[3].push(s.settling_band);
+            // Only the balancer planes hold weights that can stop short.
+            out[4].push(
+                (p < balancer_planes)
+                    .then(|| super::diagnosis::plane_dead_band(plan, d, p))
+                    .flatten(),
+            );
         }
     }
     for (p, values) in columns.into_iter().enumerate() {

@@ -218,7 +218,8 @@ fn window_rows(pieces: &[Piece], from: u64, to: u64) -> PolarsResult<Option<Data
 
 /// Per-plane columns the summary reads when a file has them (rotors with
 /// several planes).
-pub const PLANE_SUMMARY_COLUMNS: [&str; 2] = ["plane_settling_revs", "plane_residual_abs"];
+pub const PLANE_SUMMARY_COLUMNS: [&str; 3] =
+    ["plane_settling_revs", "plane_residual_abs", "plane_a_ref"];
 
 /// Columns the summary reads when a file has them: how contact was
 /// modelled (files written before the column have none).

@@ -782,3 +782,114 @@ fn a_raced_ranking_says_its_lower_ranks_rest_on_fewer_runs() {
         "{stdout}"
     );
 }
+
+/// A two-plane grinder on soft supports, 3 or 4 balls per plane, with
+/// rolling resistance and a race `offset` (m): each plane settles into its
+/// own band δ·A_ref of the plane, far narrower than the rotor's where the
+/// couple and the static part nearly cancel.
+fn two_plane_grinder(results: &Path, name: &str, offset: f64) -> String {
+    format!(
+        r#"name = "{name}"
+output = "{}"
+seed = 7
+[scene.rotor]
+model = "two_support"
+mass = 2.0
+transverse_inertia = 0.01
+polar_inertia = 0.003
+k1 = 2.0e4
+l1 = 0.06
+k2 = 2.0e4
+l2 = 0.06
+b1 = 30.0
+b2 = 30.0
+planes = [-0.05, 0.05]
+[scene.speed]
+mode = "constant"
+omega = 700.0
+[scene.effects.race_eccentricity]
+offset = {offset:e}
+[scene.effects.rolling_resistance]
+coefficient = 5e-5
+[designs]
+kind = "ball"
+n = [3, 4]
+rho = 0.15
+race_radius = 0.04
+density = 7850.0
+drag = 0.05
+[sampling]
+samples = 6
+unbalance = {{ distribution = "uniform", min = 0.1, max = 0.5, relative_to = "capacity" }}
+[sampling.couple]
+unbalance = {{ distribution = "uniform", min = 0.05, max = 0.3, relative_to = "capacity" }}
+phase = "uniform"
+[metrics]
+t_end_revs = 400
+hold_revs = 50
+"#,
+        results.display()
+    )
+}
+
+/// A race eccentricity between plane 0's own band and the rotor's: the
+/// runs it stops name the plane (the rotor's r/A_ref is inside its band),
+/// the caution names the floor, and the dead band is compared plane by
+/// plane (before, every comparison used the whole rotor's band).
+#[test]
+fn a_floor_above_one_planes_band_is_named_per_plane() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = two_plane_grinder(&tmp.path().join("results"), "grinder", 5e-6);
+    let out = run(tmp.path(), &text, &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    let runs = read_parquet(&tmp.path().join("results/grinder/runs.parquet")).unwrap();
+    let reasons: Vec<String> = runs
+        .column("reason")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .flatten()
+        .filter(|r| r.starts_with("censored"))
+        .map(str::to_string)
+        .collect();
+    assert!(!reasons.is_empty(), "{stdout}");
+    for r in &reasons {
+        assert!(
+            r.starts_with("censored: plane 0 whirls") && r.contains("the whole rotor's r/A_ref"),
+            "{r}"
+        );
+    }
+    assert!(
+        stdout.contains("with a caution: it settles in only")
+            && stdout.contains("runs that did not settle have plane 0's own settling band δ·A_ref")
+            && stdout.contains("at or below a whirl no balancer removes, 5.000 µm: the race eccentricity"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("against each plane's own settling band")
+            && stdout.contains("plane 0 1.70 µm vs")
+            && stdout.contains("plane 1 1.70 µm vs"),
+        "{stdout}"
+    );
+}
+
+/// Where no design works, the diagnosis compares the floor with each
+/// plane's own band (median A_ref of the plane) and names the plane.
+#[test]
+fn a_floor_that_stops_every_design_is_diagnosed_against_the_planes_band() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = two_plane_grinder(&tmp.path().join("results"), "floor", 1.3e-5);
+    let out = run(tmp.path(), &text, &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("verdict: no design balances this rotor")
+            && stdout.contains("e_r = 13.000 µm, as large as plane 0's own settling band δ·A_ref"),
+        "{stdout}"
+    );
+    assert_eq!(
+        diagnosis_cause(&tmp.path().join("results/floor/summary.parquet")).as_deref(),
+        Some("whirl_floor")
+    );
+}

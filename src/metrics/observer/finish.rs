@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::metrics::Budget;
+use crate::metrics::reference::plane_whirls;
 
 impl SettlingObserver<'_> {
     /// Turn the observations and the solver's report into the run's metrics.
@@ -95,7 +96,11 @@ impl SettlingObserver<'_> {
                     Outcome::Censored,
                     match self.operating_since {
                         Some(_) => format!(
-                            "censored: r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
+                            "censored: {}r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
+                            match self.planes_outside_text(y_final) {
+                                planes if planes.is_empty() => planes,
+                                planes => planes + "the whole rotor's ",
+                            },
                             vibration(self.system, y_final) / self.a_ref,
                             self.options.delta,
                             rms / self.a_ref
@@ -167,5 +172,32 @@ impl SettlingObserver<'_> {
             }),
         };
         (metrics, self.series)
+    }
+}
+
+impl SettlingObserver<'_> {
+    /// On a rotor with several watched planes, the planes outside their own
+    /// band δ·A_ref of the plane at state `y`, each with its whirl and band
+    /// ("plane 0 whirls 4.994 µm, above its own band 3.827 µm; "): the
+    /// whole rotor's r/A_ref can sit inside its band while one plane,
+    /// whose A_ref is smaller, does not.
+    fn planes_outside_text(&self, y: &[f64]) -> String {
+        let Some(pw) = &self.planes else {
+            return String::new();
+        };
+        let mut r = vec![0.0; pw.a_ref.len()];
+        plane_whirls(self.system, y, &mut r);
+        r.iter()
+            .zip(&pw.a_ref)
+            .enumerate()
+            .filter(|(_, (r, a))| **r > self.options.delta * **a)
+            .map(|(p, (r, a))| {
+                format!(
+                    "plane {p} whirls {:.3} µm, above its own band δ·A_ref of the plane = {:.3} µm; ",
+                    r * 1e6,
+                    self.options.delta * a * 1e6
+                )
+            })
+            .collect()
     }
 }

@@ -135,6 +135,7 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
         design,
         part,
         shortfalls,
+        unsettled_floor,
         edges,
         pareto,
     } = &decision.recommendation
@@ -171,6 +172,10 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
         .collect();
     if !short.is_empty() {
         line += &format!(", with a caution: {}", short.join("; "));
+        // The cause of the shortfall, when a floor explains it.
+        if let Some(floor) = unsettled_floor {
+            line += &format!(" ({floor})");
+        }
     }
     // A winner at the end of a swept axis: the best may lie beyond it.
     for e in edges {

@@ -36,8 +36,33 @@ pub(super) fn dead_band_line(sum: &Summary, order: &[usize]) -> Result<String, U
     if dead.iter().all(Option::is_none) {
         return Ok(String::new());
     }
-    let band = sum.f("settling_band_m")?;
     let ids = design_ids(sum)?;
+    let planes = plane_bands(sum)?;
+    if !planes.is_empty() {
+        // Each plane settles into its own band: compare plane by plane.
+        let parts: Vec<String> = order
+            .iter()
+            .map(|&i| {
+                let each: Vec<String> = planes
+                    .iter()
+                    .enumerate()
+                    .map(|(p, (dead, band))| {
+                        format!(
+                            "plane {p} {} µm vs {} µm",
+                            num(dead[i].map(|d| d * 1e6), 2),
+                            num(band[i].map(|b| b * 1e6), 2)
+                        )
+                    })
+                    .collect();
+                format!("design {} {}", ids[i], each.join(", "))
+            })
+            .collect();
+        return Ok(format!(
+            "dead band μ_s·l (l the track radius) against each plane's own settling band δ·A_ref (median A_ref of the plane), in ranking order: {}\n",
+            parts.join("; ")
+        ));
+    }
+    let band = sum.f("settling_band_m")?;
     let parts: Vec<String> = order
         .iter()
         .map(|&i| {
@@ -53,6 +78,28 @@ pub(super) fn dead_band_line(sum: &Summary, order: &[usize]) -> Result<String, U
         "dead band μ_s·l (l the track radius) against the settling band δ·A_ref (median A_ref), in ranking order: {}\n",
         parts.join(", ")
     ))
+}
+
+/// Per plane, each design's dead band and own settling band.
+type PlaneBands = Vec<(Vec<Option<f64>>, Vec<Option<f64>>)>;
+
+/// Per balancer plane with weights (a dead band), its dead band and own
+/// settling band per design; empty on a rotor with one plane or a summary
+/// written before the columns.
+fn plane_bands(sum: &Summary) -> Result<PlaneBands, UserError> {
+    let mut out = Vec::new();
+    for p in 0.. {
+        let [.., band, dead] = autobal::study::plane_summary::column_names(p);
+        if sum.0.column(&dead).is_err() {
+            break;
+        }
+        let dead = sum.f(&dead)?;
+        if dead.iter().all(Option::is_none) {
+            break;
+        }
+        out.push((dead, sum.f(&band)?));
+    }
+    Ok(out)
 }
 
 /// Whether the weights were solid, said under every ranking: a study that
