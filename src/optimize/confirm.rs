@@ -35,11 +35,11 @@ pub struct Confirmed {
 impl Confirmed {
     /// Not distinguishable from the overall pick: the interval covers 0,
     /// or the difference is too small to matter
-    /// ([`material`](crate::study::verdict::material), 1 %).
+    /// ([`material_difference`](crate::study::verdict::material_difference), 1 %).
     pub fn ties(&self) -> bool {
         self.vs_overall.is_some_and(|d| {
             (d.interval.0 <= 0.0 && d.interval.1 >= 0.0)
-                || !crate::study::verdict::material(d.a, d.b, d.difference)
+                || !crate::study::verdict::material_difference(&d)
         })
     }
 }

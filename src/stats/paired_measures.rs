@@ -45,6 +45,10 @@ pub struct Difference {
     pub p_value: f64,
     /// Which test: "paired_t", "bootstrap_paired", "bootstrap", "mcnemar", "two_proportion".
     pub test: &'static str,
+    /// The size the smallest difference worth reporting is a share of:
+    /// max(|a|, |b|) unless the measure sets another (a restricted mean
+    /// takes its settled runs' times, which no horizon moves).
+    pub scale: f64,
 }
 
 fn check_level(level: f64) {
@@ -98,9 +102,11 @@ pub fn paired_mean_difference(a: &[f64], b: &[f64], level: f64) -> Option<Differ
         2.0 * t.sf((dm / se).abs())
     };
     let p = p.max(exact_floor(n, n, true));
+    let (ma, mb) = (mean(a), mean(b));
     Some(Difference {
-        a: mean(a),
-        b: mean(b),
+        a: ma,
+        b: mb,
+        scale: ma.abs().max(mb.abs()),
         difference: dm,
         interval: (dm - q * se, dm + q * se),
         p_value: honest_p(p),
@@ -213,6 +219,7 @@ pub fn bootstrap_difference(
     Some(Difference {
         a: qa,
         b: qb,
+        scale: qa.abs().max(qb.abs()),
         difference: qa - qb,
         interval: (lower, upper),
         p_value: honest_p(p),
@@ -260,6 +267,7 @@ pub fn share_difference(a: &[bool], b: &[bool], paired: bool, level: f64) -> Opt
     Some(Difference {
         a: pa,
         b: pb,
+        scale: pa.abs().max(pb.abs()),
         difference: d,
         interval: ((d - z * se).max(-1.0), (d + z * se).min(1.0)),
         p_value: honest_p(p),

@@ -156,6 +156,8 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.ts_median_km_hi.push(median_hi);
         let rmst = km.as_ref().map(|k| k.restricted_mean(scale.tau));
         rows.ts_rmst.push(rmst.map(|r| r.estimate));
+        rows.ts_mean_settled
+            .push(runs.and_then(DesignRuns::settled_mean));
         // Inside [0, τ] by construction: no clipping.
         let rmst_interval = rmst.map(|r| r.bounded_interval(LEVEL));
         rows.ts_rmst_lo.push(rmst_interval.map(|i| i.lower));
@@ -327,6 +329,7 @@ struct SummaryColumns {
     ts_median_from_start: Vec<Option<f64>>,
     ts_median_km_lo: Vec<Option<f64>>,
     ts_median_km_hi: Vec<Option<f64>>,
+    ts_mean_settled: Vec<Option<f64>>,
     ts_rmst: Vec<Option<f64>>,
     ts_rmst_lo: Vec<Option<f64>>,
     ts_rmst_hi: Vec<Option<f64>>,
@@ -478,6 +481,7 @@ impl SummaryColumns {
             Column::new("settling_revs_rmst".into(), self.ts_rmst),
             Column::new("settling_revs_rmst_lo".into(), self.ts_rmst_lo),
             Column::new("settling_revs_rmst_hi".into(), self.ts_rmst_hi),
+            Column::new("settling_revs_mean_settled".into(), self.ts_mean_settled),
             Column::new("settling_horizon_revs".into(), self.horizon),
             Column::new("settling_revs_p90_all_runs".into(), self.ts_p90_all),
             Column::new("vs_best_verdict".into(), self.vs_best_verdict),

@@ -317,6 +317,7 @@ mod verdict_tests {
             difference: Some(Difference {
                 a,
                 b,
+                scale: a.abs().max(b.abs()),
                 difference: a - b,
                 interval: (a - b - 1.0, a - b + 1.0),
                 p_value: p,

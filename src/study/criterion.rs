@@ -286,17 +286,18 @@ impl Criterion {
                 level,
                 rng,
             ),
-            Criterion::Mean if paired => paired_mean_difference(
-                &capped_times(a, scale.tau),
-                &capped_times(b, scale.tau),
-                level,
-            ),
-            Criterion::Mean => mean_difference_bootstrap(
-                &capped_times(a, scale.tau),
-                &capped_times(b, scale.tau),
-                level,
-                rng,
-            ),
+            Criterion::Mean => {
+                let (x, y) = (capped_times(a, scale.tau), capped_times(b, scale.tau));
+                let d = if paired {
+                    paired_mean_difference(&x, &y, level)
+                } else {
+                    mean_difference_bootstrap(&x, &y, level, rng)
+                };
+                d.map(|d| Difference {
+                    scale: settled_scale(a, b).unwrap_or(d.scale),
+                    ..d
+                })
+            }
             Criterion::P90 => quantile_difference(
                 &capped_times(a, scale.tau),
                 &capped_times(b, scale.tau),
@@ -357,6 +358,7 @@ pub fn sign_difference(c: &SettlingComparison, a: f64, b: f64) -> Difference {
     Difference {
         a,
         b,
+        scale: a.abs().max(b.abs()),
         difference: -c.median_difference,
         interval: (
             -c.median_difference_interval.1,
@@ -364,6 +366,17 @@ pub fn sign_difference(c: &SettlingComparison, a: f64, b: f64) -> Difference {
         ),
         p_value: honest_p(c.sign_test_p),
         test: "sign",
+    }
+}
+
+/// The larger of two designs' mean settling times over their settled runs
+/// (`None` when neither settled): the scale of a restricted mean's
+/// difference, which the horizon does not move.
+pub fn settled_scale(a: &DesignRuns, b: &DesignRuns) -> Option<f64> {
+    let mean = |d: &DesignRuns| d.settled_mean();
+    match (mean(a), mean(b)) {
+        (Some(x), Some(y)) => Some(x.max(y)),
+        (x, y) => x.or(y),
     }
 }
 

@@ -315,10 +315,19 @@ fn disagreements(
             let interval = (column("diff_lo")?, column("diff_hi")?);
             let values = c.f(value_column(m))?;
             let (a, b) = (values[design.row], values[best.row]);
+            // A restricted mean's difference is judged against the settled
+            // runs' mean time (horizon-free), as the verdicts judged it.
+            let settled = c.f_or_none("settling_revs_mean_settled")?;
+            let own_scale = match (settled[design.row], settled[best.row]) {
+                (Some(x), Some(y)) => Some(x.max(y)),
+                (x, y) => x.or(y),
+            }
+            .filter(|_| m == Criterion::Mean);
             // A value beyond the run has no size: only the sign and p count.
             let d = Difference {
                 a: a.unwrap_or(0.0),
                 b: b.unwrap_or(0.0),
+                scale: own_scale.unwrap_or(a.unwrap_or(0.0).abs().max(b.unwrap_or(0.0).abs())),
                 difference: diff,
                 interval: (
                     interval.0.unwrap_or(f64::NEG_INFINITY),

@@ -28,6 +28,17 @@ pub struct DesignRuns {
 }
 
 impl DesignRuns {
+    /// The mean settling time of the runs that settled; `None` when none did.
+    pub fn settled_mean(&self) -> Option<f64> {
+        let times: Vec<f64> = self
+            .settling
+            .iter()
+            .filter(|o| o.settled)
+            .map(|o| o.time)
+            .collect();
+        (!times.is_empty()).then(|| times.iter().sum::<f64>() / times.len() as f64)
+    }
+
     /// Its first `n` runs (all of them when it has fewer).
     pub fn first(&self, n: usize) -> DesignRuns {
         let n = n.min(self.sample_ids.len());

@@ -145,6 +145,14 @@ pub fn material(a: f64, b: f64, difference: f64) -> bool {
     difference.abs() >= MIN_RELATIVE_EFFECT * a.abs().max(b.abs())
 }
 
+/// Whether a measured difference is large enough to report: 1 % of its
+/// own scale (for a restricted mean, of the settled runs' mean time, so
+/// that a longer horizon, which adds τ to every censored run of both
+/// designs, cannot turn a difference into "not distinguishable").
+pub fn material_difference(d: &Difference) -> bool {
+    d.difference.abs() >= MIN_RELATIVE_EFFECT * d.scale
+}
+
 /// Which design of a comparison of A against B a measure favours.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Favours {
@@ -160,7 +168,7 @@ pub enum Favours {
 /// Holm-adjusted p-value, non-zero, and large enough to matter
 /// ([`material`]). `None` when it favours neither.
 pub fn favoured(criterion: Criterion, d: &Difference, p_holm: f64, alpha: f64) -> Option<Favours> {
-    let significant = p_holm <= alpha && d.difference != 0.0 && material(d.a, d.b, d.difference);
+    let significant = p_holm <= alpha && d.difference != 0.0 && material_difference(d);
     significant.then(|| {
         if criterion.a_better(d.difference) {
             Favours::A
@@ -302,6 +310,10 @@ pub fn compare(
                 (Criterion::Median, None) if !paired => unpaired.map(|u| Difference {
                     a: medians.0.unwrap_or(f64::INFINITY),
                     b: medians.1.unwrap_or(f64::INFINITY),
+                    scale: medians
+                        .0
+                        .unwrap_or(f64::INFINITY)
+                        .max(medians.1.unwrap_or(f64::INFINITY)),
                     difference: medians.0.unwrap_or(f64::INFINITY)
                         - medians.1.unwrap_or(f64::INFINITY),
                     interval: (f64::NEG_INFINITY, f64::INFINITY),
@@ -628,6 +640,51 @@ mod tests {
         }
     }
 
+    /// Two designs whose runs have the same outcomes at any horizon: B
+    /// settles 2.4 rev after A in each of 14 paired runs, and 6 runs of
+    /// each never settle (censored at the horizon τ).
+    fn horizon_pair(tau: f64) -> [DesignRuns; 2] {
+        let make = |id: u32, shift: f64| DesignRuns {
+            design_id: id,
+            sample_ids: (0..20).collect(),
+            settling: (0..20)
+                .map(|i| match i {
+                    0..14 => Observation {
+                        time: 20.0 + 0.5 * f64::from(i) + shift + 0.01 * f64::from(i % 3),
+                        settled: true,
+                    },
+                    _ => Observation {
+                        time: tau,
+                        settled: false,
+                    },
+                })
+                .collect(),
+            residual: vec![Some(0.02); 20],
+            residual_abs: vec![Some(1e-6); 20],
+        };
+        [make(0, 0.0), make(1, 2.4)]
+    }
+
+    #[test]
+    fn a_verdict_on_the_restricted_mean_does_not_hang_on_the_horizon() {
+        // The difference of the restricted means is 14·2.4/20 = 1.68 rev at
+        // every τ, while the means grow with τ (6 of 20 runs counted at τ):
+        // 1 % of the mean (1.8 rev at τ = 550, 3.5 at 1 150) would call it
+        // "not distinguishable"; 1 % of the settled runs' mean (0.26 rev)
+        // keeps the verdict.
+        for tau in [550.0, 1150.0] {
+            let designs = horizon_pair(tau);
+            let scale = Scale {
+                tau,
+                rev_seconds: 0.01,
+            };
+            let v = best_versus_rest(&designs, Criterion::Mean, &scale, 0.05, true, 1).unwrap();
+            assert_eq!(v.best, 0, "τ = {tau}");
+            let verdicts: Vec<Verdict> = v.others.iter().map(|o| o.2).collect();
+            assert_eq!(verdicts, vec![Verdict::BestBetter], "τ = {tau}");
+        }
+    }
+
     #[test]
     fn a_design_that_works_ranks_above_a_faster_one_that_mostly_fails() {
         // A: 4 of 10 runs settle by 10 rev, the rest never (40 %: no
@@ -659,6 +716,7 @@ mod tests {
             difference: Some(Difference {
                 a: 0.364_003,
                 b: 0.364_000,
+                scale: 0.364_003,
                 difference: 3e-6,
                 interval: (2e-6, 4e-6),
                 p_value: 1e-4,
@@ -671,6 +729,7 @@ mod tests {
             difference: Some(Difference {
                 a: 0.40,
                 b: 0.36,
+                scale: 0.40,
                 difference: 0.04,
                 ..tiny.difference.unwrap()
             }),

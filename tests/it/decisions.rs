@@ -2,6 +2,7 @@
 //! does not work (and why), failed runs never absorbed, divergence judged
 //! on a scale that covers the start, run-ups timed from the operating speed.
 
+use autobal::study::criterion::Criterion;
 use autobal::study::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
 use autobal::study::io::read_parquet;
 use autobal::study::verdict::{Favours, Shortfall, favoured};
@@ -562,11 +563,32 @@ fn the_decision_is_typed_and_follows_the_rules_on_a_many_design_study() {
         ),
         other => panic!("{other:?}"),
     }
+    // A restricted mean's difference is judged against the settled runs'
+    // mean time of the two designs, every other against the larger value.
+    let settled_mean = |id: u32| -> Option<f64> {
+        let row = decision.ranked.iter().find(|r| r.id == id)?.row;
+        summary
+            .column("settling_revs_mean_settled")
+            .unwrap()
+            .f64()
+            .unwrap()
+            .get(row)
+    };
     for d in &decision.disagreements {
         assert_ne!(d.measure, decision.criterion);
+        let (a, b) = (d.values.0.unwrap_or(0.0), d.values.1.unwrap_or(0.0));
+        let scale = match d.measure {
+            Criterion::Mean => settled_mean(d.design)
+                .into_iter()
+                .chain(settled_mean(best.id))
+                .reduce(f64::max)
+                .unwrap_or(a.abs().max(b.abs())),
+            _ => a.abs().max(b.abs()),
+        };
         let difference = autobal::stats::paired_measures::Difference {
-            a: d.values.0.unwrap_or(0.0),
-            b: d.values.1.unwrap_or(0.0),
+            a,
+            b,
+            scale,
             difference: d.difference,
             interval: (f64::NEG_INFINITY, f64::INFINITY),
             p_value: d.p_holm,
@@ -864,7 +886,9 @@ fn a_floor_above_one_planes_band_is_named_per_plane() {
     assert!(
         stdout.contains("with a caution: it settles in only")
             && stdout.contains("runs that did not settle have plane 0's own settling band δ·A_ref")
-            && stdout.contains("at or below a whirl no balancer removes, 5.000 µm: the race eccentricity"),
+            && stdout.contains(
+                "at or below a whirl no balancer removes, 5.000 µm: the race eccentricity"
+            ),
         "{stdout}"
     );
     assert!(
