@@ -440,9 +440,18 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
         part,
         shortfalls: shortfalls(settled, worse),
         unsettled_floor: c.s_or_none("unsettled_floor")?[i].clone(),
-        edges: edges(&grid, i),
+        edges: edges(&grid, i, &beaten(c)?),
         pareto: ranked.iter().filter(|d| d.pareto).map(|d| d.id).collect(),
     })
+}
+
+/// Per summary row: whether #1 is significantly better than it on the
+/// criterion (`vs_best_verdict` = `best_better`).
+fn beaten(c: &SummaryColumns) -> PolarsResult<Vec<bool>> {
+    Ok(c.s("vs_best_verdict")?
+        .iter()
+        .map(|v| v.as_deref().and_then(StoredVerdict::parse) == Some(StoredVerdict::BestBetter))
+        .collect())
 }
 
 #[cfg(test)]

@@ -95,9 +95,13 @@ pub struct Edge {
 }
 
 /// The swept axes (at least three values among the designs of the winner's
-/// kind) on whose end the winner sits: there the best may lie beyond what
-/// was swept. `designs` holds (kind, n, ρ, β) per design, `best` its index.
-pub fn edges(designs: &[(String, f64, f64, f64)], best: usize) -> Vec<Edge> {
+/// kind) on whose end the winner sits, where the best may lie beyond what
+/// was swept: only where the winner is significantly better than its
+/// neighbours one step inside (`beaten[j]`: #1 better than design j; a
+/// winner tied with them says nothing about beyond), and only where a step
+/// beyond is a part that exists (n + 1 balls or rollers that fit, a ρ
+/// below ρ_max). `designs` holds (kind, n, ρ, β) per design, `best` its index.
+pub fn edges(designs: &[(String, f64, f64, f64)], best: usize, beaten: &[bool]) -> Vec<Edge> {
     let Some(winner) = designs.get(best) else {
         return Vec::new();
     };
@@ -124,13 +128,63 @@ pub fn edges(designs: &[(String, f64, f64, f64)], best: usize) -> Vec<Edge> {
                 return None;
             }
             let high = v == *swept.last()?;
-            (high || v == swept[0]).then_some(Edge {
+            if !(high || v == swept[0]) {
+                return None;
+            }
+            let inside = if high {
+                swept[swept.len() - 2]
+            } else {
+                swept[1]
+            };
+            // The neighbours one step inside: same kind, the other axes as
+            // the winner's where the grid has such designs.
+            let neighbours: Vec<usize> = (0..designs.len())
+                .filter(|&j| designs[j].0 == winner.0 && value(&designs[j]) == inside)
+                .collect();
+            let same_elsewhere: Vec<usize> = neighbours
+                .iter()
+                .copied()
+                .filter(|&j| {
+                    pick.iter()
+                        .filter(|(other, _)| *other != axis)
+                        .all(|(_, f)| f(&designs[j]) == f(winner))
+                })
+                .collect();
+            let neighbours = if same_elsewhere.is_empty() {
+                neighbours
+            } else {
+                same_elsewhere
+            };
+            let beats = !neighbours.is_empty()
+                && neighbours
+                    .iter()
+                    .all(|&j| beaten.get(j).copied().unwrap_or(false));
+            (beats && beyond_exists(winner, axis, high, (v - inside).abs())).then_some(Edge {
                 axis,
                 high,
                 value: v,
             })
         })
         .collect()
+}
+
+/// Whether a step beyond the winner along `axis` is a part that exists:
+/// one more ball or roller that still fits at its ρ, a ρ half the last
+/// `step` larger still below ρ_max(n), at least one weight; pendulums pass
+/// each other and always fit.
+fn beyond_exists(winner: &(String, f64, f64, f64), axis: Axis, high: bool, step: f64) -> bool {
+    let (kind, n, rho) = (&winner.0, winner.1, winner.2);
+    let packed = kind != "pendulum";
+    let fits = |n: f64, rho: f64| {
+        !packed
+            || crate::design::geometry::rho_max(n as u32).is_ok_and(|max| rho < max * (1.0 - 1e-9))
+    };
+    match (axis, high) {
+        (Axis::Count, true) => fits(n + 1.0, rho),
+        (Axis::Count, false) => n > 1.0,
+        (Axis::Rho, true) => fits(n, rho + 0.5 * step),
+        (Axis::Rho, false) | (Axis::Drag, _) => true,
+    }
 }
 
 /// The smallest difference worth reporting, relative to the larger of the
@@ -764,8 +818,10 @@ mod tests {
                 .map(|&b| ("ball".to_string(), 3.0, 0.3, b))
                 .collect()
         };
-        // The optical drive: the largest drag swept wins.
-        let e = edges(&grid(&[3e-5, 3e-4, 3e-3]), 2);
+        // The optical drive: the largest drag swept wins, better than the
+        // next inside.
+        let all = [true; 3];
+        let e = edges(&grid(&[3e-5, 3e-4, 3e-3]), 2, &all);
         assert_eq!(
             e,
             vec![Edge {
@@ -774,9 +830,34 @@ mod tests {
                 value: 3e-3
             }]
         );
-        assert!(!edges(&grid(&[3e-5, 3e-4, 3e-3]), 0)[0].high);
+        assert!(!edges(&grid(&[3e-5, 3e-4, 3e-3]), 0, &all)[0].high);
         // Inside the sweep, or a two-value comparison: nothing to extend.
-        assert!(edges(&grid(&[3e-5, 3e-4, 3e-3]), 1).is_empty());
-        assert!(edges(&grid(&[3e-4, 3e-3]), 1).is_empty());
+        assert!(edges(&grid(&[3e-5, 3e-4, 3e-3]), 1, &all).is_empty());
+        assert!(edges(&grid(&[3e-4, 3e-3]), 1, &all).is_empty());
+    }
+
+    #[test]
+    fn edge_advice_needs_a_win_over_the_interior_and_a_part_beyond() {
+        // The optical drive: 5 balls at the smallest ρ swept, tied with
+        // ρ = 0.146 one step inside: nothing says the best is beyond.
+        let grid: Vec<(String, f64, f64, f64)> = [0.1, 0.146, 0.2]
+            .iter()
+            .map(|&rho| ("ball".to_string(), 5.0, rho, 0.01))
+            .collect();
+        assert!(edges(&grid, 0, &[false, false, true]).is_empty());
+        assert_eq!(edges(&grid, 0, &[false, true, true]).len(), 1);
+        // At the largest ρ swept, better than the inside, but 5 balls half
+        // a step larger would not fit (ρ_max(5) = 0.3702): no advice beyond.
+        let packed: Vec<(String, f64, f64, f64)> = [0.3, 0.34, 0.37]
+            .iter()
+            .map(|&rho| ("ball".to_string(), 5.0, rho, 0.01))
+            .collect();
+        assert!(edges(&packed, 2, &[true, true, false]).is_empty());
+        // Pendulums pass each other: a larger ρ always exists.
+        let swung: Vec<(String, f64, f64, f64)> = packed
+            .iter()
+            .map(|d| ("pendulum".to_string(), d.1, d.2, d.3))
+            .collect();
+        assert_eq!(edges(&swung, 2, &[true, true, false]).len(), 1);
     }
 }
