@@ -95,6 +95,26 @@ pub struct Evaluator<'a> {
 }
 
 impl Evaluator<'_> {
+    /// The candidate as a part to build ("5 balls of 3.2 mm diameter, …";
+    /// each plane's with a design per plane); `None` when it cannot be built.
+    pub fn part(&self, c: &Candidate) -> Option<String> {
+        let design = self.design(c).ok()?;
+        let one = |d: &Design| {
+            crate::study::design::part_text(
+                d.spec.kind.name(),
+                d.spec.n,
+                (d.rho, d.spec.race_radius),
+                d.weight_mass,
+                d.spec.drag,
+                d.roller_length(),
+            )
+        };
+        Some(match design.plane_designs.first() {
+            Some(other) => format!("plane 0: {}; plane 1: {}", one(&design), one(other)),
+            None => one(&design),
+        })
+    }
+
     /// Build the candidate as a design, or say which constraint it breaks.
     fn design(&self, c: &Candidate) -> Result<Design, String> {
         let rhos = std::iter::once(c.rho).chain(c.plane1.map(|p| p.rho));

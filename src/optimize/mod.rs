@@ -8,6 +8,7 @@
 //! the results.
 
 pub mod confirm;
+pub mod cross_check;
 pub mod evaluate;
 pub mod noisy_simplex;
 pub mod search;
@@ -274,6 +275,7 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
             (c, r)
         })
         .collect();
+    let results = cross_check_counts(&evaluator, results);
     let mut evaluations = Vec::new();
     let mut terminations = Vec::new();
     let mut best = Vec::new();
@@ -346,6 +348,31 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
         dir,
         confirmation,
     })
+}
+
+/// Each count's search (one design per plane) checked against the other
+/// counts' optima on its own samples ([`cross_check`]), one round, every
+/// count in parallel from the first searches' optima.
+fn cross_check_counts(
+    evaluator: &Evaluator<'_>,
+    results: Vec<(evaluate::Candidate, search::SearchResult)>,
+) -> Vec<(evaluate::Candidate, search::SearchResult)> {
+    let seeds: Vec<cross_check::Seed> = results
+        .iter()
+        .filter(|(c, _)| c.plane1.is_none())
+        .filter_map(|(c, r)| {
+            let best = best_of(&r.evaluations, evaluator.spec.objective)?;
+            Some((format!("{} n = {}", c.kind, c.n), best.candidate))
+        })
+        .collect();
+    results
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|(c, r)| match c.plane1 {
+            None => (c, cross_check::cross_check(evaluator, c, r, &seeds)),
+            Some(_) => (c, r),
+        })
+        .collect()
 }
 
 /// The paper's complete optimisation per kind (grow ρ to the housing limit,

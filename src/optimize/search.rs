@@ -202,11 +202,7 @@ const MAX_PASSES: usize = 20;
 /// The best logged evaluation (lowest cost).
 fn best_logged(cost: &CandidateCost<'_>) -> Option<Evaluation> {
     let log = cost.log.lock().expect("log lock");
-    let key = |e: &Evaluation| match e.value {
-        Some(v) if v.is_finite() && cost.evaluator.spec.objective.maximise() => -v,
-        Some(v) if v.is_finite() => v,
-        _ => INFEASIBLE,
-    };
+    let key = |e: &Evaluation| solver_cost(cost.evaluator, e);
     log.iter().min_by(|a, b| key(a).total_cmp(&key(b))).cloned()
 }
 
@@ -279,7 +275,7 @@ pub fn search_slot(evaluator: &Evaluator<'_>, base: Candidate, slot: Slot) -> Se
         log: Mutex::new(Vec::new()),
     };
     if spec.free.contains(&Variable::Drag) {
-        return nelder_mead(&cost, lo, hi, budget);
+        return nelder_mead(&cost, lo, hi, budget, None);
     }
     // A coarse scan brackets the best ρ (Brent only finds a local minimum) …
     // five points, or four when that is the whole budget: the scan never
@@ -450,11 +446,7 @@ pub fn search_planes(evaluator: &Evaluator<'_>, base: Candidate) -> SearchResult
 
 /// The cost of a logged evaluation as the solvers see it.
 fn cost_of(cost: &CandidateCost<'_>, e: &Evaluation) -> f64 {
-    match e.value {
-        Some(v) if v.is_finite() && cost.evaluator.spec.objective.maximise() => -v,
-        Some(v) if v.is_finite() => v,
-        _ => INFEASIBLE,
-    }
+    solver_cost(cost.evaluator, e)
 }
 
 /// The search's result with its stop stated honestly: a bound overrides
@@ -497,6 +489,68 @@ fn finish(
         termination: text,
         stop,
     }
+}
+
+/// Points tried on one count's own samples, outside its search: the
+/// evaluations (phase `phase`) and each point's cost as the solvers see it
+/// (lower is better) with its standard error.
+pub(super) fn try_points(
+    evaluator: &Evaluator<'_>,
+    base: Candidate,
+    points: &[(f64, f64)],
+    phase: &'static str,
+) -> (Vec<Evaluation>, Vec<(f64, f64)>) {
+    let cost = CandidateCost {
+        evaluator,
+        base,
+        slot: Slot::Plane0,
+        drag: base.drag,
+        phase,
+        log: Mutex::new(Vec::new()),
+    };
+    let scored = points
+        .iter()
+        .map(|&(rho, drag)| {
+            let f = cost.eval(rho, drag);
+            let se = cost
+                .log
+                .lock()
+                .expect("log lock")
+                .last()
+                .map_or(0.0, |e| e.std_err);
+            (f, se)
+        })
+        .collect();
+    (cost.take_log(), scored)
+}
+
+/// A logged evaluation's cost as the solvers see it (lower is better).
+pub(super) fn solver_cost(evaluator: &Evaluator<'_>, e: &Evaluation) -> f64 {
+    match e.value {
+        Some(v) if v.is_finite() && evaluator.spec.objective.maximise() => -v,
+        Some(v) if v.is_finite() => v,
+        _ => INFEASIBLE,
+    }
+}
+
+/// The Nelder–Mead search of `base`'s count over (ρ, ln β), restarted
+/// from (ρ, β) = `from` with `budget` evaluations.
+pub(super) fn nelder_mead_from(
+    evaluator: &Evaluator<'_>,
+    base: Candidate,
+    from: (f64, f64),
+    budget: u64,
+) -> SearchResult {
+    let (lo, hi) = rho_interval(evaluator, base.n);
+    let cost = CandidateCost {
+        evaluator,
+        base,
+        slot: Slot::Plane0,
+        drag: base.drag,
+        phase: "scan",
+        log: Mutex::new(Vec::new()),
+    };
+    nelder_mead(&cost, lo, hi, budget, Some(from))
 }
 
 /// The simplex's view of the candidates: (ρ, ln β) clamped into the box,
@@ -545,13 +599,20 @@ impl noisy_simplex::Objective for SimplexCost<'_, '_> {
     }
 }
 
-/// Nelder–Mead over (ρ, ln β) from the middle of the box: it stops when the
+/// Nelder–Mead over (ρ, ln β) from `from` (default: the middle of the box
+/// in ρ, the study's drag): it stops when the
 /// simplex's values differ by less than their standard errors, restarts from
 /// its best point (at least once, and again while a restart improves by more
 /// than a standard error), then checks the optimum against its 8 neighbours
 /// at half the first steps on the same samples; a neighbour that beats it by
 /// more than its standard error restarts the search there.
-fn nelder_mead(cost: &CandidateCost<'_>, lo: f64, hi: f64, budget: u64) -> SearchResult {
+fn nelder_mead(
+    cost: &CandidateCost<'_>,
+    lo: f64,
+    hi: f64,
+    budget: u64,
+    from: Option<(f64, f64)>,
+) -> SearchResult {
     let spec = cost.evaluator.spec;
     let [dlo, dhi] = spec
         .drag_bounds
@@ -565,7 +626,8 @@ fn nelder_mead(cost: &CandidateCost<'_>, lo: f64, hi: f64, budget: u64) -> Searc
         budget,
         seen: HashMap::new(),
     };
-    let mut start = vec![0.5 * (lo + hi), cost.drag.ln().clamp(ln_drag.0, ln_drag.1)];
+    let (rho0, drag0) = from.unwrap_or((0.5 * (lo + hi), cost.drag));
+    let mut start = vec![rho0.clamp(lo, hi), drag0.ln().clamp(ln_drag.0, ln_drag.1)];
     let mut previous: Option<Vertex> = None;
     let mut restarts = 0;
     let mut stop = "budget";

@@ -51,6 +51,18 @@ impl Objective {
         !matches!(self, Objective::Capacity | Objective::ATilde)
     }
 
+    /// The objective's unit as printed ("rev", "m", "kg·m"; empty for a
+    /// share or a dimensionless measure).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Objective::Capacity => "kg·m",
+            Objective::SettlingMean | Objective::SettlingMedian | Objective::SettlingP90 => "rev",
+            Objective::Residual => "A_ref",
+            Objective::ResidualP95 => "m",
+            Objective::ATilde | Objective::SettledFraction | Objective::PResidualBelow => "",
+        }
+    }
+
     /// snake_case name.
     pub fn name(self) -> &'static str {
         match self {

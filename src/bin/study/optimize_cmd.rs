@@ -36,11 +36,14 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         WhenExists::from_overwrite(args.overwrite),
     )?;
     let out = optimize(&plan)?;
-    let objective = plan
-        .file
-        .optimize
-        .as_ref()
-        .map_or("", |o| o.objective.name());
+    let spec = plan.file.optimize.clone();
+    let objective = spec.as_ref().map_or("", |o| o.objective.name());
+    let unit = spec.as_ref().map_or("", |o| o.objective.unit());
+    let objective_header = if unit.is_empty() {
+        objective.to_string()
+    } else {
+        format!("{objective}\n{unit}")
+    };
     // A residual in metres (µm-sized) would print as 0.00000 at the other
     // objectives' five decimals.
     let metres = plan
@@ -122,7 +125,7 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         "n",
         "ρ",
         "β\nN·s/m",
-        objective,
+        &objective_header,
         "± SE",
         "on fresh\nsamples ± SE",
         "capacity\nkg·m",
@@ -137,8 +140,12 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
     print!("{table}");
     print!("{}", wrap(&dropped_note(&dropped), text_width()));
     if let Some(c) = confirmation {
-        print!("{}", wrap(&confirmation_lines(c, &with_se), text_width()));
+        print!(
+            "{}",
+            wrap(&confirmation_lines(c, &with_se, unit), text_width())
+        );
     }
+    print!("{}", wrap(&pick_line(&plan, &out), text_width()));
     for (label, _, why) in &out.terminations {
         say_err(&format!("{label}: {why}"));
     }
@@ -155,16 +162,22 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
 fn confirmation_lines(
     c: &autobal::optimize::confirm::Confirmation,
     shown: &dyn Fn(f64, f64) -> String,
+    unit: &str,
 ) -> String {
     let pick = &c.rows[c.overall];
     let mut text = format!(
-        "overall: {} is the best of the (kind, n) optima on {} fresh samples (samples {}–{}, which the search never used): {} ± {}",
+        "overall: {} is the best of the (kind, n) optima on {} fresh samples (samples {}–{}, which the search never used): {} ± {}{}",
         pick.scope,
         c.samples,
         c.first_sample,
         c.first_sample + u64::from(c.samples) - 1,
         shown(pick.value, pick.std_err),
         shown(pick.std_err, pick.std_err),
+        if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        },
     );
     if c.search_pick != c.overall {
         let own = &c.rows[c.search_pick];
@@ -204,4 +217,25 @@ fn confirmation_lines(
         );
     }
     text
+}
+
+/// The overall pick as a part to build, in mm and g ("pick: 5 balls of …").
+fn pick_line(
+    plan: &autobal::study::config::StudyPlan,
+    out: &autobal::optimize::OptimizeOutput,
+) -> String {
+    let Some(spec) = plan.file.optimize.as_ref() else {
+        return String::new();
+    };
+    let Some(pick) = out.best.iter().find(|b| b.scope == "overall") else {
+        return String::new();
+    };
+    let evaluator = autobal::optimize::evaluate::Evaluator {
+        plan,
+        spec,
+        samples: 0,
+    };
+    evaluator
+        .part(&pick.evaluation.candidate)
+        .map_or(String::new(), |part| format!("pick: {part}\n"))
 }
