@@ -68,7 +68,7 @@ pub fn cross_check(
         return SearchResult {
             evaluations,
             termination: format!(
-                "{}; no other count's optimum ({}) beats it on these samples",
+                "{}; no other count's optimum ({}) beats it by more than their standard errors on these samples",
                 first.termination,
                 tried
                     .iter()
