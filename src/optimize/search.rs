@@ -599,6 +599,34 @@ impl noisy_simplex::Objective for SimplexCost<'_, '_> {
     }
 }
 
+/// The points an optimum `x` of the simplex is checked against: the 8 of
+/// a grid at half the first `steps`, then, for each other vertex of the
+/// final `simplex`, x ± the edge towards it scaled to the same distance in
+/// step units (a valley where ρ and β rise together runs along the
+/// simplex, not along the axes).
+fn neighbours(x: &[f64], simplex: &[Vertex], steps: &[f64; 2]) -> Vec<Vec<f64>> {
+    let mut out = Vec::new();
+    for i in [-1.0, 0.0, 1.0] {
+        for j in [-1.0, 0.0, 1.0] {
+            if i != 0.0 || j != 0.0 {
+                out.push(vec![x[0] + 0.5 * i * steps[0], x[1] + 0.5 * j * steps[1]]);
+            }
+        }
+    }
+    for v in simplex.iter().filter(|v| v.x != x) {
+        let d = [(v.x[0] - x[0]) / steps[0], (v.x[1] - x[1]) / steps[1]];
+        let norm = d[0].hypot(d[1]);
+        if norm == 0.0 || !norm.is_finite() {
+            continue;
+        }
+        for sign in [1.0, -1.0] {
+            let k = sign * 0.5 / norm;
+            out.push(vec![x[0] + k * d[0] * steps[0], x[1] + k * d[1] * steps[1]]);
+        }
+    }
+    out
+}
+
 /// Nelder–Mead over (ρ, ln β) from `from` (default: the middle of the box
 /// in ρ, the study's drag): it stops when the
 /// simplex's values differ by less than their standard errors, restarts from
@@ -649,38 +677,32 @@ fn nelder_mead(
             restarts += 1;
             continue;
         }
-        // Confirm the optimum against its neighbours.
+        // Confirm the optimum against its neighbours: the 8 of a grid at
+        // half the first steps, and 2 along each of the final simplex's own
+        // edges (at the same scaled distance), which follow a valley that
+        // runs across the axes.
         let optimum = previous.clone().unwrap_or(best);
         let mut beaten: Option<Vertex> = None;
         let mut out_of_budget = false;
-        'grid: for i in [-1.0, 0.0, 1.0] {
-            for j in [-1.0, 0.0, 1.0] {
-                if i == 0.0 && j == 0.0 {
-                    continue;
+        for x in neighbours(&optimum.x, &simplex, &steps) {
+            match noisy_simplex::Objective::eval(&mut objective, &x) {
+                None => {
+                    out_of_budget = true;
+                    break;
                 }
-                let x = vec![
-                    optimum.x[0] + 0.5 * i * steps[0],
-                    optimum.x[1] + 0.5 * j * steps[1],
-                ];
-                match noisy_simplex::Objective::eval(&mut objective, &x) {
-                    None => {
-                        out_of_budget = true;
-                        break 'grid;
+                Some((f, se)) if f < optimum.f - optimum.se => {
+                    if beaten.as_ref().is_none_or(|b| f < b.f) {
+                        beaten = Some(Vertex { x, f, se });
                     }
-                    Some((f, se)) if f < optimum.f - optimum.se => {
-                        if beaten.as_ref().is_none_or(|b| f < b.f) {
-                            beaten = Some(Vertex { x, f, se });
-                        }
-                    }
-                    Some(_) => {}
                 }
+                Some(_) => {}
             }
         }
         match (beaten, out_of_budget) {
             (None, false) => {
                 stop = "converged";
                 how = format!(
-                    "the simplex's values came within their standard errors, after {restarts} restart{} from its best point; confirmed against its 8 neighbours at ρ ± {:.4}, ln β ± {:.3} on the same samples",
+                    "the simplex's values came within their standard errors, after {restarts} restart{} from its best point; confirmed against its 8 neighbours at ρ ± {:.4}, ln β ± {:.3} and along the simplex's own edges on the same samples",
                     if restarts == 1 { "" } else { "s" },
                     0.5 * steps[0],
                     0.5 * steps[1]
@@ -729,6 +751,37 @@ mod tests {
             feasible: true,
             constraint: "ok".into(),
             phase: "test",
+        }
+    }
+
+    /// The check follows the simplex's own edges, at half a step in step
+    /// units: a valley along (2, 1) steps is probed along it, which the
+    /// axis grid alone (spacing ½ step along ρ, ln β and their diagonals)
+    /// does not do.
+    #[test]
+    fn the_optimum_is_checked_along_the_simplexs_own_edges() {
+        let vertex = |x: [f64; 2]| Vertex {
+            x: x.to_vec(),
+            f: 0.0,
+            se: 0.0,
+        };
+        let steps = [0.1, 2.0];
+        let simplex = [vertex([0.3, 1.0]), vertex([0.5, 3.0]), vertex([0.3, 0.0])];
+        let points = neighbours(&[0.3, 1.0], &simplex, &steps);
+        assert_eq!(points.len(), 8 + 4);
+        // Along (0.2, 2.0) = (2, 1) steps, half a step away, both ways.
+        let unit = [2.0 / 5f64.sqrt(), 1.0 / 5f64.sqrt()];
+        for sign in [1.0, -1.0] {
+            let want = [
+                0.3 + sign * 0.5 * unit[0] * 0.1,
+                1.0 + sign * 0.5 * unit[1] * 2.0,
+            ];
+            assert!(
+                points
+                    .iter()
+                    .any(|p| (p[0] - want[0]).abs() < 1e-12 && (p[1] - want[1]).abs() < 1e-12),
+                "{want:?} not in {points:?}"
+            );
         }
     }
 
