@@ -23,8 +23,11 @@ use super::criterion::Criterion;
 use super::design_runs::{SettlingClock, design_runs, measure_scale};
 use super::measured_runs::DesignRuns;
 use super::stream::{Purpose, stream};
-use super::verdict::{Favours, LEVEL, balances, favoured, pareto_set, ranking};
+use super::verdict::{
+    Favours, LEVEL, balances, favoured, material_difference, pareto_set, ranking,
+};
 use crate::stats::holm::holm_adjust;
+use crate::stats::paired_measures::Difference;
 use crate::stats::spending::Spending;
 use polars::prelude::*;
 use std::ops::Range;
@@ -264,18 +267,17 @@ pub fn leaves(
     measures.extend(plan.file.summary.pareto.iter().copied());
     measures.retain(|&m| m != criterion);
     measures.dedup();
-    // The leader must be ahead on each other measure by MARGIN_Z standard
-    // errors: a design that might still turn out better on one keeps running,
-    // so that the finding "better than #1 on m" cannot be lost with it.
+    // On each other measure the leader must be ahead by MARGIN_Z standard
+    // errors, or the design's lead, even MARGIN_Z standard errors larger,
+    // must stay under the minimum effect a finding needs
+    // ([`material_difference`]): a design that might still turn out better
+    // on one by a difference worth reporting keeps running, so that the
+    // finding "better than #1 on m" cannot be lost with it.
     let at_least_as_good = |d: &DesignRuns| {
         measures.iter().enumerate().all(|(j, m)| {
             let (a, b) = (m.value(leader, &scale), m.value(d, &scale));
-            match m.order(a, b) {
-                std::cmp::Ordering::Equal => return true,
-                // Behind on the point estimate: not ahead by any margin,
-                // and no bootstrap interval is needed to say so.
-                std::cmp::Ordering::Greater => return false,
-                std::cmp::Ordering::Less => {}
+            if m.order(a, b) == std::cmp::Ordering::Equal {
+                return true;
             }
             let mut rng = stream(
                 plan.file.seed,
@@ -286,7 +288,18 @@ pub fn leaves(
             match m.compare(leader, d, paired, &scale, LEVEL, &mut rng) {
                 Some(x) if x.interval.0.is_finite() && x.interval.1.is_finite() => {
                     let se = (x.interval.1 - x.interval.0) / (2.0 * Z_95);
-                    m.a_better(x.difference) && x.difference.abs() >= MARGIN_Z * se
+                    let lead = if m.a_better(x.difference) {
+                        x.difference.abs()
+                    } else {
+                        -x.difference.abs()
+                    };
+                    let ahead = lead >= MARGIN_Z * se;
+                    // The design's largest plausible lead, still immaterial.
+                    let immaterial = !material_difference(&Difference {
+                        difference: (MARGIN_Z * se - lead).max(0.0),
+                        ..x
+                    });
+                    ahead || immaterial
                 }
                 _ => m.order(a, b) == std::cmp::Ordering::Less,
             }
