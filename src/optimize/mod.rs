@@ -177,6 +177,20 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             &format!("samples per candidate: 1 to {MAX_SAMPLES}"),
         ));
     }
+    // As `study run` refuses it: a Sobol sequence is even only over 2^m points.
+    if let Some(n) = spec.samples
+        && plan.file.sampling.sequence == crate::study::stream::Sequence::Sobol
+        && !n.is_power_of_two()
+    {
+        return Err(bad(
+            "samples",
+            n.to_string(),
+            &format!(
+                "with sampling.sequence = \"sobol\" a power of two (e.g. {}): a Sobol sequence is even only over 2^m points",
+                n.checked_next_power_of_two().unwrap_or(1 << 16)
+            ),
+        ));
+    }
     if let Some(n) = spec.confirm_samples
         && n > MAX_SAMPLES
     {

@@ -256,7 +256,7 @@ fn path_base(verb: &[String], flag: &str) -> Option<(Vec<&'static str>, &'static
             "d",
         ),
         (["simulate"], _) => (vec!["simulate", "scene.toml"], "csv"),
-        (["compare"], _) => (vec!["compare", "results/corpus", "--designs", "0,0"], "svg"),
+        (["compare"], _) => (vec!["compare", "results/corpus", "--designs", "0,1"], "svg"),
         (["calibrate"], _) => (
             vec![
                 "calibrate",
@@ -373,7 +373,8 @@ fn every_path_flag_of_every_verb_refuses_folders_links_and_missing_or_read_only_
  {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let study = crate::bad_input::study(Path::new("results"));
+    // Two designs, so that `compare --designs 0,1` has two to compare.
+    let study = crate::bad_input::study(Path::new("results")).replace("n = 3\n", "n = [3, 4]\n");
     std::fs::write(dir.join("corpus.toml"), &study).unwrap();
     std::fs::write(dir.join("scene.toml"), crate::bad_input::scene()).unwrap();
     std::fs::write(

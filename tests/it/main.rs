@@ -15,6 +15,7 @@ mod cli_simulate;
 mod compare;
 mod contact;
 mod contact_gauge;
+mod contradictions;
 mod convergence;
 mod couple_unbalance;
 mod decisions;

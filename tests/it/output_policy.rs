@@ -167,7 +167,9 @@ fn overwrite_replaces_a_single_file_and_a_dead_writers_temporary_is_removed() {
 /// its output folder.
 fn corpus_study(dir: &Path, extra: &str) -> (PathBuf, PathBuf) {
     let path = dir.join("corpus.toml");
-    std::fs::write(&path, study(&dir.join("results")) + extra).unwrap();
+    // Two designs, so that `compare --designs 0,1` has two to compare.
+    let text = study(&dir.join("results")).replace("n = 3\n", "n = [3, 4]\n");
+    std::fs::write(&path, text + extra).unwrap();
     (path, dir.join("results/corpus"))
 }
 
@@ -287,7 +289,7 @@ fn a_corrupt_runs_file_is_reported_with_its_path() {
     // A damaged results file is the user's input: exit 2, named once.
     for args in [
         vec!["run", p, "--quiet", "--resume"],
-        vec!["compare", folder.to_str().unwrap(), "--designs", "0,0"],
+        vec!["compare", folder.to_str().unwrap(), "--designs", "0,1"],
         vec![
             "plot",
             "study",
@@ -454,7 +456,7 @@ fn a_trailing_dot_a_link_a_read_only_folder_or_a_file_as_folder_is_refused_befor
         ("--report", &["claims", "corpus.toml"]),
         ("--out", &["report", "results/corpus"]),
         ("--out", &["plot", "design"]),
-        ("--plot", &["compare", "results/corpus", "--designs", "0,0"]),
+        ("--plot", &["compare", "results/corpus", "--designs", "0,1"]),
     ];
     for (flag, verb) in base {
         let figure = verb[0] == "plot" || *flag == "--plot";
@@ -540,7 +542,7 @@ fn a_results_table_of_the_wrong_kind_is_refused_naming_the_file_and_the_missing_
     let f = folder.to_str().unwrap();
     let figs = tmp.path().join("figs");
     for args in [
-        vec!["compare", f, "--designs", "0,0"],
+        vec!["compare", f, "--designs", "0,1"],
         vec!["plot", "study", f, "--out", figs.to_str().unwrap()],
         vec!["run", p, "--quiet", "--resume"],
     ] {

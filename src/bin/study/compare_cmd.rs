@@ -75,6 +75,19 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
                 2,
             ));
         }
+        // One folder's design against itself (one folder, or the same folder
+        // twice): every paired difference is 0.
+        (Some(d), _) if d[0] == d[1] && same_folder(dir_a, dir_b) => {
+            return Err(UserError(
+                format!(
+                    "--designs {},{}: a design compared with itself; name two different designs of {}",
+                    d[0],
+                    d[1],
+                    dir_a.display()
+                ),
+                2,
+            ));
+        }
         (Some(d), _) => (Some(d[0]), Some(d[1])),
         (None, 1) => {
             return Err(UserError(
@@ -401,4 +414,14 @@ fn disagreement_lines(verdict: &PairVerdict) -> Vec<String> {
         ));
     }
     lines
+}
+
+/// Whether two folder arguments name the same folder (the same path, or
+/// the same folder once links and `..` are resolved).
+fn same_folder(a: &std::path::Path, b: &std::path::Path) -> bool {
+    a == b
+        || matches!(
+            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
+            (Ok(x), Ok(y)) if x == y
+        )
 }

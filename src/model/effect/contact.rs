@@ -126,6 +126,25 @@ impl EffectSpec for ContactSpec {
                 "parting over closing speed in an impact: 0 (a dead impact, the default) up to below 1",
             ));
         }
+        // A setting that cannot take effect is refused, naming both keys.
+        if self.restitution != 0.0 && self.model == ContactModel::Penalty {
+            return Err(invalid(
+                &format!("{key}.restitution"),
+                self.restitution,
+                &format!(
+                    "is used by rigid contact only, and {key}.model is \"penalty\" (whose {key}.damping_ratio sets the rebound): set model = \"rigid\" or remove restitution"
+                ),
+            ));
+        }
+        if !self.enabled && self.model == ContactModel::Rigid {
+            return Err(SceneError::Invalid {
+                field: format!("{key}.model"),
+                value: "rigid".into(),
+                reason: format!(
+                    "asks for rigid contact while {key}.enabled = false switches contact off: remove one of the two"
+                ),
+            });
+        }
         Ok(())
     }
 
