@@ -543,3 +543,33 @@ fn a_counts_optimum_is_checked_against_the_other_counts_optima() {
         "the 5-ball optimum printed is the 4-ball point, better on its samples"
     );
 }
+
+/// `study optimize` names the pick as a part to build, in mm and g
+/// (before: (ρ, β) only).
+#[test]
+fn the_pick_is_printed_as_a_part() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = crate::bad_input::study(&tmp.path().join("results"))
+        .replace("n = 3\n", "n = [3, 4]\n")
+        + "[optimize]\nobjective = \"capacity\"\nfree = [\"rho\"]\n";
+    let path = tmp.path().join("s.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["optimize", path.to_str().unwrap(), "--wide"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let pick = stdout
+        .lines()
+        .find(|l| l.starts_with("pick: "))
+        .unwrap_or_else(|| panic!("no pick line: {stdout}"));
+    assert!(
+        pick.contains(" balls of ") && pick.contains(" mm diameter, ") && pick.contains(" g each"),
+        "{pick}"
+    );
+}
