@@ -143,6 +143,29 @@ fn check_plane(field: &str, plane: usize, rotor: &RotorModel) -> Result<(), Scen
 }
 
 impl Scene {
+    /// Rigid contact holds weights of finite size apart; point masses
+    /// never touch, so asking for it cannot take effect.
+    fn check_rigid_contact_has_sizes(&self) -> Result<(), SceneError> {
+        let rigid = self
+            .effects
+            .contact
+            .as_ref()
+            .is_some_and(|c| c.model == crate::model::effect::contact::ContactModel::Rigid);
+        if rigid
+            && self.balancer.is_none()
+            && self.balancers.is_empty()
+            && !self.cargo.is_empty()
+            && self.cargo.iter().all(|c| c.radius <= 0.0)
+        {
+            return Err(SceneError::Invalid {
+                field: "effects.contact.model".into(),
+                value: "rigid".into(),
+                reason: "every weight is a point mass ([[cargo]] without a radius): point masses never touch, so there is nothing to hold rigid; give the weights a radius or remove model".into(),
+            });
+        }
+        Ok(())
+    }
+
     /// Check every field; the first problem found is returned.
     pub fn validate(&self) -> Result<(), SceneError> {
         self.rotor.validate()?;
@@ -180,24 +203,7 @@ impl Scene {
             planes: self.rotor.as_rotor().planes(),
             prescribed_speed: self.speed.is_prescribed(),
         })?;
-        // Rigid contact holds weights of finite size apart; point masses
-        // never touch, so asking for it cannot take effect.
-        if self
-            .effects
-            .contact
-            .as_ref()
-            .is_some_and(|c| c.model == crate::model::effect::contact::ContactModel::Rigid)
-            && self.balancer.is_none()
-            && self.balancers.is_empty()
-            && !self.cargo.is_empty()
-            && self.cargo.iter().all(|c| c.radius <= 0.0)
-        {
-            return Err(SceneError::Invalid {
-                field: "effects.contact.model".into(),
-                value: "rigid".into(),
-                reason: "every weight is a point mass ([[cargo]] without a radius): point masses never touch, so there is nothing to hold rigid; give the weights a radius or remove model".into(),
-            });
-        }
+        self.check_rigid_contact_has_sizes()?;
         let designs: Vec<(String, &DesignSpec)> = self
             .balancer
             .iter()

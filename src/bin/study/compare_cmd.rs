@@ -65,38 +65,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         [a, b] => (a, b),
         _ => unreachable!("clap takes one or two folders"),
     };
-    let (design_a, design_b) = match (&args.designs, args.folders.len()) {
-        (Some(d), _) if d.len() != 2 => {
-            return Err(UserError(
-                format!(
-                    "--designs: two design ids A,B are needed, {} given",
-                    d.len()
-                ),
-                2,
-            ));
-        }
-        // One folder's design against itself (one folder, or the same folder
-        // twice): every paired difference is 0.
-        (Some(d), _) if d[0] == d[1] && same_folder(dir_a, dir_b) => {
-            return Err(UserError(
-                format!(
-                    "--designs {},{}: a design compared with itself; name two different designs of {}",
-                    d[0],
-                    d[1],
-                    dir_a.display()
-                ),
-                2,
-            ));
-        }
-        (Some(d), _) => (Some(d[0]), Some(d[1])),
-        (None, 1) => {
-            return Err(UserError(
-                "one folder: say which two of its designs to compare with --designs A,B".into(),
-                2,
-            ));
-        }
-        (None, _) => (None, None),
-    };
+    let (design_a, design_b) = design_pair(args, dir_a, dir_b)?;
     let a = Side::load(dir_a, design_a)?;
     let b = Side::load(dir_b, design_b)?;
     let criterion = args.rank_by.unwrap_or(a.default_criterion);
@@ -424,4 +393,45 @@ fn same_folder(a: &std::path::Path, b: &std::path::Path) -> bool {
             (std::fs::canonicalize(a), std::fs::canonicalize(b)),
             (Ok(x), Ok(y)) if x == y
         )
+}
+
+/// The two design ids asked for (`None`: the folder's only design), or a
+/// refusal: not two ids, none with one folder, a design against itself.
+fn design_pair(
+    args: &CompareArgs,
+    dir_a: &std::path::Path,
+    dir_b: &std::path::Path,
+) -> Result<(Option<u32>, Option<u32>), UserError> {
+    Ok(match (&args.designs, args.folders.len()) {
+        (Some(d), _) if d.len() != 2 => {
+            return Err(UserError(
+                format!(
+                    "--designs: two design ids A,B are needed, {} given",
+                    d.len()
+                ),
+                2,
+            ));
+        }
+        // One folder's design against itself (one folder, or the same folder
+        // twice): every paired difference is 0.
+        (Some(d), _) if d[0] == d[1] && same_folder(dir_a, dir_b) => {
+            return Err(UserError(
+                format!(
+                    "--designs {},{}: a design compared with itself; name two different designs of {}",
+                    d[0],
+                    d[1],
+                    dir_a.display()
+                ),
+                2,
+            ));
+        }
+        (Some(d), _) => (Some(d[0]), Some(d[1])),
+        (None, 1) => {
+            return Err(UserError(
+                "one folder: say which two of its designs to compare with --designs A,B".into(),
+                2,
+            ));
+        }
+        (None, _) => (None, None),
+    })
 }
