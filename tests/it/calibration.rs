@@ -197,3 +197,29 @@ fn bad_rig_files_are_refused_naming_the_key() {
         String::from_utf8_lossy(&out.stderr).contains("effects.rolling_resistance.coefficient")
     );
 }
+
+/// Every shipped rig file reads, and its scene accepts every key it sets:
+/// a rig whose calibration takes an hour and a half must not fail on a
+/// typo after the first draws.
+#[test]
+fn every_shipped_rig_file_builds_its_problem() {
+    use autobal::calibrate::problem::RigProblem;
+    use autobal::calibrate::rig_file::RigFile;
+    use autobal::scene_file::SceneFile;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut rigs: Vec<_> = std::fs::read_dir(root.join("rigs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    rigs.sort();
+    assert!(rigs.len() >= 3, "{rigs:?}");
+    for path in rigs {
+        let rig = RigFile::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let scene_path = rig.scene_path(&path);
+        let scene = SceneFile::read(&scene_path)
+            .unwrap_or_else(|e| panic!("{}: {e}", scene_path.display()));
+        RigProblem::new(rig, scene, &scene_path.display().to_string())
+            .unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
+    }
+}
