@@ -290,6 +290,18 @@ impl Scene {
                             &format!("must be in [0, {}] m (0: no contact)", RACE_RADIUS_RANGE.1),
                         ));
                     }
+                    // The weight's centre runs at l from the axis: a radius
+                    // above l would put the weight across the shaft.
+                    if c.radius > c.track_radius {
+                        return Err(invalid(
+                            &format!("cargo[{j}].radius"),
+                            c.radius,
+                            &format!(
+                                "is larger than cargo[{j}].track_radius = {} m: the weight's centre runs at the track radius, so a larger weight would reach across the axis",
+                                c.track_radius
+                            ),
+                        ));
+                    }
                     if !(c.kappa.is_finite() && c.kappa >= 1.0) {
                         return Err(invalid(
                             &format!("cargo[{j}].kappa"),

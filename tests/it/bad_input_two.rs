@@ -9,7 +9,7 @@ use std::path::Path;
 use std::process::Command;
 
 /// A small two-plane study with a couple that follows the static part.
-fn study(results: &Path) -> String {
+pub(crate) fn study(results: &Path) -> String {
     format!(
         r#"name = "two"
 output = "{}"

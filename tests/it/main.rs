@@ -30,6 +30,7 @@ mod fuzz_cli;
 mod fuzz_input;
 mod fuzz_schema;
 mod golden;
+mod impossible_scenes;
 mod integrate;
 mod model_conservation;
 mod model_flexible;

@@ -401,6 +401,7 @@ impl StudyFile {
                 ));
             }
         }
+        unbalance_within_reason(s, &designs).map_err(refused)?;
         let total = designs.len() as u64 * u64::from(s.samples);
         if total > MAX_TOTAL_RUNS {
             return Err(invalid(
@@ -706,4 +707,55 @@ fn scene_error_key(e: SceneError, kind: Kind, n: u32) -> InvalidKey {
             }
         }
     }
+}
+
+/// Most unbalance, per plane, over a design's capacity that a study may
+/// draw, whatever `require_balanceable` says.
+const MOST_OVER_CAPACITY: f64 = 1e3;
+
+/// Refuse unbalances beyond [`MOST_OVER_CAPACITY`] times a design's
+/// capacity, naming the key: the runs would measure nothing but the plain
+/// rotor, and at 1e300 their numbers overflow and every run fails.
+fn unbalance_within_reason(s: &Sampling, designs: &[Design]) -> Result<(), InvalidKey> {
+    let in_kgm = |v: f64, scale: Scale, d: &Design| match scale {
+        Scale::Absolute => v,
+        Scale::Capacity => v * d.capacity,
+    };
+    let static_key = format!(
+        "sampling.unbalance.{}",
+        s.unbalance.distribution.upper_key()
+    );
+    for d in designs {
+        let most = MOST_OVER_CAPACITY * d.capacity;
+        let u_s = in_kgm(s.unbalance.distribution.upper(), s.unbalance.scale(), d);
+        let (key, worst) = match s.couple.as_ref().map(|c| (&c.unbalance, c.follows_static)) {
+            Some((Some(u), _)) => (
+                format!("sampling.couple.unbalance.{}", u.distribution.upper_key()),
+                u_s + in_kgm(u.distribution.upper(), u.scale(), d),
+            ),
+            Some((None, Some(c))) => (
+                "sampling.couple.follows_static".into(),
+                u_s * (1.0 + c.abs()),
+            ),
+            _ => (static_key.clone(), u_s),
+        };
+        let key = if u_s > most { static_key.clone() } else { key };
+        // NaN included: a value that is not a number means nothing either.
+        if !matches!(
+            worst.partial_cmp(&most),
+            Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+        ) {
+            return Err(InvalidKey::new(
+                &key,
+                format!("{worst:.4e} kg·m in a plane"),
+                format!(
+                    "more than {MOST_OVER_CAPACITY} times the capacity {:.4e} kg·m of design {} ({}): the weights could not move the whirl, and the runs would measure the plain rotor; lower it",
+                    d.capacity,
+                    d.id,
+                    super::super::plane_designs::describe(d)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
