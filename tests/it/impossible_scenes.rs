@@ -1,8 +1,9 @@
-//! What a scene or study cannot mean is refused before any run, naming the
-//! key (exit 2, nothing written): a weight larger than its track radius,
-//! unbalances beyond a thousand times what the weights can cancel (before,
-//! a 1.5 m ball on a 1 m track ran and exited 0, and 1e300 times the
-//! capacity exited 1 after every run had failed).
+//! What a scene, a study or a study folder cannot mean is refused before
+//! any run, naming the key or the entry (exit 2, nothing written): a weight
+//! larger than its track radius, unbalances beyond a thousand times what
+//! the weights can cancel (before, a 1.5 m ball on a 1 m track ran and
+//! exited 0, and 1e300 times the capacity exited 1 after every run had
+//! failed), a folder whose entries are of the wrong kind.
 
 use crate::fixtures::simulate_text;
 use std::process::Command;
@@ -81,4 +82,56 @@ fn unbalances_far_beyond_the_capacity_are_refused_naming_the_key() {
         "unbalance = { distribution = \"fixed\", value = 2.0, relative_to = \"capacity\" }\nrequire_balanceable = false",
     );
     assert_eq!(code, Some(0), "{err}");
+}
+
+/// Every entry of a study folder listed with its bytes (folders as such).
+fn snapshot(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Option<Vec<u8>>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p.clone());
+                out.push((p, None));
+            } else {
+                out.push((p.clone(), Some(std::fs::read(&p).unwrap())));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A study folder whose `chunks` is a file, or whose `study.toml` is a
+/// folder: `--resume` exits 2 naming the entry and leaves the folder as it
+/// was (before: exit 1 with a bare "os error 17" or "21").
+#[test]
+fn a_misshapen_study_folder_is_refused_naming_the_entry() {
+    for (entry, make_dir) in [("chunks", false), ("study.toml", true)] {
+        let tmp = tempfile::tempdir().unwrap();
+        let results = tmp.path().join("results");
+        let path = tmp.path().join("s.toml");
+        std::fs::write(&path, crate::bad_input::study(&results)).unwrap();
+        let folder = results.join("corpus");
+        std::fs::create_dir_all(&folder).unwrap();
+        if make_dir {
+            std::fs::create_dir(folder.join(entry)).unwrap();
+        } else {
+            std::fs::write(folder.join(entry), b"not a folder").unwrap();
+        }
+        let before = snapshot(&folder);
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["run", path.to_str().unwrap(), "--quiet", "--resume"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{entry}: {err}");
+        assert!(
+            err.contains(&folder.join(entry).display().to_string())
+                && err.contains("nothing was changed"),
+            "{entry}: {err}"
+        );
+        assert_eq!(snapshot(&folder), before, "{entry}: the folder changed");
+    }
 }

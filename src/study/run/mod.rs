@@ -247,6 +247,19 @@ pub enum RunError {
         /// Runs of the study (of the shard, with `--shard`).
         total: u64,
     },
+    /// An entry of the study folder is of the wrong kind (a file where its
+    /// `chunks/` folder belongs, a folder named `study.toml`).
+    #[error(
+        "{path} is {found}, where the study folder keeps its {want}; nothing was changed: move it away, or choose another output folder"
+    )]
+    Misshapen {
+        /// The entry.
+        path: String,
+        /// What it is ("a file", "a folder").
+        found: &'static str,
+        /// What belongs there.
+        want: &'static str,
+    },
     /// Reading or writing Parquet failed.
     #[error("{0}")]
     Polars(#[from] PolarsError),
@@ -279,8 +292,36 @@ impl RunError {
                 | RunError::Locked(_)
                 | RunError::NotOwned { .. }
                 | RunError::AdaptiveSharded
+                | RunError::Misshapen { .. }
         ) || matches!(self, RunError::Polars(e) if super::io::is_not_parquet(e))
     }
+}
+
+/// Refuse a study folder whose own entries are of the wrong kind, before
+/// anything in it is touched (before, `--resume` with a file named
+/// `chunks` ended on a bare "os error 17").
+fn check_entry_kinds(dir: &Path) -> Result<(), RunError> {
+    let entries: [(&str, bool, &'static str); 5] = [
+        ("chunks", true, "chunks/ folder of finished runs"),
+        ("study.toml", false, "copy of the study file (study.toml)"),
+        (PLAN_ID_FILE, false, "plan id (plan.sha256)"),
+        ("runs.parquet", false, "runs table (runs.parquet)"),
+        ("summary.parquet", false, "summary table (summary.parquet)"),
+    ];
+    for (name, want_dir, want) in entries {
+        let path = dir.join(name);
+        let Ok(meta) = std::fs::metadata(&path) else {
+            continue;
+        };
+        if meta.is_dir() != want_dir {
+            return Err(RunError::Misshapen {
+                path: path.display().to_string(),
+                found: if meta.is_dir() { "a folder" } else { "a file" },
+                want,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Folder of a study's (or a shard's) files.
@@ -355,6 +396,7 @@ fn run_in_folder(
     let chunks = dir.join("chunks");
     let runs_path = dir.join("runs.parquet");
     let summary_path = dir.join("summary.parquet");
+    check_entry_kinds(&dir)?;
     // Provenance asks git for the commit: once per run, shared with the plan id.
     let provenance = Provenance::new(&plan.text, plan.file.seed, &shard_label(options.shard));
     let id = plan_id(plan, &provenance);
