@@ -135,3 +135,31 @@ fn a_misshapen_study_folder_is_refused_naming_the_entry() {
         assert_eq!(snapshot(&folder), before, "{entry}: the folder changed");
     }
 }
+
+/// `--resume` over a truncated runs.parquet is refused and leaves the
+/// folder byte for byte as it was (before: exit 2, but a new `chunks/`).
+#[test]
+fn a_refused_resume_over_a_damaged_table_leaves_the_folder_as_it_was() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let path = tmp.path().join("s.toml");
+    std::fs::write(&path, crate::bad_input::study(&results)).unwrap();
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(["run", path.to_str().unwrap(), "--quiet"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert!(run(&[]).status.success());
+    let folder = results.join("corpus");
+    let runs = folder.join("runs.parquet");
+    let bytes = std::fs::read(&runs).unwrap();
+    std::fs::write(&runs, &bytes[..bytes.len() / 2]).unwrap();
+    let before = snapshot(&folder);
+    let out = run(&["--resume"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("runs.parquet"), "{err}");
+    assert_eq!(snapshot(&folder), before, "the refusal changed the folder");
+}

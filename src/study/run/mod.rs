@@ -440,9 +440,11 @@ fn run_in_folder(
         write_text(&manifest, &super::io::folder_copy(&plan.text))?;
         write_text(&plan_file, &id)?;
     }
+    // What earlier invocations finished: only their run ids are read, the
+    // table before anything is made, so that a damaged one is refused with
+    // the folder as it was.
+    let earlier_table = earlier_table_pieces(&runs_path)?;
     std::fs::create_dir_all(&chunks)?;
-
-    // What earlier invocations finished: only their run ids are read.
     let total_ids = plan.total_runs();
     let mut done = vec![false; total_ids as usize];
     let mark_done = |pieces: &[Piece], done: &mut Vec<bool>| {
@@ -454,7 +456,6 @@ fn run_in_folder(
             }
         }
     };
-    let earlier_table = earlier_table_pieces(&runs_path)?;
     mark_done(&earlier_table, &mut done);
     mark_done(&chunk_pieces(&chunks)?, &mut done);
     let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
