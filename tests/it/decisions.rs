@@ -385,7 +385,7 @@ fn settled_fractions(summary: &Path) -> Vec<f64> {
 /// A small optical-drive rotor with four light balls and little drag: the
 /// symmetric fan of its balanced family is unstable, yet other positions of
 /// the family are stable and the runs settle there within about 1 000 rev.
-fn optical_drive(results: &Path, name: &str, t_end_revs: u32) -> String {
+pub(crate) fn optical_drive(results: &Path, name: &str, t_end_revs: u32) -> String {
     format!(
         r#"name = "{name}"
 output = "{}"

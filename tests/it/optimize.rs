@@ -440,44 +440,15 @@ fn no_search_spends_more_than_max_evaluations() {
 /// An optical drive with ρ and β free whose searches start on a slow
 /// plateau (β = 0.2 N·s/m, most runs counted at the 150-rev horizon).
 fn optical_drive_plan(output: &Path) -> StudyPlan {
-    let text = format!(
-        r#"
-name = "od"
-output = "{}"
-seed = 7
-[scene]
-start = "locked_steady"
-[scene.rotor]
-mass = 0.01
-kx = 1800.0
-ky = 1800.0
-bx = 0.3
-by = 0.3
-[scene.speed]
-mode = "constant"
-omega = 754.0
-[designs]
-kind = "ball"
-n = [3, 4, 5]
-rho = 0.1
-race_radius = 0.015
-density = 7850.0
-drag = 0.2
-[sampling]
-samples = 12
-unbalance = {{ distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }}
-initial = "clustered"
-[metrics]
-hold_revs = 50
-t_end_revs = 200
-[optimize]
-objective = "settling_mean"
-free = ["rho", "drag"]
-rho_bounds = [0.05, 0.2]
-drag_bounds = [0.001, 1.0]
-max_evaluations = 20
-"#,
-        output.display()
+    let text = crate::decisions::optical_drive(output, "od", 200)
+        .replace("n = 4\nrho = 0.067", "n = [3, 4, 5]\nrho = 0.1")
+        .replace("drag = 3e-5", "drag = 0.2")
+        .replace("samples = 4", "samples = 12")
+        + "[optimize]\nobjective = \"settling_mean\"\nfree = [\"rho\", \"drag\"]\nrho_bounds = [0.05, 0.2]\ndrag_bounds = [0.001, 1.0]\nmax_evaluations = 20\n";
+    assert!(
+        text.contains("n = [3, 4, 5]")
+            && text.contains("drag = 0.2")
+            && text.contains("samples = 12")
     );
     StudyFile::parse(&text, "od.toml")
         .unwrap()
