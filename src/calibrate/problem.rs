@@ -49,7 +49,35 @@ impl RigProblem {
             memo: Mutex::new(HashMap::new()),
         };
         problem.check_keys()?;
+        problem.check_light_spots()?;
         Ok(problem)
+    }
+
+    /// A ball offset is read from the light spot: refuse a point whose
+    /// case has no static unbalance to put one opposite.
+    fn check_light_spots(&self) -> Result<(), InvalidKey> {
+        for (k, p) in self.rig.points.iter().enumerate() {
+            let Some(i) = self.rig.cases.iter().position(|c| c.name == p.case) else {
+                continue;
+            };
+            if p.quantity != Quantity::BallOffsetDeg {
+                continue;
+            }
+            let sim = self
+                .case_scene(i, &[])
+                .map_err(|why| InvalidKey::new(&format!("point[{k}].case"), &p.case, why))?;
+            if sim.scene.rotor.as_rotor().static_unbalance().0 <= 0.0 {
+                return Err(InvalidKey::new(
+                    &format!("point[{k}].quantity"),
+                    p.quantity.name(),
+                    format!(
+                        "case \"{}\" has no static unbalance, so no light spot to measure the balls from",
+                        p.case
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn check_keys(&self) -> Result<(), InvalidKey> {
@@ -224,9 +252,11 @@ impl RigProblem {
                 let steps = sim
                     .stepped_sweep_windowed(&speeds, dwell, window, None)
                     .map_err(|e| e.to_string())?;
+                let (size, angle) = sim.scene.rotor.as_rotor().static_unbalance();
                 Ok(Observed::Stepped {
                     steps,
                     top_rpm: rpm[1],
+                    light_spot: (size > 0.0).then_some(angle + PI),
                 })
             }
         }
@@ -237,10 +267,21 @@ impl RigProblem {
         match (observed, p.quantity) {
             (Observed::Run { settling_time, .. }, Quantity::SettlingTime) => Ok(*settling_time),
             (Observed::Run { residual, .. }, Quantity::Residual) => Ok(*residual),
-            (Observed::Stepped { steps, top_rpm }, Quantity::OnsetRpm) => {
+            (Observed::Stepped { steps, top_rpm, .. }, Quantity::OnsetRpm) => {
                 Ok(crate::study::stepped_bands::onset(steps).map_or(*top_rpm, |w| w * 30.0 / PI))
             }
-            (Observed::Stepped { steps, .. }, q) => {
+            (
+                Observed::Stepped {
+                    steps, light_spot, ..
+                },
+                q,
+            ) => {
+                if q == Quantity::BallOffsetDeg && light_spot.is_none() {
+                    return Err(
+                        "the case has no static unbalance: no light spot to measure the balls from"
+                            .into(),
+                    );
+                }
                 let [lo, hi] = p.rpm.unwrap_or([0.0, f64::INFINITY]);
                 let tol = 1e-6 * hi.abs().max(1.0);
                 let in_band: Vec<f64> = steps
@@ -254,7 +295,7 @@ impl RigProblem {
                         let r = s.omega * 30.0 / PI;
                         r >= lo - tol && r <= hi + tol
                     })
-                    .filter_map(|s| step_value(s, q))
+                    .filter_map(|s| step_value(s, q, *light_spot))
                     .collect();
                 if in_band.is_empty() {
                     return Err(format!(
@@ -273,9 +314,12 @@ impl RigProblem {
     }
 }
 
-/// A step's bearing peak (the bearings' mean) or its ratio to the same
-/// without the balls' unbalance.
-fn step_value(s: &StepPoint, q: Quantity) -> Option<f64> {
+/// A step's bearing peak (the bearings' mean), its ratio to the same
+/// without the balls' unbalance, or the balls' offset from the light spot.
+fn step_value(s: &StepPoint, q: Quantity, light_spot: Option<f64>) -> Option<f64> {
+    if q == Quantity::BallOffsetDeg {
+        return ball_offset_deg(&s.angles_deg, light_spot?);
+    }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
     let with = mean(s.bearing_peak.as_deref()?);
     let without = mean(s.bearing_peak_without.as_deref()?);
@@ -286,9 +330,61 @@ fn step_value(s: &StepPoint, q: Quantity) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
+/// How far (degrees, 0–180, either way) the weights' mean direction sits
+/// from the light spot (radians, rotor frame): a rig photographing its
+/// balls reads this, since balanced balls straddle the light spot
+/// symmetrically. None when the weights' directions cancel (no mean).
+fn ball_offset_deg(angles_deg: &[f64], light_spot: f64) -> Option<f64> {
+    let (sin, cos) = angles_deg
+        .iter()
+        .map(|a| a.to_radians().sin_cos())
+        .fold((0.0, 0.0), |(s, c), (si, ci)| (s + si, c + ci));
+    if sin.hypot(cos) < 1e-9 * angles_deg.len() as f64 {
+        return None;
+    }
+    let offset = (sin.atan2(cos) - light_spot).rem_euclid(2.0 * PI);
+    Some(offset.min(2.0 * PI - offset).to_degrees())
+}
+
 /// What one case's run or sweep measured.
 #[derive(Debug)]
 enum Observed {
-    Run { settling_time: f64, residual: f64 },
-    Stepped { steps: Vec<StepPoint>, top_rpm: f64 },
+    Run {
+        settling_time: f64,
+        residual: f64,
+    },
+    Stepped {
+        steps: Vec<StepPoint>,
+        top_rpm: f64,
+        /// The static unbalance's opposite (rotor frame, radians); None
+        /// without a static unbalance.
+        light_spot: Option<f64>,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ball_offset_deg;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn balls_straddling_the_light_spot_have_no_offset_and_a_turned_pair_has_its_turn() {
+        // Light spot at 90°: balls at 90 ± 40° are balanced, at 90 − 18 ± 40°
+        // turned clockwise by 18°, the same size read either way.
+        let spot = PI / 2.0;
+        assert!(ball_offset_deg(&[50.0, 130.0], spot).unwrap() < 1e-12);
+        let turned = ball_offset_deg(&[32.0, 112.0], spot).unwrap();
+        assert!((turned - 18.0).abs() < 1e-9, "{turned}");
+        let other_way = ball_offset_deg(&[68.0, 148.0], spot).unwrap();
+        assert!((other_way - 18.0).abs() < 1e-9, "{other_way}");
+        // Across 0°/360° and at the far side: 180°, never more.
+        let wrapped = ball_offset_deg(&[350.0, 30.0], 0.0).unwrap();
+        assert!((wrapped - 10.0).abs() < 1e-9, "{wrapped}");
+        assert!((ball_offset_deg(&[250.0, 290.0], spot).unwrap() - 180.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn opposite_balls_have_no_mean_direction() {
+        assert_eq!(ball_offset_deg(&[10.0, 190.0], 0.0), None);
+    }
 }

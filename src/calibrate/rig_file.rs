@@ -99,6 +99,9 @@ pub enum Quantity {
     /// Lowest run-up speed from which the balls help for good (rpm;
     /// `stepped`; the top speed when they never do).
     OnsetRpm,
+    /// Mean over the steps in `rpm` of the angle between the balls' mean
+    /// direction and the light spot, either way (degrees; `stepped`).
+    BallOffsetDeg,
 }
 
 impl Quantity {
@@ -110,6 +113,7 @@ impl Quantity {
             Quantity::BearingPeak => "bearing_peak",
             Quantity::Ratio => "ratio",
             Quantity::OnsetRpm => "onset_rpm",
+            Quantity::BallOffsetDeg => "ball_offset_deg",
         }
     }
 
@@ -117,7 +121,7 @@ impl Quantity {
     pub fn is_stepped(self) -> bool {
         matches!(
             self,
-            Quantity::BearingPeak | Quantity::Ratio | Quantity::OnsetRpm
+            Quantity::BearingPeak | Quantity::Ratio | Quantity::OnsetRpm | Quantity::BallOffsetDeg
         )
     }
 }
@@ -379,12 +383,14 @@ impl RigFile {
             ));
         }
         match (p.quantity, p.rpm) {
-            (Quantity::BearingPeak | Quantity::Ratio, None) => Err(InvalidKey::new(
-                "rpm",
-                "missing",
-                "give the speed band [lo, hi] (rpm) the reading averages over",
-            )),
-            (Quantity::BearingPeak | Quantity::Ratio, Some([lo, hi]))
+            (Quantity::BearingPeak | Quantity::Ratio | Quantity::BallOffsetDeg, None) => {
+                Err(InvalidKey::new(
+                    "rpm",
+                    "missing",
+                    "give the speed band [lo, hi] (rpm) the reading averages over",
+                ))
+            }
+            (Quantity::BearingPeak | Quantity::Ratio | Quantity::BallOffsetDeg, Some([lo, hi]))
                 if !(lo.is_finite() && hi.is_finite() && lo <= hi) =>
             {
                 Err(InvalidKey::new(
@@ -393,7 +399,12 @@ impl RigFile {
                     "must be [lo, hi], finite, with lo ≤ hi",
                 ))
             }
-            (q, Some(_)) if !matches!(q, Quantity::BearingPeak | Quantity::Ratio) => {
+            (q, Some(_))
+                if !matches!(
+                    q,
+                    Quantity::BearingPeak | Quantity::Ratio | Quantity::BallOffsetDeg
+                ) =>
+            {
                 Err(InvalidKey::new(
                     "rpm",
                     "given",

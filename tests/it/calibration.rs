@@ -223,3 +223,47 @@ fn every_shipped_rig_file_builds_its_problem() {
             .unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
     }
 }
+
+/// A ball offset is read from the light spot: a point on a case without
+/// a static unbalance (Bristol's 0 washers, a pure couple) is refused
+/// before any run, naming the point.
+#[test]
+fn a_ball_offset_without_a_light_spot_is_refused() {
+    use autobal::calibrate::problem::RigProblem;
+    use autobal::calibrate::rig_file::RigFile;
+    use autobal::scene_file::SceneFile;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("rigs/bristol_fig12_angles.toml")).unwrap();
+    let scene_path = root.join("scenes/bristol_uncertain.toml");
+    let text = text.replace(
+        "scene = \"../scenes/bristol_uncertain.toml\"",
+        &format!("scene = {:?}", scene_path.display().to_string()),
+    );
+    let last = text.rfind("case = \"2 washers\"").unwrap();
+    let moved = format!(
+        "{}case = \"0 washers\"{}",
+        &text[..last],
+        &text[last + "case = \"2 washers\"".len()..]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    for (body, refused) in [(text, false), (moved, true)] {
+        let path = dir.path().join("rig.toml");
+        std::fs::write(&path, body).unwrap();
+        let rig = RigFile::read(&path).unwrap();
+        let offset_point = rig.points.len() - 1;
+        let scene = SceneFile::read(&scene_path).unwrap();
+        let made = RigProblem::new(rig, scene, "bristol_uncertain.toml");
+        match made {
+            Ok(_) => assert!(!refused, "a ball offset on a pure couple was accepted"),
+            Err(e) => {
+                assert!(refused, "{e:?}");
+                let shown = format!("{e:?} {e}");
+                assert!(
+                    shown.contains(&format!("point[{offset_point}].quantity"))
+                        && shown.contains("light spot"),
+                    "{shown}"
+                );
+            }
+        }
+    }
+}
