@@ -65,10 +65,10 @@ impl RigProblem {
             }
             let sim = self
                 .case_scene(i, &[])
-                .map_err(|why| InvalidKey::new(&format!("point[{k}].case"), &p.case, why))?;
+                .map_err(|why| InvalidKey::new(format!("point[{k}].case"), &p.case, why))?;
             if sim.scene.rotor.as_rotor().static_unbalance().0 <= 0.0 {
                 return Err(InvalidKey::new(
-                    &format!("point[{k}].quantity"),
+                    format!("point[{k}].quantity"),
                     p.quantity.name(),
                     format!(
                         "case \"{}\" has no static unbalance, so no light spot to measure the balls from",
