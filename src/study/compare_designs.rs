@@ -33,6 +33,9 @@ pub enum CompareError {
     /// The folder holds several designs and none was named.
     #[error("{0}: holds {1} designs; say which with --designs A,B")]
     WhichDesign(String, usize),
+    /// The folder's runs recorded another study or seed than its study.toml.
+    #[error("{0} does not hold the runs of the study.toml beside it: {1}")]
+    ForeignTable(String, String),
     /// The study text stored in the folder is invalid.
     #[error("{0}: {1}")]
     BadStudy(String, String),
@@ -84,6 +87,14 @@ impl Side {
         let plan: StudyPlan = StudyFile::parse(&text, &shown)
             .and_then(|f| f.plan(&text, &shown))
             .map_err(|e| CompareError::BadStudy(shown.clone(), e.to_string()))?;
+        if let Some(reason) =
+            super::io::foreign_table(&runs_path, &plan.text, plan.file.seed, None)?
+        {
+            return Err(CompareError::ForeignTable(
+                runs_path.display().to_string(),
+                reason,
+            ));
+        }
         let id = match design {
             Some(id) => id,
             None if plan.designs.len() == 1 => plan.designs[0].id,

@@ -186,6 +186,46 @@ pub fn same_study(recorded: &str, study_text: &str) -> bool {
     recorded == study_sha256(study_text) || recorded == sha256_hex(study_text)
 }
 
+/// Why the table at `path` does not hold runs of `study_text` with `seed`
+/// (and, when given, of shard `shard`), from the provenance it recorded
+/// when written; None when it does. A table copied in from another
+/// study, seed or shard must not be continued, merged or compared as if
+/// it were this one's.
+pub fn foreign_table(
+    path: &Path,
+    study_text: &str,
+    seed: u64,
+    shard: Option<&str>,
+) -> PolarsResult<Option<String>> {
+    let recorded = read_metadata(path).map_err(|e| about(path, e))?;
+    let get = |key: &str| {
+        recorded
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    };
+    let short = |hash: &str| hash.chars().take(12).collect::<String>();
+    Ok(match (get("study_sha256"), get("seed"), get("shard")) {
+        (None, ..) | (_, None, _) => {
+            Some("it records no study and seed: autobal's study runs did not write it".into())
+        }
+        (Some(hash), ..) if !same_study(hash, study_text) => Some(format!(
+            "it was written by another study file (sha256 {}…, not {}… of the study.toml beside it)",
+            short(hash),
+            short(&study_sha256(study_text))
+        )),
+        (_, Some(s), _) if s != seed.to_string() => Some(format!(
+            "it was written with seed {s}, not the study's {seed}"
+        )),
+        (_, _, found) => match (shard, found) {
+            (Some(want), Some(found)) if found != want => {
+                Some(format!("it holds shard {found}, not {want}"))
+            }
+            _ => None,
+        },
+    })
+}
+
 /// Write a text file atomically.
 pub fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
     let tmp = temp_path(path);
@@ -262,4 +302,49 @@ fn write_series_csv(
         w.flush()?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each field of the recorded provenance is checked: the study's hash,
+    /// its seed, the shard, and a table that records none is foreign too.
+    #[test]
+    fn a_tables_recorded_study_seed_and_shard_must_all_match() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("runs.parquet");
+        let mut df = df!("run_id" => [0u64, 1]).unwrap();
+        let text = "name = \"s\"\nseed = 5\n";
+        write_parquet(&path, &mut df, &Provenance::new(text, 5, "1/2")).unwrap();
+        let check = |text: &str, seed: u64, shard: Option<&str>| {
+            foreign_table(&path, text, seed, shard).unwrap()
+        };
+        assert_eq!(check(text, 5, Some("1/2")), None);
+        assert_eq!(check(text, 5, None), None);
+        assert!(
+            check("name = \"t\"\n", 5, None)
+                .unwrap()
+                .contains("another study file")
+        );
+        assert!(
+            check(text, 6, None)
+                .unwrap()
+                .contains("seed 5, not the study's 6")
+        );
+        assert!(
+            check(text, 5, Some("all"))
+                .unwrap()
+                .contains("shard 1/2, not all")
+        );
+        let bare = dir.path().join("bare.parquet");
+        let mut file = File::create(&bare).unwrap();
+        ParquetWriter::new(&mut file).finish(&mut df).unwrap();
+        assert!(
+            foreign_table(&bare, text, 5, None)
+                .unwrap()
+                .unwrap()
+                .contains("records no study")
+        );
+    }
 }

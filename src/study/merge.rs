@@ -17,6 +17,9 @@ pub enum MergeError {
     /// Shards come from different study files.
     #[error("{0}: comes from a different study file or autobal build than {1}")]
     DifferentStudy(String, String),
+    /// A shard's runs recorded another study or seed than its folder's.
+    #[error("{0} does not hold the shards' study's runs: {1}")]
+    ForeignTable(String, String),
     /// Two shards hold the same run.
     #[error("run {0} appears in more than one shard")]
     Duplicate(u64),
@@ -85,6 +88,12 @@ pub fn merge(
     let plan: StudyPlan = super::config::StudyFile::parse(&text, &first_dir)
         .and_then(|f| f.plan(&text, &first_dir))
         .map_err(|e| MergeError::BadStudy(first_dir.clone(), e.to_string()))?;
+    for dir in dirs {
+        let path = dir.join("runs.parquet");
+        if let Some(reason) = super::io::foreign_table(&path, &plan.text, plan.file.seed, None)? {
+            return Err(MergeError::ForeignTable(path.display().to_string(), reason));
+        }
+    }
     let total = plan.total_runs();
     let mut seen = vec![false; total as usize];
     for &id in pieces.iter().flat_map(|p| p.ids()) {

@@ -26,6 +26,7 @@ mod events;
 mod every_rotor;
 mod extremes;
 mod fixtures;
+mod foreign_rows;
 mod fuzz_cli;
 mod fuzz_input;
 mod fuzz_schema;

@@ -215,6 +215,27 @@ pub enum RunError {
         /// This run's plan id.
         expected: String,
     },
+    /// A results table in the folder recorded another study, seed or
+    /// shard than the one asked to continue.
+    #[error(
+        "cannot resume in {folder}: {path} does not hold this study's runs: {reason}; nothing was changed (move it away, or run with --overwrite to replace it)"
+    )]
+    ForeignTable {
+        /// The folder.
+        folder: String,
+        /// The table.
+        path: String,
+        /// What its provenance says.
+        reason: String,
+    },
+    /// `--resume` on a folder whose plan id is missing or unreadable.
+    #[error(
+        "cannot resume in {path}: its {PLAN_ID_FILE} is missing or unreadable, so which autobal build made its runs cannot be told; nothing was changed (run with --overwrite to replace them)"
+    )]
+    PlanUnknown {
+        /// The folder.
+        path: String,
+    },
     /// Another process is writing the folder.
     #[error(transparent)]
     Locked(#[from] LockError),
@@ -289,6 +310,8 @@ impl RunError {
                 | RunError::ResultsExist { .. }
                 | RunError::NoPlan { .. }
                 | RunError::PlanChanged { .. }
+                | RunError::ForeignTable { .. }
+                | RunError::PlanUnknown { .. }
                 | RunError::Locked(_)
                 | RunError::NotOwned { .. }
                 | RunError::AdaptiveSharded
@@ -344,6 +367,29 @@ pub fn plan_id(plan: &StudyPlan, provenance: &Provenance) -> String {
         "autobal {}\ncommit {}\n{}",
         provenance.version, provenance.git_commit, plan.text
     ))
+}
+
+/// A resumed folder's runs were made by this build: its plan id says so.
+/// Without one (missing, unreadable) nothing says which build made them.
+fn check_resumed_plan(
+    dir: &Path,
+    plan_file: &Path,
+    id: &str,
+    has_results: bool,
+) -> Result<(), RunError> {
+    match std::fs::read_to_string(plan_file) {
+        Ok(found) if found.trim() != id => Err(RunError::PlanChanged {
+            path: dir.display().to_string(),
+            found: found.trim().to_string(),
+            expected: id.to_string(),
+        }),
+        Ok(_) => Ok(()),
+        Err(_) if has_results => Err(RunError::PlanUnknown {
+            path: dir.display().to_string(),
+        }),
+        // Nothing finished yet: record the plan now.
+        Err(_) => Ok(write_text(plan_file, id)?),
+    }
 }
 
 /// Label stored in provenance: "all" or "k/N".
@@ -409,13 +455,19 @@ fn run_in_folder(
                 path: dir.display().to_string(),
             });
         }
-        if let Ok(found) = std::fs::read_to_string(&plan_file)
-            && found.trim() != id
+        check_resumed_plan(&dir, &plan_file, &id, has_results)?;
+        if runs_path.exists()
+            && let Some(reason) = super::io::foreign_table(
+                &runs_path,
+                &plan.text,
+                plan.file.seed,
+                Some(provenance.shard.as_str()),
+            )?
         {
-            return Err(RunError::PlanChanged {
-                path: dir.display().to_string(),
-                found: found.trim().to_string(),
-                expected: id,
+            return Err(RunError::ForeignTable {
+                folder: dir.display().to_string(),
+                path: runs_path.display().to_string(),
+                reason,
             });
         }
     } else {
