@@ -232,8 +232,17 @@ pub fn parent_of(path: &Path) -> PathBuf {
 }
 
 /// Create and remove a file only this process names, to learn whether
-/// `folder` can be written (simultaneous starts never collide on it).
+/// `folder` can be written (simultaneous starts never collide on it). A
+/// folder whose permissions allow no writing is refused even where the
+/// system would let this process write (as root): whoever made it
+/// read-only meant its contents to stay.
 pub fn probe_writable(folder: &Path) -> std::io::Result<()> {
+    if std::fs::metadata(folder)?.permissions().readonly() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::PermissionDenied,
+            "the folder is read-only (its permissions allow no writing)",
+        ));
+    }
     let probe = folder.join(format!(".write-probe-{}", std::process::id()));
     std::fs::write(&probe, b"")?;
     std::fs::remove_file(&probe)

@@ -123,10 +123,12 @@ pub fn merge(
             .map(Path::to_path_buf)
             .unwrap_or_else(|| PathBuf::from(".")),
     };
-    std::fs::create_dir_all(&dir).map_err(|source| RunError::NotWritable {
+    let not_writable = |source| RunError::NotWritable {
         path: dir.display().to_string(),
         source,
-    })?;
+    };
+    std::fs::create_dir_all(&dir).map_err(not_writable)?;
+    crate::output_file::probe_writable(&dir).map_err(not_writable)?;
     // The merged folder is a results folder like any other: one writer, and
     // results already there are replaced only when asked.
     let _lock = FolderLock::acquire(&dir).map_err(RunError::from)?;

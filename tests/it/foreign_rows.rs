@@ -1,7 +1,9 @@
-//! Runs copied in from another study or seed are never adopted: `--resume`,
+//! Results folders are changed only by the runs that own them. Runs copied
+//! in from another study or seed are never adopted: `--resume`,
 //! `study merge` and `study compare` check each table's recorded
 //! provenance against the study beside it and refuse a mismatch naming the
-//! file, leaving every folder as it was.
+//! file, leaving every folder as it was; a folder made read-only is not
+//! overwritten.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -141,4 +143,29 @@ fn a_resume_without_the_plan_id_is_refused() {
     let out = study_bin(&["run", path.to_str().unwrap(), "--quiet", "--resume"]);
     refused(&out, &folder, "plan.sha256 is missing or unreadable");
     assert_eq!(snapshot(&folder), before);
+}
+
+/// A results folder made read-only is not overwritten, even by a process
+/// the system would let write it (root): refused before any work, exit 2,
+/// the folder as it was.
+#[test]
+fn a_read_only_results_folder_is_not_overwritten() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("r");
+    let path = study_file(tmp.path(), &results, 5, "s.toml");
+    let out = study_bin(&["run", path.to_str().unwrap(), "--quiet"]);
+    assert!(out.status.success());
+    let folder = results.join("corpus");
+    let before = snapshot(&folder);
+    let mode = |m: u32| std::fs::set_permissions(&folder, std::fs::Permissions::from_mode(m));
+    mode(0o555).unwrap();
+    let out = study_bin(&["run", path.to_str().unwrap(), "--quiet", "--overwrite"]);
+    mode(0o755).unwrap();
+    refused(&out, &folder, "read-only");
+    assert_eq!(
+        snapshot(&folder),
+        before,
+        "a read-only folder was rewritten"
+    );
 }
