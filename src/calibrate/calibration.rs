@@ -254,7 +254,11 @@ impl RigProblem {
                     (Some(a), Some(b), Some(c)) => Some([a, b, c]),
                     _ => None,
                 };
-                let pq = |x| predictive_quantile(&model, weights, p.sd, x);
+                // A reading cannot leave its quantity's range (no negative
+                // ratio, no offset past 180°): the Gaussian reading's
+                // quantiles, clipped to it, are those of the reading.
+                let (lo, hi) = p.quantity.range();
+                let pq = |x| predictive_quantile(&model, weights, p.sd, x).map(|v| v.clamp(lo, hi));
                 let predictive = pq(0.025).zip(pq(0.975)).map(|(a, b)| [a, b]);
                 PointOutcome {
                     measured: measured[i],

@@ -117,6 +117,15 @@ impl Quantity {
         }
     }
 
+    /// The values a reading of it can take: every quantity is a size or a
+    /// speed (≥ 0), and an angle either way is at most 180°.
+    pub fn range(self) -> (f64, f64) {
+        match self {
+            Quantity::BallOffsetDeg => (0.0, 180.0),
+            _ => (0.0, f64::INFINITY),
+        }
+    }
+
     /// True when a stepped sweep measures it (false: a run does).
     pub fn is_stepped(self) -> bool {
         matches!(
