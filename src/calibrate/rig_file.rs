@@ -320,7 +320,7 @@ impl RigFile {
             step_rpm,
             dwell,
             window,
-            ..
+            down,
         } = self.protocol
         else {
             return Ok(());
@@ -352,6 +352,18 @@ impl RigFile {
             && !(w.is_finite() && w > 0.0 && w <= dwell)
         {
             return bad("window", w, "must be positive and no longer than the dwell");
+        }
+        let to_rad = std::f64::consts::PI / 30.0;
+        let speeds = crate::simulation::stepped::stepped_speeds(
+            rpm[0] * to_rad,
+            rpm[1] * to_rad,
+            step_rpm * to_rad,
+            down,
+        );
+        if let Err(crate::model::scene::SceneError::Invalid { reason, .. }) =
+            crate::simulation::stepped::check_dwell(&speeds, dwell)
+        {
+            return bad("dwell", dwell, &reason);
         }
         Ok(())
     }

@@ -48,6 +48,35 @@ impl Direction {
     }
 }
 
+/// Whether a sweep over `speeds` (rad/s) holding each for `dwell` seconds
+/// can be run: each dwell at least the revolution it measures, and the
+/// whole sweep no more revolutions than any run may take
+/// ([`crate::metrics::MAX_REVS`]): a day's dwell at millions of rpm is a
+/// job that never ends, refused before it starts.
+pub fn check_dwell(speeds: &[(Direction, f64)], dwell: f64) -> Result<(), SceneError> {
+    let slowest = speeds.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
+    let invalid = |reason: String| SceneError::Invalid {
+        field: "dwell".into(),
+        value: dwell.to_string(),
+        reason,
+    };
+    if !(dwell.is_finite() && dwell * slowest >= 2.0 * PI) {
+        return Err(invalid(format!(
+            "each dwell must last at least one revolution, the one measured: {:.4} s at the slowest speed {slowest} rad/s",
+            2.0 * PI / slowest
+        )));
+    }
+    let revolutions: f64 = speeds.iter().map(|s| dwell * s.1 / (2.0 * PI)).sum();
+    let most = crate::metrics::MAX_REVS;
+    if revolutions > most {
+        return Err(invalid(format!(
+            "the sweep's {} dwells would turn the rotor {revolutions:.3e} revolutions, more than the {most:e} any run may take; shorten the dwell, narrow the speed range or take larger steps",
+            speeds.len()
+        )));
+    }
+    Ok(())
+}
+
 /// The speeds of a stepped sweep: from `lo` up to `hi` in steps of `step`
 /// (both ends included; the last step shorter if need be) and, with
 /// `down`, back to `lo` without repeating `hi`.
@@ -165,18 +194,7 @@ impl Simulation {
         window: Option<f64>,
         mut series: Option<&mut SweepSeries>,
     ) -> Result<Vec<StepPoint>, SteppedError> {
-        let slowest = speeds.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
-        if !(dwell.is_finite() && dwell * slowest >= 2.0 * PI) {
-            return Err(SceneError::Invalid {
-                field: "dwell".into(),
-                value: dwell.to_string(),
-                reason: format!(
-                    "each dwell must last at least one revolution, the one measured: {:.4} s at the slowest speed {slowest} rad/s",
-                    2.0 * PI / slowest
-                ),
-            }
-            .into());
-        }
+        check_dwell(speeds, dwell)?;
         let mut points = Vec::with_capacity(speeds.len());
         let mut state: Option<Vec<f64>> = None;
         // The spin angle φ at the start of the next dwell (mod 2π).

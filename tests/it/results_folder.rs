@@ -225,3 +225,42 @@ fn resume_of_a_complete_study_says_so_and_prints_its_ranking_without_a_rate() {
     let out = String::from_utf8_lossy(&again.stdout);
     assert!(out.contains("recommendation"), "no ranking: {out}");
 }
+
+/// A study of 2 runs in 4 shards: two shards hold no run. Each is a valid
+/// shard all the same (exit 0, an empty runs table), and their merge is the
+/// unsharded run's table (before: those shards failed with "no data" and
+/// the merge could not be made).
+#[test]
+fn an_empty_shard_is_a_shard_and_merges() {
+    let (tmp, path, folder) = setup();
+    assert!(study(&path, &[]).status.success());
+    let shards: Vec<PathBuf> = (1..=4)
+        .map(|k| {
+            let out = study(&path, &["--shard", &format!("{k}/4")]);
+            assert!(out.status.success(), "shard {k}/4: {}", stderr(&out));
+            folder.join(format!("shard-{k}-of-4"))
+        })
+        .collect();
+    // Every column but the wall time, which no two runs share.
+    let rows = |p: &Path| {
+        autobal::study::io::read_parquet(p)
+            .unwrap()
+            .drop("wall_time_s")
+            .unwrap()
+    };
+    assert_eq!(rows(&shards[3].join("runs.parquet")).height(), 0);
+    let merged_dir = tmp.path().join("merged");
+    let merged = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["merge", "--out", merged_dir.to_str().unwrap()])
+        .args(&shards)
+        .output()
+        .unwrap();
+    assert!(merged.status.success(), "{}", stderr(&merged));
+    let whole = rows(&folder.join("runs.parquet"));
+    let joined = rows(&merged_dir.join("runs.parquet"));
+    assert_eq!(whole.height(), 2);
+    assert!(
+        whole.equals_missing(&joined),
+        "the merge differs from one run"
+    );
+}

@@ -236,3 +236,48 @@ fn the_stepped_verb_warns_records_and_refuses_by_flag() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--series"));
     assert!(!dir.path().join("s2.parquet").exists());
 }
+
+/// A sweep that could never end (a day's dwell at millions of rpm: 10¹⁰
+/// revolutions) and an output file named for another format are refused
+/// before any dwell, exit 2, naming the flag and writing nothing.
+#[test]
+fn an_endless_sweep_and_a_csv_name_are_refused_up_front() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let study = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_study"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .arg("stepped")
+            .arg("scenes/three_balls.toml")
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let endless = study(&["--rpm", "8e6..9e6", "--step-rpm", "1e5", "--dwell", "86400"]);
+    let err = String::from_utf8_lossy(&endless.stderr);
+    assert_eq!(endless.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--dwell 86400") && err.contains("revolutions"),
+        "{err}"
+    );
+    for flag in ["--out", "--series"] {
+        let csv = dir.path().join("steps.csv");
+        let out = study(&[
+            "--rpm",
+            "38..40",
+            "--step-rpm",
+            "1",
+            "--dwell",
+            "5",
+            flag,
+            csv.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag}: {err}");
+        assert!(
+            err.contains(flag) && err.contains(".parquet"),
+            "{flag}: {err}"
+        );
+        assert!(!csv.exists(), "{flag}: wrote {}", csv.display());
+    }
+}

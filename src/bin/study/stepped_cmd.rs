@@ -5,7 +5,7 @@ use crate::UserError;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
 use autobal::simulation::stepped::{
-    StepPoint, SteppedError, SweepSeries, stepped_speeds, to_dataframe,
+    StepPoint, SteppedError, SweepSeries, check_dwell, stepped_speeds, to_dataframe,
 };
 use autobal::study::io::{Provenance, write_parquet};
 use clap::Args;
@@ -125,6 +125,17 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
         ("--series", &args.series),
     ] {
         if let Some(path) = path {
+            // Steps hold a list per bearing, which CSV cannot: any other
+            // name would hold Parquet under the wrong name.
+            if path.extension().is_none_or(|e| e != "parquet") {
+                return Err(UserError(
+                    format!(
+                        "{flag} {}: study stepped writes Parquet files only; name it .parquet",
+                        path.display()
+                    ),
+                    2,
+                ));
+            }
             prepare(flag, path, WhenExists::from_overwrite(args.overwrite))?;
         }
     }
@@ -139,6 +150,9 @@ pub fn run(args: &SteppedArgs) -> Result<(), UserError> {
         args.step_rpm * to_rad,
         !args.up_only,
     );
+    // Before the first dwell (or draw): an endless sweep is refused whole.
+    check_dwell(&speeds, args.dwell)
+        .map_err(|e| UserError(format!("--dwell {}: {}", args.dwell, reason(&e)), 2))?;
     if draws > 0 {
         let outputs = crate::stepped_bands_cmd::Outputs {
             bands: args.out.as_deref(),

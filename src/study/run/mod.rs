@@ -612,7 +612,16 @@ fn run_in_folder(
     // table and removing the chunks) its copy is kept.
     let mut pieces = earlier_table;
     pieces.extend(chunk_pieces(&chunks)?);
-    let written = write_runs(&pieces, total_ids, &runs_path, &provenance)?;
+    let written = if total == 0 {
+        // A shard whose slice of a small study holds no run is a shard all
+        // the same: an empty table with the runs' columns, which `merge`
+        // reads as such.
+        let mut empty = super::record::to_dataframe(&[])?;
+        write_parquet(&runs_path, &mut empty, &provenance)?;
+        0
+    } else {
+        write_runs(&pieces, total_ids, &runs_path, &provenance)?
+    };
     drop(pieces);
     let summary = if options.shard.is_none() {
         let table = read_summary_columns(&runs_path)?;
