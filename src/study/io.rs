@@ -197,7 +197,7 @@ pub fn foreign_table(
     seed: u64,
     shard: Option<&str>,
 ) -> PolarsResult<Option<String>> {
-    let recorded = read_metadata(path).map_err(|e| about(path, e))?;
+    let recorded = read_metadata(path)?;
     let get = |key: &str| {
         recorded
             .iter()

@@ -309,7 +309,8 @@ fn write_study(dir: &Path) {
     std::fs::write(dir.join("study.toml"), STUDY_TOML).unwrap();
     let plan = study_plan();
     let runs = study_runs(&plan, 40);
-    let provenance = Provenance::new("fixture", 1, "all");
+    // The fixture's runs belong to the study.toml beside them, as a run's do.
+    let provenance = Provenance::new(STUDY_TOML, autobal::study::config::DEFAULT_SEED, "all");
     let mut summary = summarize(&plan, &runs).unwrap();
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance).unwrap();
     write_parquet(
