@@ -214,17 +214,9 @@ pub fn check_study(
         Some(path) => {
             let seed = runs_file_seed(path, plan)?;
             (
-                design_samples(&read_table(path, TableKind::Runs).map_err(|e| {
-                    let shown = path.display().to_string();
-                    let text = e.to_string();
-                    CheckError::BadRuns {
-                        message: text
-                            .strip_prefix(&format!("{shown}: "))
-                            .unwrap_or(&text)
-                            .to_string(),
-                        path: shown,
-                    }
-                })?)?,
+                design_samples(
+                    &read_table(path, TableKind::Runs).map_err(|e| bad_runs(path, &e))?,
+                )?,
                 seed,
                 path.clone(),
             )
@@ -257,6 +249,20 @@ pub fn check_study(
     })
 }
 
+/// A runs file's read error, the file named once (the reader's message
+/// begins with it too).
+fn bad_runs(path: &Path, e: &polars::prelude::PolarsError) -> CheckError {
+    let shown = path.display().to_string();
+    let text = e.to_string();
+    CheckError::BadRuns {
+        message: text
+            .strip_prefix(&format!("{shown}: "))
+            .unwrap_or(&text)
+            .to_string(),
+        path: shown,
+    }
+}
+
 /// The seed of a finished, unsharded runs file of this very study.
 fn runs_file_seed(path: &Path, plan: &StudyPlan) -> Result<u64, CheckError> {
     let bad = |message: &str| CheckError::BadRuns {
@@ -266,7 +272,7 @@ fn runs_file_seed(path: &Path, plan: &StudyPlan) -> Result<u64, CheckError> {
     if !path.is_file() {
         return Err(bad("no such file"));
     }
-    let meta = read_metadata(path).map_err(|e| bad(&e.to_string()))?;
+    let meta = read_metadata(path).map_err(|e| bad_runs(path, &e))?;
     let get = |k: &str| {
         meta.iter()
             .find(|(key, _)| key == k)

@@ -104,6 +104,49 @@ pub fn about(path: &Path, e: PolarsError) -> PolarsError {
     }
 }
 
+/// `e`, met while writing `path`, as the write failure it is, naming
+/// `path`: a write cut short reads in polars' words like a damaged file
+/// ("out of specification", "Invalid thrift"), which would blame the
+/// user's input. When the file system has no room left, says that. Call it
+/// before the partial temporary file is removed, which frees its room.
+pub fn about_writing(path: &Path, e: PolarsError) -> PolarsError {
+    let full = no_room_left(path);
+    let cause = if full {
+        "no space left on device".to_string()
+    } else {
+        e.to_string()
+    };
+    let kind = if full {
+        std::io::ErrorKind::StorageFull
+    } else {
+        std::io::ErrorKind::Other
+    };
+    PolarsError::IO {
+        error: std::sync::Arc::new(std::io::Error::new(kind, cause.clone())),
+        msg: Some(format!("{}: could not be written: {cause}", path.display()).into()),
+    }
+}
+
+/// Whether the file system holding `path` has less than a mebibyte left
+/// for this process (statvfs: no crate offers it for a path).
+fn no_room_left(path: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let Ok(name) = std::ffi::CString::new(folder.as_os_str().as_bytes()) else {
+        return false;
+    };
+    // SAFETY: `name` is a NUL-terminated path and `stats` a plain struct
+    // statvfs fills; both outlive the call.
+    let mut stats: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(name.as_ptr(), &mut stats) } != 0 {
+        return false;
+    }
+    u128::from(stats.f_bavail) * u128::from(stats.f_frsize) < 1 << 20
+}
+
 /// Write `df` to `path` atomically, with provenance in the key-value metadata.
 pub fn write_parquet(path: &Path, df: &mut DataFrame, provenance: &Provenance) -> PolarsResult<()> {
     let tmp = temp_path(path);
@@ -114,11 +157,12 @@ pub fn write_parquet(path: &Path, df: &mut DataFrame, provenance: &Provenance) -
                 .with_key_value_metadata(Some(KeyValueMetadata::from_static(provenance.pairs())))
                 .finish(df)
         })
-        .and_then(|_| move_into_place(&tmp, path).map_err(PolarsError::from));
+        .and_then(|_| move_into_place(&tmp, path).map_err(PolarsError::from))
+        .map_err(|e| about_writing(path, e));
     if written.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    written.map(|_| ()).map_err(|e| about(path, e))
+    written.map(|_| ())
 }
 
 /// A study's chunk of finished runs, atomically, as an Arrow IPC file:
@@ -131,11 +175,12 @@ pub fn write_chunk(path: &Path, df: &mut DataFrame) -> PolarsResult<()> {
     let written = File::create(&tmp)
         .map_err(PolarsError::from)
         .and_then(|file| IpcWriter::new(file).finish(df))
-        .and_then(|_| move_into_place(&tmp, path).map_err(PolarsError::from));
+        .and_then(|_| move_into_place(&tmp, path).map_err(PolarsError::from))
+        .map_err(|e| about_writing(path, e));
     if written.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    written.map_err(|e| about(path, e))
+    written
 }
 
 /// Read a Parquet file written by [`write_parquet`].

@@ -5,7 +5,7 @@
 //! runs. The window boundaries lie in run-id space, so the same runs give the
 //! same file however they were split into pieces (threads, resumes, shards).
 
-use super::io::{Provenance, about, temp_path};
+use super::io::{Provenance, about, about_writing, temp_path};
 use polars::prelude::*;
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -139,20 +139,25 @@ pub fn write_runs(
     provenance: &Provenance,
 ) -> PolarsResult<u64> {
     let tmp = temp_path(out);
-    let result = write_windows(pieces, total_ids, &tmp, provenance)
-        .and_then(|rows| std::fs::rename(&tmp, out).map(|_| rows).map_err(Into::into));
+    // The pieces' read errors name their own files; the writer's name `out`.
+    let result = write_windows(pieces, total_ids, (&tmp, out), provenance).and_then(|rows| {
+        std::fs::rename(&tmp, out)
+            .map(|_| rows)
+            .map_err(|e| about_writing(out, e.into()))
+    });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    result.map_err(|e| about(out, e))
+    result
 }
 
 fn write_windows(
     pieces: &[Piece],
     total_ids: u64,
-    tmp: &Path,
+    (tmp, out): (&Path, &Path),
     provenance: &Provenance,
 ) -> PolarsResult<u64> {
+    let writing = |e: PolarsError| about_writing(out, e);
     let mut writer: Option<polars::io::parquet::write::BatchedWriter<File>> = None;
     let mut rows = 0u64;
     let mut from = 0;
@@ -164,25 +169,28 @@ fn write_windows(
         };
         if writer.is_none() {
             writer = Some(
-                ParquetWriter::new(File::create(tmp)?)
+                ParquetWriter::new(File::create(tmp).map_err(|e| writing(e.into()))?)
                     .with_key_value_metadata(Some(KeyValueMetadata::from_static(
                         provenance.pairs(),
                     )))
-                    .batched(window.schema())?,
+                    .batched(window.schema())
+                    .map_err(writing)?,
             );
         }
         if let Some(w) = writer.as_mut() {
-            w.write_batch(&window)?;
+            w.write_batch(&window).map_err(writing)?;
         }
         rows += window.height() as u64;
         from = to;
     }
     match writer {
         Some(w) => {
-            w.finish()?;
+            w.finish().map_err(writing)?;
         }
         None => {
-            return Err(PolarsError::NoData("no runs to write".into()));
+            return Err(PolarsError::NoData(
+                format!("{}: no runs to write", out.display()).into(),
+            ));
         }
     }
     Ok(rows)

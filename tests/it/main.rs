@@ -22,6 +22,7 @@ mod decisions;
 mod design_capacity;
 mod design_criterion;
 mod design_transient;
+mod disk_full;
 mod events;
 mod every_rotor;
 mod extremes;

@@ -282,6 +282,9 @@ fn a_corrupt_runs_file_is_reported_with_its_path() {
     let (path, folder) = corpus_study(tmp.path(), "");
     let p = path.to_str().unwrap();
     assert!(study_cmd(&["run", p, "--quiet"]).status.success());
+    let baseline = tmp.path().join("baseline");
+    let made = study_cmd(&["baseline", p, "--out", baseline.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", stderr(&made));
     let runs = folder.join("runs.parquet");
     std::fs::write(&runs, b"not parquet at all").unwrap();
     let figures = tmp.path().join("figs");
@@ -289,6 +292,14 @@ fn a_corrupt_runs_file_is_reported_with_its_path() {
     // A damaged results file is the user's input: exit 2, named once.
     for args in [
         vec!["run", p, "--quiet", "--resume"],
+        vec![
+            "check",
+            p,
+            "--baseline",
+            baseline.to_str().unwrap(),
+            "--runs",
+            runs.to_str().unwrap(),
+        ],
         vec!["compare", folder.to_str().unwrap(), "--designs", "0,1"],
         vec![
             "plot",
