@@ -417,9 +417,32 @@ fn flag_cases(study_path: &str, scene_path: &str) -> Vec<(Vec<String>, &'static 
     ]
 }
 
+/// Every entry under `dir` with its bytes (folders as such), sorted: two
+/// equal snapshots mean nothing under `dir` was made, changed or removed.
+pub(crate) fn tree_snapshot(dir: &Path) -> Vec<(std::path::PathBuf, Option<Vec<u8>>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p.clone());
+                out.push((p, None));
+            } else {
+                out.push((p.clone(), Some(std::fs::read(&p).unwrap())));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Run the study `text` from `dir`: exit code, stderr, and whether the
+/// run changed anything under `dir` (beyond the study file it was given).
 fn run_study(dir: &Path, text: &str) -> (Option<i32>, String, bool) {
     let path = dir.join("case.toml");
     std::fs::write(&path, text).unwrap();
+    let before = tree_snapshot(dir);
     let out = Command::new(env!("CARGO_BIN_EXE_study"))
         .args(["run", path.to_str().unwrap(), "--quiet"])
         .output()
@@ -427,7 +450,7 @@ fn run_study(dir: &Path, text: &str) -> (Option<i32>, String, bool) {
     (
         out.status.code(),
         String::from_utf8_lossy(&out.stderr).to_string(),
-        dir.join("results").exists(),
+        tree_snapshot(dir) != before,
     )
 }
 
@@ -490,14 +513,17 @@ fn every_bad_command_line_is_refused_naming_the_flag() {
     let cases = flag_cases(study_path.to_str().unwrap(), scene_path.to_str().unwrap());
     assert!(STUDY_CASES.len() + SCENE_CASES.len() + cases.len() >= 60);
     for (args, needle) in cases {
+        // Every refusal leaves the whole tree as it was, not only results/.
+        let before = tree_snapshot(tmp.path());
         let out = Command::new(env!("CARGO_BIN_EXE_study"))
             .args(&args)
             .output()
             .unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
-        if out.status.code() != Some(2) || !err.contains(needle) {
+        let changed = tree_snapshot(tmp.path()) != before;
+        if out.status.code() != Some(2) || !err.contains(needle) || changed {
             failures.push(format!(
-                "{args:?}: exit {:?}, expected {needle:?} in: {err}",
+                "{args:?}: exit {:?}, changed the tree: {changed}, expected {needle:?} in: {err}",
                 out.status.code()
             ));
         }

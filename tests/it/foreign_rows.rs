@@ -23,24 +23,6 @@ fn study_file(dir: &Path, results: &Path, seed: u64, file: &str) -> PathBuf {
     path
 }
 
-/// Every file under `dir` with its bytes.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push((p.clone(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 fn refused(out: &Output, names: &Path, why: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -71,11 +53,11 @@ fn a_table_of_another_seed_is_neither_resumed_nor_compared() {
     let runs = folder.join("runs.parquet");
     std::fs::copy(a.join("corpus/runs.parquet"), &runs).unwrap();
     std::fs::remove_file(folder.join("summary.parquet")).unwrap();
-    let before = snapshot(&folder);
+    let before = crate::bad_input::tree_snapshot(&folder);
     let out = study_bin(&["run", six.to_str().unwrap(), "--quiet", "--resume"]);
     refused(&out, &runs, "written by another study file");
     assert_eq!(
-        snapshot(&folder),
+        crate::bad_input::tree_snapshot(&folder),
         before,
         "a refused resume changed the folder"
     );
@@ -113,7 +95,7 @@ fn a_shard_of_another_seed_is_not_merged() {
     let first = shards.join("shard-1-of-2");
     let runs = first.join("runs.parquet");
     std::fs::copy(b.join("corpus/shard-1-of-2/runs.parquet"), &runs).unwrap();
-    let before = snapshot(&shards);
+    let before = crate::bad_input::tree_snapshot(&shards);
     let out = study_bin(&[
         "merge",
         first.to_str().unwrap(),
@@ -121,7 +103,7 @@ fn a_shard_of_another_seed_is_not_merged() {
     ]);
     refused(&out, &runs, "written by another study file");
     assert_eq!(
-        snapshot(&shards),
+        crate::bad_input::tree_snapshot(&shards),
         before,
         "a refused merge changed the folders"
     );
@@ -139,10 +121,10 @@ fn a_resume_without_the_plan_id_is_refused() {
     let folder = results.join("corpus");
     std::fs::remove_file(folder.join("plan.sha256")).unwrap();
     std::fs::remove_file(folder.join("summary.parquet")).unwrap();
-    let before = snapshot(&folder);
+    let before = crate::bad_input::tree_snapshot(&folder);
     let out = study_bin(&["run", path.to_str().unwrap(), "--quiet", "--resume"]);
     refused(&out, &folder, "plan.sha256 is missing or unreadable");
-    assert_eq!(snapshot(&folder), before);
+    assert_eq!(crate::bad_input::tree_snapshot(&folder), before);
 }
 
 /// A results folder made read-only is not overwritten, even by a process
@@ -157,14 +139,14 @@ fn a_read_only_results_folder_is_not_overwritten() {
     let out = study_bin(&["run", path.to_str().unwrap(), "--quiet"]);
     assert!(out.status.success());
     let folder = results.join("corpus");
-    let before = snapshot(&folder);
+    let before = crate::bad_input::tree_snapshot(&folder);
     let mode = |m: u32| std::fs::set_permissions(&folder, std::fs::Permissions::from_mode(m));
     mode(0o555).unwrap();
     let out = study_bin(&["run", path.to_str().unwrap(), "--quiet", "--overwrite"]);
     mode(0o755).unwrap();
     refused(&out, &folder, "read-only");
     assert_eq!(
-        snapshot(&folder),
+        crate::bad_input::tree_snapshot(&folder),
         before,
         "a read-only folder was rewritten"
     );

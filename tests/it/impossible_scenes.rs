@@ -84,25 +84,6 @@ fn unbalances_far_beyond_the_capacity_are_refused_naming_the_key() {
     assert_eq!(code, Some(0), "{err}");
 }
 
-/// Every entry of a study folder listed with its bytes (folders as such).
-fn snapshot(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Option<Vec<u8>>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p.clone());
-                out.push((p, None));
-            } else {
-                out.push((p.clone(), Some(std::fs::read(&p).unwrap())));
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 /// A study folder whose `chunks` is a file, or whose `study.toml` is a
 /// folder: `--resume` exits 2 naming the entry and leaves the folder as it
 /// was (before: exit 1 with a bare "os error 17" or "21").
@@ -120,7 +101,7 @@ fn a_misshapen_study_folder_is_refused_naming_the_entry() {
         } else {
             std::fs::write(folder.join(entry), b"not a folder").unwrap();
         }
-        let before = snapshot(&folder);
+        let before = crate::bad_input::tree_snapshot(&folder);
         let out = Command::new(env!("CARGO_BIN_EXE_study"))
             .args(["run", path.to_str().unwrap(), "--quiet", "--resume"])
             .output()
@@ -132,7 +113,11 @@ fn a_misshapen_study_folder_is_refused_naming_the_entry() {
                 && err.contains("nothing was changed"),
             "{entry}: {err}"
         );
-        assert_eq!(snapshot(&folder), before, "{entry}: the folder changed");
+        assert_eq!(
+            crate::bad_input::tree_snapshot(&folder),
+            before,
+            "{entry}: the folder changed"
+        );
     }
 }
 
@@ -156,10 +141,14 @@ fn a_refused_resume_over_a_damaged_table_leaves_the_folder_as_it_was() {
     let runs = folder.join("runs.parquet");
     let bytes = std::fs::read(&runs).unwrap();
     std::fs::write(&runs, &bytes[..bytes.len() / 2]).unwrap();
-    let before = snapshot(&folder);
+    let before = crate::bad_input::tree_snapshot(&folder);
     let out = run(&["--resume"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("runs.parquet"), "{err}");
-    assert_eq!(snapshot(&folder), before, "the refusal changed the folder");
+    assert_eq!(
+        crate::bad_input::tree_snapshot(&folder),
+        before,
+        "the refusal changed the folder"
+    );
 }

@@ -42,9 +42,14 @@ const DEFAULT_LEADING: u32 = 3;
 fn same_study_files(runs: &Path, summary: &Path) -> Result<(), UserError> {
     let hash = |path: &Path| -> Result<Option<String>, UserError> {
         if !path.is_file() {
+            let what = if path.exists() {
+                "not a file"
+            } else {
+                "not found"
+            };
             return Err(UserError(
                 format!(
-                    "{}: not found (give the output folder of a finished `study run` or `study merge`)",
+                    "{}: {what} (give the output folder of a finished `study run` or `study merge`)",
                     path.display()
                 ),
                 2,
