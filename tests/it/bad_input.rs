@@ -414,6 +414,37 @@ fn flag_cases(study_path: &str, scene_path: &str) -> Vec<(Vec<String>, &'static 
         ),
         // A FIFO or a folder as the study file: refused at once, not read.
         (s(&["run", "/"]), "not a text file"),
+        // A sweep that would never end, and a file named for another format.
+        (
+            s(&[
+                "stepped",
+                scene_path,
+                "--rpm",
+                "8e6..9e6",
+                "--step-rpm",
+                "1e5",
+                "--dwell",
+                "86400",
+            ]),
+            "--dwell",
+        ),
+        (
+            s(&[
+                "stepped",
+                scene_path,
+                "--rpm",
+                "38..40",
+                "--step-rpm",
+                "1",
+                "--dwell",
+                "5",
+                "--out",
+                "steps.csv",
+            ]),
+            "--out",
+        ),
+        // A design against itself.
+        (s(&["compare", study_path, "--designs", "0,0"]), "itself"),
     ]
 }
 
