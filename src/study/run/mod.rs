@@ -10,8 +10,8 @@ use super::adaptive::{Precision, batch_ids, batches, precision};
 use super::aggregate::summarize_table;
 use super::config::StudyPlan;
 use super::design::Design;
-use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet, write_text};
-use super::lock::{FolderLock, LockError};
+use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet};
+use super::lock::LockError;
 use super::racing::{Departure, Race, only_running, races};
 use super::record::{RunRecord, from_dataframe, to_dataframe};
 use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
@@ -27,6 +27,7 @@ use std::time::{Duration, Instant};
 
 mod assemble;
 mod executor;
+mod folder;
 
 pub use assemble::{
     run_design_sample, run_design_sample_in, run_one, sample_simulation, sample_simulation_in,
@@ -320,33 +321,6 @@ impl RunError {
     }
 }
 
-/// Refuse a study folder whose own entries are of the wrong kind, before
-/// anything in it is touched (before, `--resume` with a file named
-/// `chunks` ended on a bare "os error 17").
-fn check_entry_kinds(dir: &Path) -> Result<(), RunError> {
-    let entries: [(&str, bool, &'static str); 5] = [
-        ("chunks", true, "chunks/ folder of finished runs"),
-        ("study.toml", false, "copy of the study file (study.toml)"),
-        (PLAN_ID_FILE, false, "plan id (plan.sha256)"),
-        ("runs.parquet", false, "runs table (runs.parquet)"),
-        ("summary.parquet", false, "summary table (summary.parquet)"),
-    ];
-    for (name, want_dir, want) in entries {
-        let path = dir.join(name);
-        let Ok(meta) = std::fs::metadata(&path) else {
-            continue;
-        };
-        if meta.is_dir() != want_dir {
-            return Err(RunError::Misshapen {
-                path: path.display().to_string(),
-                found: if meta.is_dir() { "a folder" } else { "a file" },
-                want,
-            });
-        }
-    }
-    Ok(())
-}
-
 /// Folder of a study's (or a shard's) files.
 pub fn output_dir(plan: &StudyPlan, shard: Option<Shard>) -> PathBuf {
     let base = Path::new(&plan.file.output).join(&plan.name);
@@ -367,29 +341,6 @@ pub fn plan_id(plan: &StudyPlan, provenance: &Provenance) -> String {
         "autobal {}\ncommit {}\n{}",
         provenance.version, provenance.git_commit, plan.text
     ))
-}
-
-/// A resumed folder's runs were made by this build: its plan id says so.
-/// Without one (missing, unreadable) nothing says which build made them.
-fn check_resumed_plan(
-    dir: &Path,
-    plan_file: &Path,
-    id: &str,
-    has_results: bool,
-) -> Result<(), RunError> {
-    match std::fs::read_to_string(plan_file) {
-        Ok(found) if found.trim() != id => Err(RunError::PlanChanged {
-            path: dir.display().to_string(),
-            found: found.trim().to_string(),
-            expected: id.to_string(),
-        }),
-        Ok(_) => Ok(()),
-        Err(_) if has_results => Err(RunError::PlanUnknown {
-            path: dir.display().to_string(),
-        }),
-        // Nothing finished yet: record the plan now.
-        Err(_) => Ok(write_text(plan_file, id)?),
-    }
 }
 
 /// Label stored in provenance: "all" or "k/N".
@@ -418,7 +369,8 @@ pub fn run_study(
     })
 }
 
-/// [`run_study`] in its output folder `dir`.
+/// [`run_study`] in its output folder `dir`: claim the folder, check what
+/// it holds, run the batches not yet run, write the tables.
 fn run_in_folder(
     dir: &Path,
     plan: &StudyPlan,
@@ -426,92 +378,26 @@ fn run_in_folder(
     progress: &dyn Progress,
 ) -> Result<StudyOutput, RunError> {
     let dir = dir.to_path_buf();
-    let not_writable = |source| RunError::NotWritable {
-        path: dir.display().to_string(),
-        source,
-    };
-    std::fs::create_dir_all(&dir).map_err(not_writable)?;
-    crate::output_file::probe_writable(&dir).map_err(not_writable)?;
-
-    let _lock = FolderLock::acquire(&dir)?;
-    // A writer killed during an atomic write left its temporary file.
-    crate::output_file::remove_stale_temps(&dir, None);
-
-    let manifest = dir.join("study.toml");
-    let plan_file = dir.join(PLAN_ID_FILE);
-    let chunks = dir.join("chunks");
-    let runs_path = dir.join("runs.parquet");
-    let summary_path = dir.join("summary.parquet");
-    check_entry_kinds(&dir)?;
+    let _lock = folder::claim(&dir)?;
+    let files = folder::FolderFiles::in_folder(&dir);
     // Provenance asks git for the commit: once per run, shared with the plan id.
     let provenance = Provenance::new(&plan.text, plan.file.seed, &shard_label(options.shard));
     let id = plan_id(plan, &provenance);
-    let has_results = runs_path.exists()
-        || summary_path.exists()
-        || std::fs::read_dir(&chunks).is_ok_and(|mut d| d.next().is_some());
-    if options.resume && manifest.exists() {
-        if std::fs::read_to_string(&manifest)? != super::io::folder_copy(&plan.text) {
-            return Err(RunError::StudyChanged {
-                path: dir.display().to_string(),
-            });
-        }
-        check_resumed_plan(&dir, &plan_file, &id, has_results)?;
-        if runs_path.exists()
-            && let Some(reason) = super::io::foreign_table(
-                &runs_path,
-                &plan.text,
-                plan.file.seed,
-                Some(provenance.shard.as_str()),
-            )?
-        {
-            return Err(RunError::ForeignTable {
-                folder: dir.display().to_string(),
-                path: runs_path.display().to_string(),
-                reason,
-            });
-        }
+    if options.resume && files.manifest.exists() {
+        folder::check_resume(&dir, &files, plan, &id, &provenance)?;
     } else {
-        if has_results && options.resume && !options.overwrite {
-            return Err(RunError::NoPlan {
-                path: dir.display().to_string(),
-            });
-        }
-        if has_results && !options.overwrite {
-            return Err(RunError::ResultsExist {
-                path: dir.display().to_string(),
-            });
-        }
-        for stale in [&runs_path, &summary_path] {
-            if stale.exists() {
-                std::fs::remove_file(stale)?;
-            }
-        }
-        if chunks.exists() {
-            std::fs::remove_dir_all(&chunks)?;
-        }
-        write_text(&manifest, &super::io::folder_copy(&plan.text))?;
-        write_text(&plan_file, &id)?;
+        folder::start_afresh(&dir, &files, plan, options, &id)?;
     }
     // What earlier invocations finished: only their run ids are read, the
     // table before anything is made, so that a damaged one is refused with
     // the folder as it was.
-    let earlier_table = earlier_table_pieces(&runs_path)?;
-    std::fs::create_dir_all(&chunks)?;
+    let earlier_table = earlier_table_pieces(&files.runs)?;
+    std::fs::create_dir_all(&files.chunks)?;
     let total_ids = plan.total_runs();
     let mut done = vec![false; total_ids as usize];
-    let mark_done = |pieces: &[Piece], done: &mut Vec<bool>| {
-        for piece in pieces {
-            for &id in piece.ids() {
-                if let Some(d) = done.get_mut(id as usize) {
-                    *d = true;
-                }
-            }
-        }
-    };
     mark_done(&earlier_table, &mut done);
-    mark_done(&chunk_pieces(&chunks)?, &mut done);
+    mark_done(&chunk_pieces(&files.chunks)?, &mut done);
     let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
-    let stop_when = plan.file.sampling.stop_when.as_ref();
     let total = (0..total_ids).filter(in_slice).count() as u64;
     let already = done.iter().filter(|d| **d).count() as u64;
     progress.begin(total, already);
@@ -527,122 +413,194 @@ fn run_in_folder(
         ),
         None => None,
     };
-    let mut executed = 0;
-    let mut adaptive = None;
-    let batches = batches(plan);
-    // A shard cannot judge a race (it lacks the other shards' runs): it
-    // runs every sample, and `merge` replays the race on the merged runs.
-    let mut race = (races(plan) && options.shard.is_none()).then(|| Race::new(plan, &batches));
-    let samples = u64::from(plan.file.sampling.samples);
-    for (k, range) in batches.iter().enumerate() {
-        let pending: Vec<u64> = batch_ids(plan, range)
-            .into_iter()
-            .filter(in_slice)
-            .filter(|&id| !done[id as usize])
-            .filter(|&id| {
-                race.as_ref()
-                    .is_none_or(|r| r.runs((id / samples) as usize, (id % samples) as u32))
-            })
-            .collect();
-        let saved = execute(plan, &pending, options, pool.as_ref(), &chunks, progress)?;
-        if options
-            .cancel
-            .as_ref()
-            .is_some_and(|c| c.load(Ordering::Relaxed))
-        {
-            let finished = already + executed + saved;
-            progress.interrupted(finished, total);
-            return Err(RunError::Interrupted {
-                path: dir.display().to_string(),
-                saved: executed + saved,
-                finished,
-                total,
-            });
-        }
-        executed += pending.len() as u64;
-        let last = k + 1 == batches.len();
-        // Nothing to judge: a shard of a raced study runs every batch.
-        if stop_when.is_none() && (race.is_none() || last) {
-            continue;
-        }
-        // Judge the batches so far on their own runs only.
-        let mut pieces = earlier_table_pieces(&runs_path)?;
-        pieces.extend(chunk_pieces(&chunks)?);
-        let so_far = read_pieces_summary_columns(&pieces)?;
-        let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
-        let judged = so_far.filter(&mask)?;
-        if let Some(race) = race.as_mut().filter(|_| !last) {
-            let left = match &pool {
-                Some(p) => p.install(|| race.look(plan, k, range.end, &judged))?,
-                None => race.look(plan, k, range.end, &judged)?,
-            };
-            // Runs that will not come: the later samples of the designs that
-            // left, and of the one left when that ends the study.
-            let stopped = left.len() + usize::from(race.decided());
-            if stopped > 0 {
-                let remaining = u64::from(plan.file.sampling.samples - range.end);
-                progress.skip(remaining * stopped as u64);
-            }
-            if race.decided() {
-                break;
-            }
-        }
-        if let Some(stop) = stop_when {
-            let judged = match &race {
-                Some(race) => only_running(&judged, race)?,
-                None => judged,
-            };
-            let reached = match &pool {
-                Some(p) => p.install(|| precision(plan, stop, &judged))?,
-                None => precision(plan, stop, &judged)?,
-            };
-            let stop_here = reached.reached || k + 1 == batches.len();
-            adaptive = Some(AdaptiveOutcome {
-                batches: k + 1,
-                samples_per_design: range.end,
-                precision: reached,
-            });
-            if stop_here {
-                break;
-            }
-        }
-    }
+    let run = RunContext {
+        dir: &dir,
+        files: &files,
+        plan,
+        options,
+        pool: pool.as_ref(),
+        progress,
+    };
+    let batched = run.batches(&done, (total, already))?;
 
     // The earlier table first: on a duplicate (a crash between writing the
     // table and removing the chunks) its copy is kept.
     let mut pieces = earlier_table;
-    pieces.extend(chunk_pieces(&chunks)?);
-    let written = if total == 0 {
-        // A shard whose slice of a small study holds no run is a shard all
-        // the same: an empty table with the runs' columns, which `merge`
-        // reads as such.
-        let mut empty = super::record::to_dataframe(&[])?;
-        write_parquet(&runs_path, &mut empty, &provenance)?;
-        0
-    } else {
-        write_runs(&pieces, total_ids, &runs_path, &provenance)?
-    };
-    drop(pieces);
-    let summary = if options.shard.is_none() {
-        let table = read_summary_columns(&runs_path)?;
-        let mut summary = match &pool {
-            Some(p) => p.install(|| summarize_table(plan, &table))?,
-            None => summarize_table(plan, &table)?,
-        };
-        write_parquet(&summary_path, &mut summary, &provenance)?;
-        Some(summary)
-    } else {
-        None
-    };
-    std::fs::remove_dir_all(&chunks)?;
+    pieces.extend(chunk_pieces(&files.chunks)?);
+    let (written, summary) = run.write_tables(pieces, total, &provenance)?;
+    std::fs::remove_dir_all(&files.chunks)?;
     progress.end();
     Ok(StudyOutput {
         dir,
         runs: written,
         summary,
-        executed,
-        adaptive,
-        race: race.map(|r| r.departures()),
+        executed: batched.executed,
+        adaptive: batched.adaptive,
+        race: batched.race.map(|r| r.departures()),
         runs_planned: total_ids,
     })
+}
+
+/// Mark every run id of `pieces` as done.
+fn mark_done(pieces: &[Piece], done: &mut [bool]) {
+    for piece in pieces {
+        for &id in piece.ids() {
+            if let Some(d) = done.get_mut(id as usize) {
+                *d = true;
+            }
+        }
+    }
+}
+
+/// What one invocation of a study run works with.
+struct RunContext<'a> {
+    dir: &'a Path,
+    files: &'a folder::FolderFiles,
+    plan: &'a StudyPlan,
+    options: &'a RunOptions,
+    pool: Option<&'a rayon::ThreadPool>,
+    progress: &'a dyn Progress,
+}
+
+/// What the batches left: runs executed here, the adaptive stop, the race.
+struct Batched {
+    executed: u64,
+    adaptive: Option<AdaptiveOutcome>,
+    race: Option<Race>,
+}
+
+impl RunContext<'_> {
+    /// `f` on the run's thread pool (the global one without `--threads`).
+    fn install<T: Send>(&self, f: impl FnOnce() -> T + Send) -> T {
+        match self.pool {
+            Some(p) => p.install(f),
+            None => f(),
+        }
+    }
+
+    /// Run the batches' runs not yet `done` of this slice, judging the race
+    /// and the adaptive stop after each batch; (`total`, `already`): the
+    /// slice's runs and those finished before this invocation.
+    fn batches(&self, done: &[bool], (total, already): (u64, u64)) -> Result<Batched, RunError> {
+        let (plan, options) = (self.plan, self.options);
+        let in_slice = |id: &u64| options.shard.is_none_or(|s| s.contains(*id));
+        let stop_when = plan.file.sampling.stop_when.as_ref();
+        let mut executed = 0;
+        let mut adaptive = None;
+        let batches = batches(plan);
+        // A shard cannot judge a race (it lacks the other shards' runs): it
+        // runs every sample, and `merge` replays the race on the merged runs.
+        let mut race = (races(plan) && options.shard.is_none()).then(|| Race::new(plan, &batches));
+        let samples = u64::from(plan.file.sampling.samples);
+        for (k, range) in batches.iter().enumerate() {
+            let pending: Vec<u64> = batch_ids(plan, range)
+                .into_iter()
+                .filter(in_slice)
+                .filter(|&id| !done[id as usize])
+                .filter(|&id| {
+                    race.as_ref()
+                        .is_none_or(|r| r.runs((id / samples) as usize, (id % samples) as u32))
+                })
+                .collect();
+            let saved = execute(
+                plan,
+                &pending,
+                options,
+                self.pool,
+                &self.files.chunks,
+                self.progress,
+            )?;
+            if options
+                .cancel
+                .as_ref()
+                .is_some_and(|c| c.load(Ordering::Relaxed))
+            {
+                let finished = already + executed + saved;
+                self.progress.interrupted(finished, total);
+                return Err(RunError::Interrupted {
+                    path: self.dir.display().to_string(),
+                    saved: executed + saved,
+                    finished,
+                    total,
+                });
+            }
+            executed += pending.len() as u64;
+            let last = k + 1 == batches.len();
+            // Nothing to judge: a shard of a raced study runs every batch.
+            if stop_when.is_none() && (race.is_none() || last) {
+                continue;
+            }
+            // Judge the batches so far on their own runs only.
+            let mut pieces = earlier_table_pieces(&self.files.runs)?;
+            pieces.extend(chunk_pieces(&self.files.chunks)?);
+            let so_far = read_pieces_summary_columns(&pieces)?;
+            let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
+            let judged = so_far.filter(&mask)?;
+            if let Some(race) = race.as_mut().filter(|_| !last) {
+                let left = self.install(|| race.look(plan, k, range.end, &judged))?;
+                // Runs that will not come: the later samples of the designs that
+                // left, and of the one left when that ends the study.
+                let stopped = left.len() + usize::from(race.decided());
+                if stopped > 0 {
+                    let remaining = u64::from(plan.file.sampling.samples - range.end);
+                    self.progress.skip(remaining * stopped as u64);
+                }
+                if race.decided() {
+                    break;
+                }
+            }
+            if let Some(stop) = stop_when {
+                let judged = match &race {
+                    Some(race) => only_running(&judged, race)?,
+                    None => judged,
+                };
+                let reached = self.install(|| precision(plan, stop, &judged))?;
+                let stop_here = reached.reached || k + 1 == batches.len();
+                adaptive = Some(AdaptiveOutcome {
+                    batches: k + 1,
+                    samples_per_design: range.end,
+                    precision: reached,
+                });
+                if stop_here {
+                    break;
+                }
+            }
+        }
+        Ok(Batched {
+            executed,
+            adaptive,
+            race,
+        })
+    }
+
+    /// Write runs.parquet from `pieces` (and, unsharded, summary.parquet);
+    /// the rows written and the summary.
+    fn write_tables(
+        &self,
+        pieces: Vec<Piece>,
+        total: u64,
+        provenance: &Provenance,
+    ) -> Result<(u64, Option<DataFrame>), RunError> {
+        let runs_path = &self.files.runs;
+        let written = if total == 0 {
+            // A shard whose slice of a small study holds no run is a shard all
+            // the same: an empty table with the runs' columns, which `merge`
+            // reads as such.
+            let mut empty = super::record::to_dataframe(&[])?;
+            write_parquet(runs_path, &mut empty, provenance)?;
+            0
+        } else {
+            write_runs(&pieces, self.plan.total_runs(), runs_path, provenance)?
+        };
+        drop(pieces);
+        let summary = if self.options.shard.is_none() {
+            let table = read_summary_columns(runs_path)?;
+            let mut summary = self.install(|| summarize_table(self.plan, &table))?;
+            write_parquet(&self.files.summary, &mut summary, provenance)?;
+            Some(summary)
+        } else {
+            None
+        };
+        Ok((written, summary))
+    }
 }
