@@ -1,6 +1,7 @@
-//! The user documentation speaks to users: it cites no internal issue or
-//! pull-request numbers (a reader cannot open them) and promises nothing
-//! that has already shipped.
+//! The user documentation (README, docs, and the shipped study, scene and
+//! rig files) speaks to users: it cites no internal issue or pull-request
+//! numbers (a reader cannot open them), dates nothing by working sessions,
+//! and promises nothing that has already shipped.
 
 use std::path::{Path, PathBuf};
 
@@ -16,8 +17,8 @@ fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// README.md and docs/*.md but the developer documents, as paths relative
-/// to the repository.
+/// README.md, docs/*.md but the developer documents, and the shipped
+/// studies/, scenes/ and rigs/ files, as paths relative to the repository.
 fn user_docs() -> Vec<String> {
     let mut docs = vec!["README.md".to_string()];
     for entry in std::fs::read_dir(repo().join("docs")).expect("docs/") {
@@ -27,9 +28,29 @@ fn user_docs() -> Vec<String> {
             docs.push(format!("docs/{name}"));
         }
     }
+    // The shipped study, scene and rig files are read by users too: their
+    // headers explain them.
+    for folder in ["studies", "scenes", "rigs"] {
+        for entry in std::fs::read_dir(repo().join(folder)).expect(folder) {
+            let name = entry.expect("entry").file_name();
+            let name = name.to_string_lossy();
+            if name.ends_with(".toml") {
+                docs.push(format!("{folder}/{name}"));
+            }
+        }
+    }
     docs.retain(|d| !DEVELOPER_DOCS.contains(&d.as_str()));
     docs.sort();
     docs
+}
+
+/// Where `line` dates something by how the project was worked on ("this
+/// session", "an earlier session") rather than by a date a reader can use.
+fn working_history(line: &str) -> Option<String> {
+    let text = line.to_lowercase();
+    text.split(|c: char| !c.is_alphanumeric())
+        .any(|w| w == "session" || w == "sessions")
+        .then(|| line.to_string())
 }
 
 /// Where `line` cites an issue: "issue 32", "Issue #32", "issues 4 and 5",
@@ -87,7 +108,7 @@ fn read(path: &Path) -> String {
 }
 
 #[test]
-fn user_docs_cite_no_internal_issue_numbers() {
+fn user_docs_cite_no_internal_issue_numbers_nor_sessions() {
     let docs = user_docs();
     assert!(
         docs.len() >= 10,
@@ -96,14 +117,14 @@ fn user_docs_cite_no_internal_issue_numbers() {
     let mut found = Vec::new();
     for doc in &docs {
         for (k, line) in read(&repo().join(doc)).lines().enumerate() {
-            if let Some(hit) = issue_reference(line) {
+            if let Some(hit) = issue_reference(line).or_else(|| working_history(line)) {
                 found.push(format!("{doc}:{}: {hit}", k + 1));
             }
         }
     }
     assert!(
         found.is_empty(),
-        "user docs cite internal issues (say what changed or since when instead; developer docs are listed in DEVELOPER_DOCS):\n{}",
+        "user docs cite internal issues or date things by working sessions (say what changed or since when instead; developer docs are listed in DEVELOPER_DOCS):\n{}",
         found.join("\n")
     );
 }
@@ -119,6 +140,10 @@ fn the_issue_check_sees_the_forms_it_forbids() {
     ] {
         assert!(issue_reference(line).is_some(), "missed: {line}");
     }
+    for line in ["measured this session", "# Sessions 3-4 found"] {
+        assert!(working_history(line).is_some(), "missed: {line}");
+    }
+    assert_eq!(working_history("an ODE solver's possession"), None);
     for line in [
         "the test against #1 (at 80 columns)",
         "#1 (design 2) is better than 17",
