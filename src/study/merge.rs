@@ -54,33 +54,7 @@ pub fn merge(
     out: Option<&Path>,
     overwrite: bool,
 ) -> Result<StudyOutput, MergeError> {
-    let mut pieces: Vec<Piece> = Vec::new();
-    let mut study: Option<(String, String)> = None;
-    for dir in dirs {
-        let path = dir.join("runs.parquet");
-        if !path.exists() {
-            return Err(MergeError::Missing(dir.display().to_string()));
-        }
-        // The shard's plan: its study text and the build that ran it.
-        let text = std::fs::read_to_string(dir.join("study.toml"))
-            .map_err(|_| MergeError::Missing(dir.join("study.toml").display().to_string()))?;
-        let plan_id =
-            std::fs::read_to_string(dir.join(super::run::PLAN_ID_FILE)).unwrap_or_default();
-        let shard_plan = format!("{plan_id}\n{text}");
-        match &study {
-            None => study = Some((shard_plan, dir.display().to_string())),
-            Some((first, first_dir)) if *first != shard_plan => {
-                return Err(MergeError::DifferentStudy(
-                    dir.display().to_string(),
-                    first_dir.clone(),
-                ));
-            }
-            Some(_) => {}
-        }
-        pieces.push(Piece::open(&path)?);
-    }
-    let (shard_plan, first_dir) =
-        study.ok_or_else(|| MergeError::Missing("(no shard folders given)".into()))?;
+    let (pieces, shard_plan, first_dir) = read_shards(dirs)?;
     let text = shard_plan
         .split_once('\n')
         .map_or(shard_plan.as_str(), |(_, t)| t)
@@ -95,49 +69,8 @@ pub fn merge(
         }
     }
     let total = plan.total_runs();
-    let mut seen = vec![false; total as usize];
-    for &id in pieces.iter().flat_map(|p| p.ids()) {
-        match seen.get_mut(id as usize) {
-            Some(s) if !*s => *s = true,
-            Some(_) => return Err(MergeError::Duplicate(id)),
-            None => {
-                return Err(MergeError::BadStudy(
-                    first_dir.clone(),
-                    format!("run {id} is outside the plan's {total} runs"),
-                ));
-            }
-        }
-    }
-    if let Some(first) = seen.iter().position(|s| !s) {
-        let missing = seen.iter().filter(|s| !**s).count() as u64;
-        return Err(MergeError::Incomplete {
-            missing,
-            total,
-            first: first as u64,
-        });
-    }
-    let dir = match out {
-        Some(o) => o.to_path_buf(),
-        None => dirs[0]
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from(".")),
-    };
-    let not_writable = |source| RunError::NotWritable {
-        path: dir.display().to_string(),
-        source,
-    };
-    std::fs::create_dir_all(&dir).map_err(not_writable)?;
-    crate::output_file::probe_writable(&dir).map_err(not_writable)?;
-    // The merged folder is a results folder like any other: one writer, and
-    // results already there are replaced only when asked.
-    let _lock = FolderLock::acquire(&dir).map_err(RunError::from)?;
-    if !overwrite && (dir.join("runs.parquet").exists() || dir.join("summary.parquet").exists()) {
-        return Err(RunError::ResultsExist {
-            path: dir.display().to_string(),
-        }
-        .into());
-    }
+    check_every_run_once(&pieces, total, &first_dir)?;
+    let (dir, _lock) = claim_merged_folder(dirs, out, overwrite)?;
     let mut provenance = Provenance::new(&plan.text, plan.file.seed, "all");
     // The hash the shards recorded (older shards hashed the study file
     // with its `#:schema` line, which their folders' copies leave out).
@@ -181,4 +114,95 @@ pub fn merge(
         race: departures,
         runs_planned: plan.total_runs(),
     })
+}
+
+/// Each shard's runs table, and the plan they share ("plan id\nstudy
+/// text") with the first shard's folder; refused when a shard is
+/// unfinished or another study's or build's.
+fn read_shards(dirs: &[PathBuf]) -> Result<(Vec<Piece>, String, String), MergeError> {
+    let mut pieces: Vec<Piece> = Vec::new();
+    let mut study: Option<(String, String)> = None;
+    for dir in dirs {
+        let path = dir.join("runs.parquet");
+        if !path.exists() {
+            return Err(MergeError::Missing(dir.display().to_string()));
+        }
+        // The shard's plan: its study text and the build that ran it.
+        let text = std::fs::read_to_string(dir.join("study.toml"))
+            .map_err(|_| MergeError::Missing(dir.join("study.toml").display().to_string()))?;
+        let plan_id =
+            std::fs::read_to_string(dir.join(super::run::PLAN_ID_FILE)).unwrap_or_default();
+        let shard_plan = format!("{plan_id}\n{text}");
+        match &study {
+            None => study = Some((shard_plan, dir.display().to_string())),
+            Some((first, first_dir)) if *first != shard_plan => {
+                return Err(MergeError::DifferentStudy(
+                    dir.display().to_string(),
+                    first_dir.clone(),
+                ));
+            }
+            Some(_) => {}
+        }
+        pieces.push(Piece::open(&path)?);
+    }
+    let (shard_plan, first_dir) =
+        study.ok_or_else(|| MergeError::Missing("(no shard folders given)".into()))?;
+    Ok((pieces, shard_plan, first_dir))
+}
+
+/// The shards hold every run of the plan's `total`, each once.
+fn check_every_run_once(pieces: &[Piece], total: u64, first_dir: &str) -> Result<(), MergeError> {
+    let mut seen = vec![false; total as usize];
+    for &id in pieces.iter().flat_map(|p| p.ids()) {
+        match seen.get_mut(id as usize) {
+            Some(s) if !*s => *s = true,
+            Some(_) => return Err(MergeError::Duplicate(id)),
+            None => {
+                return Err(MergeError::BadStudy(
+                    first_dir.to_string(),
+                    format!("run {id} is outside the plan's {total} runs"),
+                ));
+            }
+        }
+    }
+    if let Some(first) = seen.iter().position(|s| !s) {
+        let missing = seen.iter().filter(|s| !**s).count() as u64;
+        return Err(MergeError::Incomplete {
+            missing,
+            total,
+            first: first as u64,
+        });
+    }
+    Ok(())
+}
+
+/// The merged folder (`out`, or the shards' parent), made, writable and
+/// locked: a results folder like any other, one writer, its results
+/// replaced only with `overwrite`.
+fn claim_merged_folder(
+    dirs: &[PathBuf],
+    out: Option<&Path>,
+    overwrite: bool,
+) -> Result<(PathBuf, FolderLock), MergeError> {
+    let dir = match out {
+        Some(o) => o.to_path_buf(),
+        None => dirs[0]
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from(".")),
+    };
+    let not_writable = |source| RunError::NotWritable {
+        path: dir.display().to_string(),
+        source,
+    };
+    std::fs::create_dir_all(&dir).map_err(not_writable)?;
+    crate::output_file::probe_writable(&dir).map_err(not_writable)?;
+    let lock = FolderLock::acquire(&dir).map_err(RunError::from)?;
+    if !overwrite && (dir.join("runs.parquet").exists() || dir.join("summary.parquet").exists()) {
+        return Err(RunError::ResultsExist {
+            path: dir.display().to_string(),
+        }
+        .into());
+    }
+    Ok((dir, lock))
 }

@@ -88,22 +88,12 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         .iter()
         .map(|b| {
             let e = &b.evaluation;
+            let [kind, n, rho] = design_cells(&e.candidate);
             vec![
                 b.scope.clone(),
-                match e.candidate.plane1 {
-                    Some(p) if p.kind != e.candidate.kind => {
-                        format!("{}/{}", e.candidate.kind, p.kind)
-                    }
-                    _ => e.candidate.kind.to_string(),
-                },
-                match e.candidate.plane1 {
-                    Some(p) => format!("{}/{}", e.candidate.n, p.n),
-                    None => e.candidate.n.to_string(),
-                },
-                match e.candidate.plane1 {
-                    Some(p) => format!("{:.3}/{:.3}", e.candidate.rho, p.rho),
-                    None => format!("{:.3}", e.candidate.rho),
-                },
+                kind,
+                n,
+                rho,
                 autobal::number_text::significant(e.candidate.drag, 4),
                 e.value.map_or("–".into(), |v| with_se(v, e.std_err)),
                 with_se(e.std_err, e.std_err),
@@ -155,6 +145,23 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         out.dir.display()
     ));
     Ok(())
+}
+
+/// A candidate's kind, n and ρ cells: "plane 0/plane 1" where a second
+/// plane's weights are its own.
+fn design_cells(c: &autobal::optimize::evaluate::Candidate) -> [String; 3] {
+    match c.plane1 {
+        Some(p) => [
+            if p.kind != c.kind {
+                format!("{}/{}", c.kind, p.kind)
+            } else {
+                c.kind.to_string()
+            },
+            format!("{}/{}", c.n, p.n),
+            format!("{:.3}/{:.3}", c.rho, p.rho),
+        ],
+        None => [c.kind.to_string(), c.n.to_string(), format!("{:.3}", c.rho)],
+    }
 }
 
 /// What the confirmation on fresh samples found: the overall pick and why,

@@ -83,6 +83,36 @@ pub fn plot_settling_times(data: &StudyData, path: &Path) -> Result<(), PlotErro
     style::render(&figure, path)
 }
 
+impl SettlingBoxes<'_> {
+    /// The labels every design shares, then how to read a box.
+    fn caption(&self) -> String {
+        format!(
+            "{}{}box: quartiles, bar: median, by Kaplan–Meier over every run (unsettled runs censored)",
+            self.labels.common,
+            if self.labels.common.is_empty() {
+                ""
+            } else {
+                ";  "
+            }
+        )
+    }
+
+    /// Each design's label, with its unsettled runs counted where it is named.
+    fn row_labels(&self, boxes: &[Option<BoxStats>]) -> Vec<String> {
+        self.labels
+            .per_design
+            .iter()
+            .zip(boxes)
+            .map(|(l, b)| match b {
+                Some(b) if b.unsettled > 0 => {
+                    format!("{l}  ({} of {} not settled)", b.unsettled, b.runs)
+                }
+                _ => l.clone(),
+            })
+            .collect()
+    }
+}
+
 impl Figure for SettlingBoxes<'_> {
     fn size(&self) -> (u32, u32) {
         (1100, category_height(self.data.designs.len()) + 24)
@@ -102,28 +132,8 @@ impl Figure for SettlingBoxes<'_> {
             .ok_or_else(|| PlotError::NoData("no positive settling time".into()))?;
         let x_format = style::log_formatter(lo, hi);
         let title = format!("{}: settling time per design", self.data.name);
-        let caption = format!(
-            "{}{}box: quartiles, bar: median, by Kaplan–Meier over every run (unsettled runs censored)",
-            self.labels.common,
-            if self.labels.common.is_empty() {
-                ""
-            } else {
-                ";  "
-            }
-        );
-        // Unsettled runs are counted where the design is named.
-        let row_labels: Vec<String> = self
-            .labels
-            .per_design
-            .iter()
-            .zip(&boxes)
-            .map(|(l, b)| match b {
-                Some(b) if b.unsettled > 0 => {
-                    format!("{l}  ({} of {} not settled)", b.unsettled, b.runs)
-                }
-                _ => l.clone(),
-            })
-            .collect();
+        let caption = self.caption();
+        let row_labels = self.row_labels(&boxes);
         let body = style::titled(root, &title)?;
         let body = style::text_block(&body, &caption, TICK)?;
         let body = style::text_block(
