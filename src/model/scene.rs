@@ -169,29 +169,7 @@ impl Scene {
     /// Check every field; the first problem found is returned.
     pub fn validate(&self) -> Result<(), SceneError> {
         self.rotor.validate()?;
-        match &self.speed {
-            SpeedLaw::Constant { omega } => spin_rate("speed.omega", *omega, false)?,
-            SpeedLaw::Ramp {
-                omega_start,
-                omega_end,
-                duration,
-            } => {
-                spin_rate("speed.omega_start", *omega_start, true)?;
-                spin_rate("speed.omega_end", *omega_end, false)?;
-                positive("speed.duration", *duration)?;
-            }
-            SpeedLaw::Motor {
-                stall_torque,
-                omega_sync,
-                omega_start,
-            } => {
-                positive("speed.stall_torque", *stall_torque)?;
-                spin_rate("speed.omega_sync", *omega_sync, false)?;
-                spin_rate("speed.omega_start", *omega_start, true)?;
-            }
-            // A free rotor coasts from its start: it must be spinning.
-            SpeedLaw::Free { omega_start } => spin_rate("speed.omega_start", *omega_start, false)?,
-        }
+        self.validate_speed()?;
         if self.rotor.as_rotor().tilt_map(0).is_some() && !self.speed.is_prescribed() {
             return Err(SceneError::Invalid {
                 field: "rotor.weights_tilt_inertia".into(),
@@ -216,102 +194,134 @@ impl Scene {
             )
             .collect();
         match (designs.is_empty(), self.cargo.is_empty()) {
-            (true, true) => {
-                return Err(SceneError::Invalid {
-                    field: "balancer".into(),
-                    value: "missing".into(),
-                    reason: "give a [balancer] design or a [[cargo]] list".into(),
-                });
+            (true, true) => Err(SceneError::Invalid {
+                field: "balancer".into(),
+                value: "missing".into(),
+                reason: "give a [balancer] design or a [[cargo]] list".into(),
+            }),
+            (false, false) => Err(SceneError::Invalid {
+                field: "balancer".into(),
+                value: "both [balancer] and [[cargo]]".into(),
+                reason: "give one of them, not both".into(),
+            }),
+            (false, true) => self.validate_designs(designs),
+            (true, false) => self.validate_cargo(),
+        }
+    }
+
+    /// The speed law's own values.
+    fn validate_speed(&self) -> Result<(), SceneError> {
+        match &self.speed {
+            SpeedLaw::Constant { omega } => spin_rate("speed.omega", *omega, false)?,
+            SpeedLaw::Ramp {
+                omega_start,
+                omega_end,
+                duration,
+            } => {
+                spin_rate("speed.omega_start", *omega_start, true)?;
+                spin_rate("speed.omega_end", *omega_end, false)?;
+                positive("speed.duration", *duration)?;
             }
-            (false, false) => {
-                return Err(SceneError::Invalid {
-                    field: "balancer".into(),
-                    value: "both [balancer] and [[cargo]]".into(),
-                    reason: "give one of them, not both".into(),
-                });
+            SpeedLaw::Motor {
+                stall_torque,
+                omega_sync,
+                omega_start,
+            } => {
+                positive("speed.stall_torque", *stall_torque)?;
+                spin_rate("speed.omega_sync", *omega_sync, false)?;
+                spin_rate("speed.omega_start", *omega_start, true)?;
             }
-            (false, true) => {
-                let weights: u64 = designs.iter().map(|(_, d)| u64::from(d.n)).sum();
-                if weights > MAX_TOTAL_WEIGHTS as u64 {
-                    return Err(SceneError::Invalid {
-                        field: designs[0].0.clone() + ".n",
-                        value: format!("{weights} weights in all"),
-                        reason: format!(
-                            "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
-                        ),
-                    });
-                }
-                for (key, d) in designs {
-                    if d.n == 0 {
-                        return Err(invalid(
-                            &format!("{key}.n"),
-                            0.0,
-                            "needs at least one weight",
-                        ));
-                    }
-                    within(
-                        &format!("{key}.race_radius"),
-                        d.race_radius,
-                        RACE_RADIUS_RANGE,
-                        "m",
-                    )?;
-                    within(&format!("{key}.density"), d.density, DENSITY_RANGE, "kg/m³")?;
-                    non_negative(&format!("{key}.drag"), d.drag)?;
-                    if d.kind == Kind::Roller {
-                        positive(&format!("{key}.roller_height"), d.roller_height)?;
-                    }
-                    check_plane(&format!("{key}.plane"), d.plane, &self.rotor)?;
-                    let rho = d.resolved_rho()?;
-                    crate::design::geometry::check_fits(d.n, rho)?;
-                }
+            // A free rotor coasts from its start: it must be spinning.
+            SpeedLaw::Free { omega_start } => spin_rate("speed.omega_start", *omega_start, false)?,
+        }
+        Ok(())
+    }
+
+    /// The `[balancer]` / `[[balancers]]` designs (`designs`: each with
+    /// its key).
+    fn validate_designs(&self, designs: Vec<(String, &DesignSpec)>) -> Result<(), SceneError> {
+        let weights: u64 = designs.iter().map(|(_, d)| u64::from(d.n)).sum();
+        if weights > MAX_TOTAL_WEIGHTS as u64 {
+            return Err(SceneError::Invalid {
+                field: designs[0].0.clone() + ".n",
+                value: format!("{weights} weights in all"),
+                reason: format!(
+                    "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
+                ),
+            });
+        }
+        for (key, d) in designs {
+            if d.n == 0 {
+                return Err(invalid(
+                    &format!("{key}.n"),
+                    0.0,
+                    "needs at least one weight",
+                ));
             }
-            (true, false) => {
-                if self.cargo.len() > MAX_TOTAL_WEIGHTS {
-                    return Err(SceneError::Invalid {
-                        field: "cargo".into(),
-                        value: format!("{} cargoes", self.cargo.len()),
-                        reason: format!(
-                            "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
-                        ),
-                    });
-                }
-                for (j, c) in self.cargo.iter().enumerate() {
-                    positive(&format!("cargo[{j}].mass"), c.mass)?;
-                    positive(&format!("cargo[{j}].track_radius"), c.track_radius)?;
-                    non_negative(&format!("cargo[{j}].drag"), c.drag)?;
-                    non_negative(&format!("cargo[{j}].rolling_coupling"), c.rolling_coupling)?;
-                    non_negative(&format!("cargo[{j}].rolling_inertia"), c.rolling_inertia)?;
-                    // As a race's radius: beyond it the weight's size is no
-                    // size (1e308 made every start a clash).
-                    if !(0.0..=RACE_RADIUS_RANGE.1).contains(&c.radius) {
-                        return Err(invalid(
-                            &format!("cargo[{j}].radius"),
-                            c.radius,
-                            &format!("must be in [0, {}] m (0: no contact)", RACE_RADIUS_RANGE.1),
-                        ));
-                    }
-                    // The weight's centre runs at l from the axis: a radius
-                    // above l would put the weight across the shaft.
-                    if c.radius > c.track_radius {
-                        return Err(invalid(
-                            &format!("cargo[{j}].radius"),
-                            c.radius,
-                            &format!(
-                                "is larger than cargo[{j}].track_radius = {} m: the weight's centre runs at the track radius, so a larger weight would reach across the axis",
-                                c.track_radius
-                            ),
-                        ));
-                    }
-                    if !(c.kappa.is_finite() && c.kappa >= 1.0) {
-                        return Err(invalid(
-                            &format!("cargo[{j}].kappa"),
-                            c.kappa,
-                            "must be ≥ 1",
-                        ));
-                    }
-                    check_plane(&format!("cargo[{j}].plane"), c.plane, &self.rotor)?;
-                }
+            within(
+                &format!("{key}.race_radius"),
+                d.race_radius,
+                RACE_RADIUS_RANGE,
+                "m",
+            )?;
+            within(&format!("{key}.density"), d.density, DENSITY_RANGE, "kg/m³")?;
+            non_negative(&format!("{key}.drag"), d.drag)?;
+            if d.kind == Kind::Roller {
+                positive(&format!("{key}.roller_height"), d.roller_height)?;
             }
+            check_plane(&format!("{key}.plane"), d.plane, &self.rotor)?;
+            let rho = d.resolved_rho()?;
+            crate::design::geometry::check_fits(d.n, rho)?;
+        }
+        Ok(())
+    }
+
+    /// The `[[cargo]]` weights given one by one.
+    fn validate_cargo(&self) -> Result<(), SceneError> {
+        if self.cargo.len() > MAX_TOTAL_WEIGHTS {
+            return Err(SceneError::Invalid {
+                field: "cargo".into(),
+                value: format!("{} cargoes", self.cargo.len()),
+                reason: format!(
+                    "at most {MAX_TOTAL_WEIGHTS} weights over every balancer: the state and the implicit method's Jacobian grow with their number"
+                ),
+            });
+        }
+        for (j, c) in self.cargo.iter().enumerate() {
+            positive(&format!("cargo[{j}].mass"), c.mass)?;
+            positive(&format!("cargo[{j}].track_radius"), c.track_radius)?;
+            non_negative(&format!("cargo[{j}].drag"), c.drag)?;
+            non_negative(&format!("cargo[{j}].rolling_coupling"), c.rolling_coupling)?;
+            non_negative(&format!("cargo[{j}].rolling_inertia"), c.rolling_inertia)?;
+            // As a race's radius: beyond it the weight's size is no
+            // size (1e308 made every start a clash).
+            if !(0.0..=RACE_RADIUS_RANGE.1).contains(&c.radius) {
+                return Err(invalid(
+                    &format!("cargo[{j}].radius"),
+                    c.radius,
+                    &format!("must be in [0, {}] m (0: no contact)", RACE_RADIUS_RANGE.1),
+                ));
+            }
+            // The weight's centre runs at l from the axis: a radius
+            // above l would put the weight across the shaft.
+            if c.radius > c.track_radius {
+                return Err(invalid(
+                    &format!("cargo[{j}].radius"),
+                    c.radius,
+                    &format!(
+                        "is larger than cargo[{j}].track_radius = {} m: the weight's centre runs at the track radius, so a larger weight would reach across the axis",
+                        c.track_radius
+                    ),
+                ));
+            }
+            if !(c.kappa.is_finite() && c.kappa >= 1.0) {
+                return Err(invalid(
+                    &format!("cargo[{j}].kappa"),
+                    c.kappa,
+                    "must be ≥ 1",
+                ));
+            }
+            check_plane(&format!("cargo[{j}].plane"), c.plane, &self.rotor)?;
         }
         Ok(())
     }

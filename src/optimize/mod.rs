@@ -83,12 +83,25 @@ pub fn checked_spec(plan: &StudyPlan) -> Result<OptimizeSpec, OptimizeError> {
     Ok(spec)
 }
 
+/// The `[optimize]` table's values, each against its own rule and the
+/// study's; the first problem found, naming its key.
 fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> {
-    let bad = |key: &str, value: String, reason: &str| OptimizeError::Invalid {
+    validate_bounds(spec)?;
+    validate_objective(spec)?;
+    validate_budget(spec, plan)
+}
+
+/// An `[optimize]` key's refusal.
+fn bad(key: &str, value: String, reason: &str) -> OptimizeError {
+    OptimizeError::Invalid {
         key: key.into(),
         value,
         reason: reason.into(),
-    };
+    }
+}
+
+/// What is free, within which bounds, and the capacity constraint.
+fn validate_bounds(spec: &OptimizeSpec) -> Result<(), OptimizeError> {
     if spec.free.is_empty() || !spec.free.contains(&spec::Variable::Rho) {
         return Err(bad(
             "free",
@@ -136,6 +149,11 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             "give safety_factor and max_unbalance together",
         ));
     }
+    Ok(())
+}
+
+/// The residual a `p_residual_below` objective counts against, and only there.
+fn validate_objective(spec: &OptimizeSpec) -> Result<(), OptimizeError> {
     match (spec.objective, spec.residual_spec) {
         (Objective::PResidualBelow, None) => {
             return Err(bad(
@@ -163,6 +181,11 @@ fn validate(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> 
             ));
         }
     }
+    Ok(())
+}
+
+/// Samples, evaluations and counts: within what a search can run.
+fn validate_budget(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), OptimizeError> {
     /// Most Monte Carlo samples per candidate (each a whole run, and the
     /// runs' metrics are held together).
     const MAX_SAMPLES: u32 = 1_000_000;
