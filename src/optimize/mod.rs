@@ -259,48 +259,9 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
     };
     let g = &plan.file.designs;
     let drag = g.drag.values()[0];
-    let mut cells = Vec::new();
-    for kind in g.kind.values() {
-        for n in g.n.values() {
-            if spec.min_n.is_none_or(|m| n >= m) {
-                cells.push((kind, n));
-            }
-        }
-    }
-    // With a design per plane, every (kind, n) of plane 1 for each of plane 0's.
+    // A second plane's own design (the complete optimisation below is of one balancer).
     let plane1 = g.per_plane.iter().find(|a| a.plane == 1);
-    let cells: Vec<evaluate::Candidate> = cells
-        .into_iter()
-        .flat_map(|(kind, n)| {
-            let base = evaluate::Candidate {
-                kind,
-                n,
-                rho: f64::NAN,
-                drag,
-                plane1: None,
-            };
-            match plane1 {
-                None => vec![base],
-                Some(a) => {
-                    let kinds = a.kind.as_ref().map_or(vec![kind], |k| k.values());
-                    let ns = a.n.as_ref().map_or(vec![n], |v| v.values());
-                    kinds
-                        .iter()
-                        .flat_map(|&k1| {
-                            ns.iter().map(move |&n1| evaluate::Candidate {
-                                plane1: Some(evaluate::PlaneChoice {
-                                    kind: k1,
-                                    n: n1,
-                                    rho: f64::NAN,
-                                }),
-                                ..base
-                            })
-                        })
-                        .collect()
-                }
-            }
-        })
-        .collect();
+    let cells = search_cells(&spec, g, drag);
     let results: Vec<_> = cells
         .par_iter()
         .with_max_len(1) // one search per job, as runs (study::run)
@@ -385,6 +346,58 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
         dir,
         confirmation,
     })
+}
+
+/// The searches to run: each (kind, n) of the designs allowed by `min_n`
+/// (ρ to be found, `drag` fixed), and with a design per plane every
+/// (kind, n) of plane 1 for each of plane 0's.
+fn search_cells(
+    spec: &OptimizeSpec,
+    g: &crate::study::config::DesignGrid,
+    drag: f64,
+) -> Vec<evaluate::Candidate> {
+    let mut cells = Vec::new();
+    for kind in g.kind.values() {
+        for n in g.n.values() {
+            if spec.min_n.is_none_or(|m| n >= m) {
+                cells.push((kind, n));
+            }
+        }
+    }
+    // With a design per plane, every (kind, n) of plane 1 for each of plane 0's.
+    let plane1 = g.per_plane.iter().find(|a| a.plane == 1);
+    cells
+        .into_iter()
+        .flat_map(|(kind, n)| {
+            let base = evaluate::Candidate {
+                kind,
+                n,
+                rho: f64::NAN,
+                drag,
+                plane1: None,
+            };
+            match plane1 {
+                None => vec![base],
+                Some(a) => {
+                    let kinds = a.kind.as_ref().map_or(vec![kind], |k| k.values());
+                    let ns = a.n.as_ref().map_or(vec![n], |v| v.values());
+                    kinds
+                        .iter()
+                        .flat_map(|&k1| {
+                            ns.iter().map(move |&n1| evaluate::Candidate {
+                                plane1: Some(evaluate::PlaneChoice {
+                                    kind: k1,
+                                    n: n1,
+                                    rho: f64::NAN,
+                                }),
+                                ..base
+                            })
+                        })
+                        .collect()
+                }
+            }
+        })
+        .collect()
 }
 
 /// Each count's search (one design per plane) checked against the other
