@@ -213,96 +213,131 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
             .balance_angle_error_deg),
         col!("wall_time_s", |r: &RunRecord| r.wall_time_s),
     ];
-    // All rows of a study sample tolerances or none do.
-    if rows.iter().any(|r| r.weights.is_some()) {
-        let weights = |pick: fn(&SampledWeights) -> &Vec<f64>| {
-            rows.iter()
-                .map(move |r| r.weights.as_ref().map(pick).cloned().unwrap_or_default())
-        };
-        let [masses, radii, tracks] = WEIGHT_COLUMNS;
-        columns.push(list_column(masses, weights(|w| &w.masses)));
-        columns.push(list_column(radii, weights(|w| &w.radii)));
-        columns.push(list_column(tracks, weights(|w| &w.track_radii)));
-        let race = |pick: fn(&(f64, f64)) -> f64| {
-            rows.iter()
-                .map(move |r| r.weights.as_ref().and_then(|w| w.race.as_ref()).map(pick))
-                .collect::<Vec<_>>()
-        };
-        let [offset, angle] = RACE_COLUMNS;
-        columns.push(Column::new(offset.into(), race(|r| r.0)));
-        columns.push(Column::new(angle.into(), race(|r| r.1)));
-    }
-    // Every row of a study has the same rotor: per-plane values or none.
-    if rows.iter().any(|r| r.metrics.plane_a_ref.is_some()) {
-        let [a, res, settling, eps] = PLANE_COLUMNS;
-        columns.push(list_column(
-            a,
-            rows.iter()
-                .map(|r| r.metrics.plane_a_ref.clone().unwrap_or_default()),
-        ));
-        columns.push(list_column(
-            res,
-            rows.iter()
-                .map(|r| r.metrics.plane_residual_abs.clone().unwrap_or_default()),
-        ));
-        let per_run: Vec<Series> = rows
-            .iter()
-            .map(|r| {
-                let v = r.metrics.plane_settling_revs.clone().unwrap_or_default();
-                Series::new(PlSmallStr::EMPTY, v)
-            })
-            .collect();
-        columns.push(Column::new(settling.into(), per_run));
-        // Empty where the model defines no per-plane ε (one balancer plane).
-        columns.push(list_column(
-            eps,
-            rows.iter()
-                .map(|r| r.metrics.plane_balancing_error.clone().unwrap_or_default()),
-        ));
-    }
-    // Every row of a study has the same rotor: bearings for all or none.
-    if rows.iter().any(|r| r.metrics.bearing_orbit_peak.is_some()) {
-        let [peak, rms] = BEARING_COLUMNS;
-        columns.push(list_column(
-            peak,
-            rows.iter()
-                .map(|r| r.metrics.bearing_orbit_peak.clone().unwrap_or_default()),
-        ));
-        columns.push(list_column(
-            rms,
-            rows.iter()
-                .map(|r| r.metrics.bearing_orbit_rms.clone().unwrap_or_default()),
-        ));
-    }
-    // All rows of a study sample a couple or none do.
-    if rows.iter().any(|r| r.couple.is_some()) {
-        let [u, fraction, direction, planes, plane_dirs] = COUPLE_COLUMNS;
-        let pick = |f: fn(&SampledCouple) -> f64| {
-            rows.iter()
-                .map(|r| r.couple.as_ref().map(f))
-                .collect::<Vec<_>>()
-        };
-        columns.push(Column::new(u.into(), pick(|c| c.unbalance)));
-        columns.push(Column::new(fraction.into(), pick(|c| c.fraction)));
-        columns.push(Column::new(direction.into(), pick(|c| c.direction_deg)));
-        let per_plane = |r: &RunRecord| {
-            r.couple.as_ref().map_or_else(Vec::new, |c| {
-                plane_unbalances((r.unbalance, r.direction_deg.to_radians()), c).to_vec()
-            })
-        };
-        columns.push(list_column(
-            planes,
-            rows.iter()
-                .map(|r| per_plane(r).iter().map(|p| p.0).collect()),
-        ));
-        columns.push(list_column(
-            plane_dirs,
-            rows.iter()
-                .map(|r| per_plane(r).iter().map(|p| p.1.to_degrees()).collect()),
-        ));
-    }
+    columns.extend(tolerance_columns(rows));
+    columns.extend(plane_columns(rows));
+    columns.extend(bearing_columns(rows));
+    columns.extend(couple_columns(rows));
     columns.extend(uncertain_columns(rows));
     DataFrame::new(rows.len(), columns)
+}
+
+/// The sampled tolerances' columns (each weight's mass, radius and track,
+/// the race's offset and angle), when the study samples them.
+fn tolerance_columns(rows: &[RunRecord]) -> Vec<Column> {
+    // All rows of a study sample tolerances or none do.
+    let mut columns = Vec::new();
+    if !rows.iter().any(|r| r.weights.is_some()) {
+        return columns;
+    }
+    let weights = |pick: fn(&SampledWeights) -> &Vec<f64>| {
+        rows.iter()
+            .map(move |r| r.weights.as_ref().map(pick).cloned().unwrap_or_default())
+    };
+    let [masses, radii, tracks] = WEIGHT_COLUMNS;
+    columns.push(list_column(masses, weights(|w| &w.masses)));
+    columns.push(list_column(radii, weights(|w| &w.radii)));
+    columns.push(list_column(tracks, weights(|w| &w.track_radii)));
+    let race = |pick: fn(&(f64, f64)) -> f64| {
+        rows.iter()
+            .map(move |r| r.weights.as_ref().and_then(|w| w.race.as_ref()).map(pick))
+            .collect::<Vec<_>>()
+    };
+    let [offset, angle] = RACE_COLUMNS;
+    columns.push(Column::new(offset.into(), race(|r| r.0)));
+    columns.push(Column::new(angle.into(), race(|r| r.1)));
+    columns
+}
+
+/// Each balancer plane's A_ref, residual, settling and ε, on rotors with
+/// several planes.
+fn plane_columns(rows: &[RunRecord]) -> Vec<Column> {
+    // Every row of a study has the same rotor: per-plane values or none.
+    let mut columns = Vec::new();
+    if !rows.iter().any(|r| r.metrics.plane_a_ref.is_some()) {
+        return columns;
+    }
+    let [a, res, settling, eps] = PLANE_COLUMNS;
+    columns.push(list_column(
+        a,
+        rows.iter()
+            .map(|r| r.metrics.plane_a_ref.clone().unwrap_or_default()),
+    ));
+    columns.push(list_column(
+        res,
+        rows.iter()
+            .map(|r| r.metrics.plane_residual_abs.clone().unwrap_or_default()),
+    ));
+    let per_run: Vec<Series> = rows
+        .iter()
+        .map(|r| {
+            let v = r.metrics.plane_settling_revs.clone().unwrap_or_default();
+            Series::new(PlSmallStr::EMPTY, v)
+        })
+        .collect();
+    columns.push(Column::new(settling.into(), per_run));
+    // Empty where the model defines no per-plane ε (one balancer plane).
+    columns.push(list_column(
+        eps,
+        rows.iter()
+            .map(|r| r.metrics.plane_balancing_error.clone().unwrap_or_default()),
+    ));
+    columns
+}
+
+/// Each bearing's orbit peak and RMS, on rotors with bearings.
+fn bearing_columns(rows: &[RunRecord]) -> Vec<Column> {
+    // Every row of a study has the same rotor: bearings for all or none.
+    let mut columns = Vec::new();
+    if !rows.iter().any(|r| r.metrics.bearing_orbit_peak.is_some()) {
+        return columns;
+    }
+    let [peak, rms] = BEARING_COLUMNS;
+    columns.push(list_column(
+        peak,
+        rows.iter()
+            .map(|r| r.metrics.bearing_orbit_peak.clone().unwrap_or_default()),
+    ));
+    columns.push(list_column(
+        rms,
+        rows.iter()
+            .map(|r| r.metrics.bearing_orbit_rms.clone().unwrap_or_default()),
+    ));
+    columns
+}
+
+/// The sampled couple's columns and each plane's unbalance, when the
+/// study samples a couple.
+fn couple_columns(rows: &[RunRecord]) -> Vec<Column> {
+    // All rows of a study sample a couple or none do.
+    let mut columns = Vec::new();
+    if !rows.iter().any(|r| r.couple.is_some()) {
+        return columns;
+    }
+    let [u, fraction, direction, planes, plane_dirs] = COUPLE_COLUMNS;
+    let pick = |f: fn(&SampledCouple) -> f64| {
+        rows.iter()
+            .map(|r| r.couple.as_ref().map(f))
+            .collect::<Vec<_>>()
+    };
+    columns.push(Column::new(u.into(), pick(|c| c.unbalance)));
+    columns.push(Column::new(fraction.into(), pick(|c| c.fraction)));
+    columns.push(Column::new(direction.into(), pick(|c| c.direction_deg)));
+    let per_plane = |r: &RunRecord| {
+        r.couple.as_ref().map_or_else(Vec::new, |c| {
+            plane_unbalances((r.unbalance, r.direction_deg.to_radians()), c).to_vec()
+        })
+    };
+    columns.push(list_column(
+        planes,
+        rows.iter()
+            .map(|r| per_plane(r).iter().map(|p| p.0).collect()),
+    ));
+    columns.push(list_column(
+        plane_dirs,
+        rows.iter()
+            .map(|r| per_plane(r).iter().map(|p| p.1.to_degrees()).collect()),
+    ));
+    columns
 }
 
 /// One column `scene.<key>` per uncertain key, in the study's key order
