@@ -2,7 +2,7 @@
 # Every table of docs/validation.md, in the page's order: the washer cases
 # (Table 2 and Fig. 12, the run-up, the ball angles), the bands over the
 # unknowns, the calibration on Fig. 12 and the protocol's effect at the
-# fitted values, and the ball angles as a fitted point. About 40 minutes
+# fitted values, and the ball angles as a fitted point. About 35 minutes
 # on two cores, after `cargo build`;
 # Python with numpy, scipy and polars.
 # Usage: scripts/bristol-validation.sh [path/to/study] [output folder]
