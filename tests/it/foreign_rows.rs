@@ -15,6 +15,16 @@ fn study_bin(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `study ARGS`, which must succeed.
+fn study_ok(args: &[&str]) {
+    let out = study_bin(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// The corpus study under `results`, with `seed`, written to `file`.
 fn study_file(dir: &Path, results: &Path, seed: u64, file: &str) -> PathBuf {
     let text = crate::bad_input::study(results).replace("seed = 5", &format!("seed = {seed}"));
@@ -42,12 +52,7 @@ fn a_table_of_another_seed_is_neither_resumed_nor_compared() {
     let five = study_file(tmp.path(), &a, 5, "five.toml");
     let six = study_file(tmp.path(), &b, 6, "six.toml");
     for path in [&five, &six] {
-        let out = study_bin(&["run", path.to_str().unwrap(), "--quiet"]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        study_ok(&["run", path.to_str().unwrap(), "--quiet"]);
     }
     let folder = b.join("corpus");
     let runs = folder.join("runs.parquet");
@@ -78,19 +83,9 @@ fn a_shard_of_another_seed_is_not_merged() {
     let five = study_file(tmp.path(), &a, 5, "five.toml");
     let six = study_file(tmp.path(), &b, 6, "six.toml");
     for k in ["1/2", "2/2"] {
-        let out = study_bin(&["run", five.to_str().unwrap(), "--quiet", "--shard", k]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        study_ok(&["run", five.to_str().unwrap(), "--quiet", "--shard", k]);
     }
-    let out = study_bin(&["run", six.to_str().unwrap(), "--quiet", "--shard", "1/2"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    study_ok(&["run", six.to_str().unwrap(), "--quiet", "--shard", "1/2"]);
     let shards = a.join("corpus");
     let first = shards.join("shard-1-of-2");
     let runs = first.join("runs.parquet");
@@ -116,8 +111,7 @@ fn a_resume_without_the_plan_id_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("r");
     let path = study_file(tmp.path(), &results, 5, "s.toml");
-    let out = study_bin(&["run", path.to_str().unwrap(), "--quiet"]);
-    assert!(out.status.success());
+    study_ok(&["run", path.to_str().unwrap(), "--quiet"]);
     let folder = results.join("corpus");
     std::fs::remove_file(folder.join("plan.sha256")).unwrap();
     std::fs::remove_file(folder.join("summary.parquet")).unwrap();
@@ -136,8 +130,7 @@ fn a_read_only_results_folder_is_not_overwritten() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("r");
     let path = study_file(tmp.path(), &results, 5, "s.toml");
-    let out = study_bin(&["run", path.to_str().unwrap(), "--quiet"]);
-    assert!(out.status.success());
+    study_ok(&["run", path.to_str().unwrap(), "--quiet"]);
     let folder = results.join("corpus");
     let before = crate::bad_input::tree_snapshot(&folder);
     let mode = |m: u32| std::fs::set_permissions(&folder, std::fs::Permissions::from_mode(m));

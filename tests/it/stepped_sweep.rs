@@ -149,20 +149,22 @@ fn a_reading_window_is_the_recorded_samples_at_the_dwells_end() {
     }
 }
 
+/// `study stepped ARGS` from the repository's root.
+fn stepped(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("stepped")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
 /// `study stepped` warns where a scene makes the protocol matter or its
 /// weights unlike solid balls, writes the recording with --series, and
 /// refuses flags that cannot take effect, naming them.
 #[test]
 fn the_stepped_verb_warns_records_and_refuses_by_flag() {
-    use std::process::Command;
-    let study = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_study"))
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .arg("stepped")
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let study = stepped;
     let dir = tempfile::tempdir().unwrap();
     let series = dir.path().join("series.parquet");
     let out = study(&[
@@ -242,17 +244,8 @@ fn the_stepped_verb_warns_records_and_refuses_by_flag() {
 /// before any dwell, exit 2, naming the flag and writing nothing.
 #[test]
 fn an_endless_sweep_and_a_csv_name_are_refused_up_front() {
-    use std::process::Command;
     let dir = tempfile::tempdir().unwrap();
-    let study = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_study"))
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .arg("stepped")
-            .arg("scenes/three_balls.toml")
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let study = |args: &[&str]| stepped(&[&["scenes/three_balls.toml"], args].concat());
     let endless = study(&["--rpm", "8e6..9e6", "--step-rpm", "1e5", "--dwell", "86400"]);
     let err = String::from_utf8_lossy(&endless.stderr);
     assert_eq!(endless.status.code(), Some(2), "{err}");
