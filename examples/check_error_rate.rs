@@ -12,11 +12,11 @@
 use autobal::check::compare::DEFAULT_ALPHA;
 use autobal::check::plant::{AlarmCount, Planted, alarms_independent, alarms_paired};
 use autobal::check::samples::{DesignSample, design_samples};
+use autobal::decide::verdict::settling_horizon;
 use autobal::stats::interval::wilson_interval;
-use autobal::study::config::load;
-use autobal::study::io::read_parquet;
+use autobal::study::plan::config::load;
+use autobal::study::results::io::read_parquet;
 use autobal::study::run::{NoProgress, RunOptions, run_study};
-use autobal::study::verdict::settling_horizon;
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

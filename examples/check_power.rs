@@ -11,8 +11,8 @@
 
 use autobal::check::compare::{CheckReport, DEFAULT_ALPHA, Metric, Verdict, compare};
 use autobal::check::samples::{DesignSample, design_samples};
-use autobal::study::config::{OneOrMany, StudyPlan, load};
-use autobal::study::record::to_dataframe;
+use autobal::study::plan::config::{OneOrMany, StudyPlan, load};
+use autobal::study::results::record::to_dataframe;
 use autobal::study::run::{NoProgress, RunOptions, run_study};
 use std::path::PathBuf;
 

@@ -10,8 +10,8 @@
 
 use autobal::optimize::evaluate::measured_residual;
 use autobal::stats::quantile::{Interpolation, quantile};
-use autobal::study::io::read_parquet;
-use autobal::study::record::{RunRecord, from_dataframe};
+use autobal::study::results::io::read_parquet;
+use autobal::study::results::record::{RunRecord, from_dataframe};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 

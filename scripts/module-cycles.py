@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Import cycles and layer violations between the modules of the library.
 
-Three graphs are checked: the crate's top modules (design, model, integrate,
-study, ...), the units inside `model` and the units inside `study`. A "unit"
+Graphs checked: the crate's top modules (design, model, integrate, decide,
+...; the study's three rooms, study::plan, study::results and study::run,
+count as modules of their own), the units inside `model`, the rooms of
+`study`, and the units inside `decide` and inside each room. A "unit"
 is a direct child of its parent (a file such as scene.rs, or a folder such as rotor/ together with
 everything below it): edges inside a unit (a file using its folder's mod.rs
 and the re-exports back) are how Rust folders work and are not counted.
@@ -25,6 +27,13 @@ CRATE_LAYERS = [
     {"model"},
     {"metrics"},
     {"simulation", "scene_file", "uncertain"},
+    # The study's rooms and the decision between them: the study file, what
+    # runs leave, the decision over them, the runner that uses all three, and
+    # the verbs on top of the runner (the rest of `study`).
+    {"study::plan"},
+    {"study::results"},
+    {"decide"},
+    {"study::run"},
     {"study"},
     {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report", "calibrate"},
 ]
@@ -34,20 +43,36 @@ MODEL_LAYERS = [
     {"system", "frame", "scene", "forced", "gap", "invariants", "linear", "balanced_family", "quasi_static", "start",
      "unbalance", "zero_approx", "critical_speeds"},
 ]
-STUDY_LAYERS = [
-    # Plain data and helpers: streams, distributions, a resolved design, a
-    # design's measured runs, files.
-    {"stream", "truncated", "distribution", "design", "measured_runs", "io", "lock", "runs_file", "summary_columns", "results_table"},
-    # The parts of the study file that check, draw or measure on their own.
-    {"couple", "tolerance", "plane_designs", "criterion", "optimize_spec"},
-    # The study file and its resolved plan.
+# Inside each room, lowest first.
+PLAN_LAYERS = [
+    {"stream", "truncated", "distribution", "design", "optimize_spec", "criterion"},
+    {"couple", "tolerance", "plane_designs"},
     {"config"},
-    # One run or one design, from a plan.
-    {"sample", "record", "failures", "diagnosis", "design_runs", "verdict", "plane_summary"},
-    # Statistics over many runs.
-    {"adaptive", "aggregate", "compare_designs", "decision", "racing", "robustness"},
-    # The runner and the verbs on top of it.
-    {"run", "merge", "study_folder", "sweep", "stability_map", "sensitivity", "stepped_bands"},
+    {"sample"},
+]
+RESULTS_LAYERS = [
+    {"io", "measured_runs", "summary_columns"},
+    {"results_table", "record"},
+    {"runs_file"},
+    {"design_runs"},
+]
+DECIDE_LAYERS = [
+    {"measure", "diagnosis", "failures", "robustness"},
+    {"verdict", "plane_summary"},
+    {"decision", "compare_designs"},
+]
+RUN_LAYERS = [
+    {"lock", "racing"},
+    {"adaptive", "aggregate"},
+    # The executor (run/mod.rs and its private files) and what uses it.
+    {"mod", "assemble", "executor", "folder"},
+    {"merge", "study_folder"},
+]
+STUDY_LAYERS = [
+    {"plan"},
+    {"results"},
+    {"run"},
+    {"sweep", "stability_map", "sensitivity", "stepped_bands"},
 ]
 
 CODE_NOISE = re.compile(
@@ -64,6 +89,16 @@ def module_path(file: Path) -> tuple:
     if parts[-1] == "mod":
         parts.pop()
     return tuple(parts)
+
+
+ROOMS = {"plan", "results", "run"}
+
+
+def crate_unit(path: tuple) -> tuple:
+    """A module path with the study's rooms joined into one crate-level unit."""
+    if len(path) >= 2 and path[0] == "study" and path[1] in ROOMS:
+        return ("study::" + path[1],) + path[2:]
+    return path
 
 
 def expand(tree: str) -> list:
@@ -115,17 +150,19 @@ def resolve(path: str, here: tuple, modules: set):
     return None
 
 
-def analyse(files, modules, depth: int, title: str, layers) -> int:
-    """Edges between the units at `depth` (0: crate modules, 1: inside one)."""
+def analyse(files, modules, depth: int, title: str, layers, unit=lambda p: p) -> int:
+    """Edges between the units at `depth` (0: crate modules, 1: inside one,
+    2: inside a room), after `unit` renames a path."""
     edges = {}
     for f in files:
-        here = module_path(f)
+        here = unit(module_path(f))
         code = CODE_NOISE.sub(" ", f.read_text())
         paths = [p for tree in USE.findall(code) for p in expand(tree)]
         code_wo_use = USE.sub(" ", code)
         paths += [re.sub(r"\s+", "", m) for m in INLINE.findall(code_wo_use)]
         for p in paths:
-            target = resolve(p, here, modules)
+            target = resolve(p, module_path(f), modules)
+            target = unit(target) if target else None
             if not target or len(target) <= depth or len(here) <= depth:
                 continue
             if target[:depth] != here[:depth]:
@@ -135,7 +172,7 @@ def analyse(files, modules, depth: int, title: str, layers) -> int:
                 edges.setdefault(a, {}).setdefault(b, set()).add(
                     "/".join(f.relative_to(ROOT).parts)
                 )
-    units = sorted({module_path(f)[depth] for f in files if len(module_path(f)) > depth})
+    units = sorted({unit(module_path(f))[depth] for f in files if len(unit(module_path(f))) > depth})
 
     print(f"{title} -> units it imports")
     for u in units:
@@ -192,14 +229,25 @@ def analyse(files, modules, depth: int, title: str, layers) -> int:
     return bad
 
 
+def in_room(path: tuple) -> tuple:
+    """A path inside a room, with the room's own module (mod.rs) as unit "mod"."""
+    return path + ("mod",) if len(path) == 2 else path
+
+
 def main() -> int:
     files = sorted(p for p in ROOT.rglob("*.rs") if "bin" not in p.relative_to(ROOT).parts)
     modules = {module_path(f) for f in files}
-    bad = analyse(files, modules, 0, "crate module", CRATE_LAYERS)
+    bad = analyse(files, modules, 0, "crate module", CRATE_LAYERS, crate_unit)
     model_files = [f for f in files if module_path(f)[:1] == ("model",)]
     bad += analyse(model_files, modules, 1, "model unit", MODEL_LAYERS)
     study_files = [f for f in files if module_path(f)[:1] == ("study",)]
-    bad += analyse(study_files, modules, 1, "study unit", STUDY_LAYERS)
+    bad += analyse(study_files, modules, 1, "study room", STUDY_LAYERS)
+    decide_files = [f for f in files if module_path(f)[:1] == ("decide",)]
+    bad += analyse(decide_files, modules, 1, "decide unit", DECIDE_LAYERS)
+    for room, layers in (("plan", PLAN_LAYERS), ("results", RESULTS_LAYERS), ("run", RUN_LAYERS)):
+        room_files = [f for f in files if module_path(f)[:2] == ("study", room)]
+        unit = in_room if room == "run" else (lambda p: p)
+        bad += analyse(room_files, modules, 2, f"study::{room} unit", layers, unit)
     return 1 if bad else 0
 
 

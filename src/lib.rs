@@ -16,7 +16,11 @@
 //!   outcome — defined once.
 //! - [`simulation`]: one run at a chosen fidelity; [`uncertain`]: scene keys
 //!   nobody measured exactly, as distributions written into a run's scene.
-//! - [`study`]: many runs on all cores, statistics with polars, Parquet.
+//! - [`study`]: many runs on all cores, statistics with polars, Parquet, in
+//!   three rooms: the study file ([`study::plan`]), what runs leave
+//!   ([`study::results`]) and the runner ([`study::run`]).
+//! - [`decide`]: summaries into a decision — criteria measured, verdicts,
+//!   diagnosis, the typed decision — used by the runner, the CLI and the report.
 //! - Analyses on top: [`optimize`], [`claims`], [`tradeoff`], [`check`], [`plot`],
 //!   sharing one set of statistics ([`stats`]).
 //!
@@ -33,6 +37,7 @@ pub mod build_info;
 pub mod calibrate;
 pub mod check;
 pub mod claims;
+pub mod decide;
 pub mod design;
 pub mod input_file;
 pub mod integrate;

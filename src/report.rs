@@ -4,11 +4,11 @@
 //! in the page is fetched: no script, font, style sheet or image comes
 //! from elsewhere, so it opens offline and can be mailed as one file.
 
+use crate::decide::compare_designs::Side;
 use crate::plot::Format;
 use crate::plot::PlotError;
 use crate::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use crate::plot::study::{StudyData, StudyFigure, plot_study};
-use crate::study::compare_designs::Side;
 use std::path::Path;
 
 /// A figure of the page.

@@ -12,7 +12,7 @@
 use crate::integrate::Method;
 use crate::scene_file::SceneFile;
 use crate::simulation::MethodChoice;
-use crate::study::config::StudyFile;
+use crate::study::plan::config::StudyFile;
 use schemars::generate::SchemaSettings;
 use schemars::transform::{Transform, transform_subschemas};
 use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};

@@ -15,8 +15,8 @@ use crate::model::effect::contact::ContactModel;
 use crate::model::frame::rotating_frame_obstacle;
 use crate::simulation::{Fidelity, MethodChoice};
 use crate::stats::quantile::{Interpolation, quantile_sorted};
-use crate::study::config::StudyPlan;
-use crate::study::io::{Provenance, write_parquet};
+use crate::study::plan::config::StudyPlan;
+use crate::study::results::io::{Provenance, write_parquet};
 use crate::study::run::sample_simulation;
 use polars::prelude::*;
 use serde::Serialize;
@@ -277,7 +277,7 @@ pub fn measure(plan: &StudyPlan, runs: &[u64]) -> Vec<TradeoffRow> {
     let reference = reference(plan);
     let mut rows = Vec::new();
     let samples = u64::from(plan.file.sampling.samples);
-    let horizon_revs = crate::study::verdict::settling_horizon(plan);
+    let horizon_revs = crate::decide::verdict::settling_horizon(plan);
     for &run_id in runs {
         let design_id = plan.designs[(run_id / samples) as usize].id;
         let (reference, _) = simulate(plan, run_id, reference);

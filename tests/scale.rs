@@ -3,7 +3,7 @@
 //! Its own test binary, so that the process's peak resident memory
 //! (VmHWM) is this study's and no other test's.
 
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
 use autobal::study::run::{NoProgress, RunOptions, run_study};
 use polars::prelude::*;
 use std::fs::File;

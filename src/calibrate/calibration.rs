@@ -13,7 +13,7 @@ use super::posterior::{
     Proposal, effective_size, log_weight, normalised, predictive_quantile, weighted_quantile,
 };
 use super::problem::{Prediction, RigProblem};
-use crate::study::stream::{Purpose, stream};
+use crate::study::plan::stream::{Purpose, stream};
 use rand::RngExt;
 use rayon::prelude::*;
 use std::sync::Arc;

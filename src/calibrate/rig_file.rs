@@ -44,7 +44,7 @@ pub struct RigFile {
 }
 
 fn default_seed() -> u64 {
-    crate::study::config::DEFAULT_SEED
+    crate::study::plan::config::DEFAULT_SEED
 }
 
 /// How the rig ran a case and read its quantities.

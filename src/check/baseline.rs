@@ -10,16 +10,16 @@
 //! Both Parquet files carry the usual provenance metadata as well.
 
 use super::samples::{DesignSample, columns_of, design_samples};
-use crate::study::aggregate::summarize;
-use crate::study::config::StudyPlan;
-use crate::study::io::{Provenance, read_metadata, write_parquet, write_text};
-use crate::study::record::{RunRecord, to_dataframe};
+use crate::study::plan::config::StudyPlan;
+use crate::study::results::io::{Provenance, read_metadata, write_parquet, write_text};
+use crate::study::results::record::{RunRecord, to_dataframe};
+use crate::study::run::aggregate::summarize;
 use polars::prelude::PolarsError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// File name of the manifest.
-pub use crate::study::study_folder::BASELINE_MANIFEST as MANIFEST;
+pub use crate::study::run::study_folder::BASELINE_MANIFEST as MANIFEST;
 
 /// Version of the folder layout; bumped when it changes incompatibly.
 pub const FORMAT: u32 = 1;
@@ -132,7 +132,7 @@ pub fn write_baseline(
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
     write_text(
         &dir.join("study.toml"),
-        &crate::study::io::folder_copy(&plan.text),
+        &crate::study::results::io::folder_copy(&plan.text),
     )?;
     let manifest = Manifest {
         format: FORMAT,
@@ -196,9 +196,9 @@ pub fn read_baseline(dir: &Path) -> Result<Baseline, BaselineError> {
             "runs.parquet comes from another study than the manifest names".into(),
         ));
     }
-    let df = crate::study::results_table::read_table(
+    let df = crate::study::results::results_table::read_table(
         &runs_path,
-        crate::study::results_table::TableKind::Runs,
+        crate::study::results::results_table::TableKind::Runs,
     )?;
     if df.height() as u64 != manifest.runs {
         return Err(inconsistent(format!(
@@ -216,8 +216,8 @@ pub fn read_baseline(dir: &Path) -> Result<Baseline, BaselineError> {
 
 /// Refuse a baseline written from another study text than `plan`'s.
 pub fn check_same_study(baseline: &Baseline, plan: &StudyPlan) -> Result<(), BaselineError> {
-    let study = crate::study::io::study_sha256(&plan.text);
-    if !crate::study::io::same_study(&baseline.manifest.study_sha256, &plan.text) {
+    let study = crate::study::results::io::study_sha256(&plan.text);
+    if !crate::study::results::io::same_study(&baseline.manifest.study_sha256, &plan.text) {
         return Err(BaselineError::DifferentStudy {
             dir: baseline.dir.display().to_string(),
             baseline: baseline.manifest.study_sha256.clone(),

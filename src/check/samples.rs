@@ -74,7 +74,7 @@ pub fn design_samples(df: &DataFrame) -> PolarsResult<Vec<DesignSample>> {
     let settled = df.column("settled")?.bool()?.clone();
     let revs = df.column("settling_revs")?.f64()?.clone();
     let residual = df.column("residual_rel")?.f64()?.clone();
-    let plane_settling = crate::study::record::nullable_lists(df, PLANE_COLUMNS[0])?;
+    let plane_settling = crate::study::results::record::nullable_lists(df, PLANE_COLUMNS[0])?;
     let mut out: Vec<DesignSample> = Vec::new();
     let mut order: Vec<usize> = (0..df.height()).collect();
     order.sort_by_key(|&i| design[i]);

@@ -13,9 +13,9 @@
 use super::baseline::{BaselineError, Manifest, check_same_study, read_baseline, write_baseline};
 use super::compare::{CheckReport, CompareError, compare};
 use super::samples::design_samples;
-use crate::study::config::StudyPlan;
-use crate::study::io::{read_metadata, read_parquet};
-use crate::study::results_table::{TableKind, read_table};
+use crate::study::plan::config::StudyPlan;
+use crate::study::results::io::{read_metadata, read_parquet};
+use crate::study::results::results_table::{TableKind, read_table};
 use crate::study::run::{Progress, RunError, RunOptions, run_study};
 use polars::prelude::PolarsError;
 use std::path::{Path, PathBuf};
@@ -81,7 +81,7 @@ pub enum CheckError {
     },
 }
 
-pub use crate::study::study_folder::SCRATCH_MARK;
+pub use crate::study::run::study_folder::SCRATCH_MARK;
 
 /// Whether `dir` may take a check's (or a baseline's) fresh run: it does
 /// not exist, is empty, or holds an earlier scratch run.
@@ -144,7 +144,7 @@ impl CheckError {
                 true
             }
             CheckError::Run(e) => e.is_user_error(),
-            CheckError::Polars(e) => crate::study::io::is_not_parquet(e),
+            CheckError::Polars(e) => crate::study::results::io::is_not_parquet(e),
         }
     }
 }
@@ -278,7 +278,9 @@ fn runs_file_seed(path: &Path, plan: &StudyPlan) -> Result<u64, CheckError> {
             .find(|(key, _)| key == k)
             .map(|(_, v)| v.as_str())
     };
-    if !get("study_sha256").is_some_and(|sha| crate::study::io::same_study(sha, &plan.text)) {
+    if !get("study_sha256")
+        .is_some_and(|sha| crate::study::results::io::same_study(sha, &plan.text))
+    {
         return Err(bad(
             "was not written by this study file (its provenance names another study)",
         ));

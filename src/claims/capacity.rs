@@ -10,7 +10,7 @@ use crate::model::effect::contact::ContactSpec;
 use crate::model::scene::{DesignSpec, RhoChoice};
 use crate::model::start::StartMode;
 use crate::simulation::Simulation;
-use crate::study::config::StudyPlan;
+use crate::study::plan::config::StudyPlan;
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -5,7 +5,7 @@ use crate::design::capacity::{capacity, weight_mass};
 use crate::design::geometry::rho_max;
 use crate::design::optimum::optimal_rho;
 use crate::model::balancer::Kind;
-use crate::study::config::DesignGrid;
+use crate::study::plan::config::DesignGrid;
 use serde::Serialize;
 
 /// A way of comparing designs with different n.

@@ -2,17 +2,17 @@
 
 use super::normalisation::Normalisation;
 use super::{ClaimsOutput, DesignResult};
+use crate::decide::verdict::{
+    Comparison, DesignRuns, Favours, Verdict, best_versus_rest, compare, favoured, holm_across,
+    measure_scale,
+};
 use crate::design::geometry::{rho_half_race, sector_angle};
 use crate::design::optimum::optimal_rho;
 use crate::model::balancer::Kind;
 use crate::model::rotor::RotorModel;
 use crate::stats::holm::holm_adjust;
-use crate::study::config::StudyPlan;
-use crate::study::criterion::Criterion;
-use crate::study::verdict::{
-    Comparison, DesignRuns, Favours, Verdict, best_versus_rest, compare, favoured, holm_across,
-    measure_scale,
-};
+use crate::study::plan::config::StudyPlan;
+use crate::study::plan::criterion::Criterion;
 use std::fmt::Write;
 
 fn f(v: Option<f64>, d: usize) -> String {

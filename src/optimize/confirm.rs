@@ -14,7 +14,7 @@
 
 use super::evaluate::{Candidate, Evaluator, estimate, statistic};
 use crate::stats::paired_measures::{Difference, bootstrap_difference};
-use crate::study::stream::{Purpose, stream};
+use crate::study::plan::stream::{Purpose, stream};
 
 /// One scope's optimum, evaluated again on the fresh samples.
 #[derive(Debug, Clone)]
@@ -35,11 +35,11 @@ pub struct Confirmed {
 impl Confirmed {
     /// Not distinguishable from the overall pick: the interval covers 0,
     /// or the difference is too small to matter
-    /// ([`material_difference`](crate::study::verdict::material_difference), 1 %).
+    /// ([`material_difference`](crate::decide::verdict::material_difference), 1 %).
     pub fn ties(&self) -> bool {
         self.vs_overall.is_some_and(|d| {
             (d.interval.0 <= 0.0 && d.interval.1 >= 0.0)
-                || !crate::study::verdict::material_difference(&d)
+                || !crate::decide::verdict::material_difference(&d)
         })
     }
 }

@@ -2,16 +2,16 @@
 //! Monte Carlo sample with common random numbers, with its standard error.
 
 use super::spec::{Objective, OptimizeSpec};
+use crate::decide::verdict::settling_horizon;
 use crate::design::transient::a_tilde;
 use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
 use crate::stats::bootstrap;
 use crate::stats::quantile::{Interpolation, quantile};
-use crate::study::config::StudyPlan;
-use crate::study::design::Design;
+use crate::study::plan::config::StudyPlan;
+use crate::study::plan::design::Design;
+use crate::study::plan::stream::{Purpose, stream};
 use crate::study::run::run_design_sample;
-use crate::study::stream::{Purpose, stream};
-use crate::study::verdict::settling_horizon;
 use rayon::prelude::*;
 
 /// A run's residual vibration for the robust-design objectives: the
@@ -100,7 +100,7 @@ impl Evaluator<'_> {
     pub fn part(&self, c: &Candidate) -> Option<String> {
         let design = self.design(c).ok()?;
         let one = |d: &Design| {
-            crate::study::design::part_text(
+            crate::study::plan::design::part_text(
                 d.spec.kind.name(),
                 d.spec.n,
                 (d.rho, d.spec.race_radius),

@@ -14,11 +14,11 @@ pub mod noisy_simplex;
 pub mod search;
 /// The `[optimize]` table is part of the study file, so it lives with the
 /// study schema; named here as well, where it is used.
-pub use crate::study::optimize_spec as spec;
+pub use crate::study::plan::optimize_spec as spec;
 
 use crate::design::complete::{best_per_n_optimum, complete_optimization};
-use crate::study::config::StudyPlan;
-use crate::study::io::{Provenance, write_parquet};
+use crate::study::plan::config::StudyPlan;
+use crate::study::results::io::{Provenance, write_parquet};
 use evaluate::{Evaluation, Evaluator};
 use polars::prelude::*;
 use rayon::prelude::*;
@@ -202,7 +202,7 @@ fn validate_budget(spec: &OptimizeSpec, plan: &StudyPlan) -> Result<(), Optimize
     }
     // As `study run` refuses it: a Sobol sequence is even only over 2^m points.
     if let Some(n) = spec.samples
-        && plan.file.sampling.sequence == crate::study::stream::Sequence::Sobol
+        && plan.file.sampling.sequence == crate::study::plan::stream::Sequence::Sobol
         && !n.is_power_of_two()
     {
         return Err(bad(
@@ -353,7 +353,7 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
 /// (kind, n) of plane 1 for each of plane 0's.
 fn search_cells(
     spec: &OptimizeSpec,
-    g: &crate::study::config::DesignGrid,
+    g: &crate::study::plan::config::DesignGrid,
     drag: f64,
 ) -> Vec<evaluate::Candidate> {
     let mut cells = Vec::new();

@@ -7,8 +7,8 @@ use super::PlotError;
 use super::style::{
     self, Figure, REFERENCE, Swatch, TICK, draw_line, linear_label, log_ticks, series_style, text,
 };
+use crate::decide::verdict::{LEVEL, SettlingClock};
 use crate::stats::survival::{Interval, KaplanMeier, Observation, Transform};
-use crate::study::verdict::{LEVEL, SettlingClock};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

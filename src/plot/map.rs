@@ -3,7 +3,7 @@
 
 use super::PlotError;
 use super::style::{self, Figure, Swatch, TICK, text};
-use crate::study::io::read_parquet;
+use crate::study::results::io::read_parquet;
 use crate::study::stability_map::MapPoint;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -6,7 +6,7 @@
 use super::PlotError;
 use super::style::{self, Figure, Swatch, TICK, draw_line, log_ticks, series_style, text};
 use crate::stats::quantile::{Interpolation, quantile_sorted};
-use crate::study::io::read_parquet;
+use crate::study::results::io::read_parquet;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

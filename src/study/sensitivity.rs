@@ -16,13 +16,15 @@
 //! the horizon τ (the restricted mean's integrand, censored runs at τ), the
 //! residual vibration (µm) and the settled indicator (settled by τ or not).
 
-use super::config::StudyPlan;
-use super::design_runs::{RunTimes, SettlingClock, settling_horizon, settling_observation};
-use super::distribution::{DirectionSpec, Distribution, InitialSpec};
-use super::record::RunRecord;
-use super::run::run_design_sample_in;
-use super::stream::{Input, Matrix, Purpose, Sequence, key_hash, stream};
 use crate::stats::sobol_indices::{PickFreeze, SobolIndex, indices};
+use crate::study::plan::config::StudyPlan;
+use crate::study::plan::distribution::{DirectionSpec, Distribution, InitialSpec};
+use crate::study::plan::stream::{Input, Matrix, Purpose, Sequence, key_hash, stream};
+use crate::study::results::design_runs::{
+    RunTimes, SettlingClock, settling_horizon, settling_observation,
+};
+use crate::study::results::record::RunRecord;
+use crate::study::run::run_design_sample_in;
 use polars::prelude::*;
 use rayon::prelude::*;
 
@@ -280,11 +282,12 @@ pub fn estimate(
 /// Write sensitivity.parquet into the study's folder (with its provenance);
 /// the caller claimed the folder.
 pub fn write(plan: &StudyPlan, rows: &[SensitivityRow]) -> PolarsResult<std::path::PathBuf> {
-    let dir = super::run::output_dir(plan, None);
+    let dir = crate::study::run::output_dir(plan, None);
     std::fs::create_dir_all(&dir)?;
     let path = dir.join(FILE);
-    let provenance = super::io::Provenance::new(&plan.text, plan.file.seed, "sensitivity");
-    super::io::write_parquet(&path, &mut to_dataframe(rows)?, &provenance)?;
+    let provenance =
+        crate::study::results::io::Provenance::new(&plan.text, plan.file.seed, "sensitivity");
+    crate::study::results::io::write_parquet(&path, &mut to_dataframe(rows)?, &provenance)?;
     Ok(path)
 }
 
@@ -309,12 +312,12 @@ pub fn read_totals(
     measure: Measure,
 ) -> Option<Vec<InputTotal>> {
     let path = dir.join(FILE);
-    let recorded = super::io::read_metadata(&path).ok()?;
+    let recorded = crate::study::results::io::read_metadata(&path).ok()?;
     let hash = recorded.iter().find(|(k, _)| k == "study_sha256")?;
-    if !super::io::same_study(&hash.1, &plan.text) {
+    if !crate::study::results::io::same_study(&hash.1, &plan.text) {
         return None;
     }
-    let df = super::io::read_parquet(&path).ok()?;
+    let df = crate::study::results::io::read_parquet(&path).ok()?;
     let col = |name: &str| df.column(name).ok().cloned();
     let (d, m, input) = (col("design_id")?, col("measure")?, col("input")?);
     let (t, lo, hi) = (

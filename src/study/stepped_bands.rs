@@ -8,10 +8,10 @@
 //! the band is what the model predicts for it, the measurement is judged
 //! against the band rather than one line.
 
-use super::stream::{Matrix, RunStreams, Sequence, key_hash};
 use crate::simulation::Simulation;
 use crate::simulation::stepped::{Direction, StepPoint, SteppedError};
 use crate::stats::quantile::{Interpolation, quantile_sorted};
+use crate::study::plan::stream::{Matrix, RunStreams, Sequence, key_hash};
 use crate::uncertain::{UncertainSpec, UncertainValue, apply, draw};
 use polars::prelude::*;
 use rand::RngExt;

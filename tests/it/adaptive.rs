@@ -2,11 +2,11 @@
 //! rows as the fixed-sample study it stopped at.
 
 use crate::fixtures::SI_SCENE;
-use autobal::study::adaptive::precision;
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::io::read_parquet;
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::io::read_parquet;
+use autobal::study::results::runs_file::read_summary_columns;
+use autobal::study::run::adaptive::precision;
 use autobal::study::run::{NoProgress, RunOptions, Shard, run_study};
-use autobal::study::runs_file::read_summary_columns;
 use polars::prelude::*;
 use std::path::Path;
 use std::process::Command;

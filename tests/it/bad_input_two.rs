@@ -4,7 +4,7 @@
 //! makes. Each case is refused with exit code 2, a message naming the key
 //! or flag, and no output folder (not even an empty parent).
 
-use autobal::study::criterion::Criterion;
+use autobal::study::plan::criterion::Criterion;
 use std::path::Path;
 use std::process::Command;
 

@@ -15,9 +15,9 @@ use autobal::stats::holm::{holm_adjust, holm_reject};
 use autobal::stats::ks::ks_two_sample;
 use autobal::stats::mood::mood_median_test;
 use autobal::stats::proportion::fisher_two_proportions;
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::io::read_parquet;
-use autobal::study::record::to_dataframe;
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::io::read_parquet;
+use autobal::study::results::record::to_dataframe;
 use autobal::study::run::{NoProgress, RunOptions, run_study};
 use std::path::Path;
 use std::process::Command;
@@ -231,7 +231,7 @@ fn same_seed_reproduces_and_another_seed_raises_no_false_alarm() {
     assert_eq!(manifest.seed, 11);
     assert_eq!(
         manifest.study_sha256,
-        autobal::study::io::sha256_hex(&p.text)
+        autobal::study::results::io::sha256_hex(&p.text)
     );
     assert_eq!(
         std::fs::read_to_string(dir.join("study.toml")).unwrap(),
@@ -483,9 +483,9 @@ fn planted_changes_do_what_they_say() {
 #[test]
 fn false_alarm_rate_is_within_its_interval_of_alpha_and_planted_shifts_are_caught() {
     use autobal::check::plant::{Planted, alarms_independent, alarms_paired};
+    use autobal::decide::verdict::settling_horizon;
     use autobal::stats::interval::wilson_interval;
-    use autobal::study::verdict::settling_horizon;
-    let shipped = autobal::study::config::load(Path::new("studies/regression.toml")).unwrap();
+    let shipped = autobal::study::plan::config::load(Path::new("studies/regression.toml")).unwrap();
     let tmp = tempfile::tempdir().unwrap();
     let seeds = 12_u64;
     let mut runs = Vec::new();

@@ -4,7 +4,7 @@ use crate::fixtures::SI_SCENE;
 use autobal::claims::normalisation::{Normalisation, design_capacity, rho_for};
 use autobal::claims::{report::render, run_claims};
 use autobal::model::balancer::Kind;
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
 use autobal::study::run::NoProgress;
 
 #[test]
@@ -138,7 +138,7 @@ t_end_revs = 300
     );
     // --rank-by median switches the measure the verdicts rest on.
     let mut by_median = plan.clone();
-    by_median.file.summary.rank_by = autobal::study::criterion::Criterion::Median;
+    by_median.file.summary.rank_by = autobal::study::plan::criterion::Criterion::Median;
     let report = render(
         &by_median,
         &out,

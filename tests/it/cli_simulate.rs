@@ -64,7 +64,7 @@ fn series_is_written_as_csv_or_parquet() {
             .status
             .success()
     );
-    let df = autobal::study::io::read_parquet(&pq).unwrap();
+    let df = autobal::study::results::io::read_parquet(&pq).unwrap();
     assert_eq!(df.height(), text.lines().count() - 1);
     let missing = tmp.path().join("no/such/dir/run.csv");
     let out = simulate(&["--series", missing.to_str().unwrap()]);

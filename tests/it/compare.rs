@@ -1,7 +1,7 @@
 //! `study compare`: paired when the designs met the same unbalances,
 //! refused pairing (with the reason) and a log-rank test when they did not.
 
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
 use autobal::study::run::{NoProgress, RunOptions, run_study};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

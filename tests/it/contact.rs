@@ -39,8 +39,8 @@ fn without_contact_the_main_job_lets_weights_pass_through_each_other() {
 #[test]
 fn sampled_starts_never_overlap() {
     use autobal::model::gap::start_clash;
-    use autobal::study::config::InitialSpec;
-    use autobal::study::sample::draw_sample;
+    use autobal::study::plan::config::InitialSpec;
+    use autobal::study::plan::sample::draw_sample;
     for name in STUDIES {
         for initial in [
             InitialSpec::Clustered,

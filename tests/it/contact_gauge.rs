@@ -4,7 +4,7 @@
 //! includes this file by path).
 
 use autobal::model::gap::GapGauge;
-use autobal::study::config::{StudyFile, StudyPlan};
+use autobal::study::plan::config::{StudyFile, StudyPlan};
 use autobal::study::run::run_one;
 use std::path::PathBuf;
 

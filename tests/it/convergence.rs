@@ -7,7 +7,7 @@
 
 use autobal::integrate::Method;
 use autobal::simulation::{MethodChoice, Simulation};
-use autobal::study::config::{StudyFile, StudyPlan};
+use autobal::study::plan::config::{StudyFile, StudyPlan};
 use std::path::PathBuf;
 
 fn plan(name: &str) -> StudyPlan {

@@ -1,12 +1,12 @@
-//! `[sampling.couple]` (src/study/couple.rs): a rotor on two supports draws
+//! `[sampling.couple]` (src/study/plan/couple.rs): a rotor on two supports draws
 //! a couple unbalance beside the static one, each balancer plane takes
 //! U_s e^{iθ_s} ± U_c e^{iθ_c}, the static draws stay those of the study
 //! without the table, every design meets the same draws, and a bad table is
 //! refused naming its key.
 
 use autobal::model::rotor::RotorModel;
-use autobal::study::config::StudyFile;
-use autobal::study::record::{COUPLE_COLUMNS, from_dataframe};
+use autobal::study::plan::config::StudyFile;
+use autobal::study::results::record::{COUPLE_COLUMNS, from_dataframe};
 use autobal::study::run::{run_one, sample_simulation};
 use num_complex::Complex64;
 
@@ -54,7 +54,7 @@ hold_revs = 10
     )
 }
 
-fn plan(text: &str) -> autobal::study::config::StudyPlan {
+fn plan(text: &str) -> autobal::study::plan::config::StudyPlan {
     StudyFile::parse(text, "couple.toml")
         .unwrap()
         .plan(text, "couple.toml")
@@ -154,7 +154,7 @@ fn a_couple_that_follows_the_static_part_is_one_load_at_one_axial_position() {
 fn runs_parquet_carries_the_couple_and_each_planes_unbalance() {
     let p = plan(&study(DRAWN, "two_support"));
     let rows: Vec<_> = (0..p.total_runs()).map(|id| run_one(&p, id)).collect();
-    let df = autobal::study::record::to_dataframe(&rows).unwrap();
+    let df = autobal::study::results::record::to_dataframe(&rows).unwrap();
     for name in COUPLE_COLUMNS {
         assert!(df.column(name).is_ok(), "{name}");
     }
@@ -165,7 +165,7 @@ fn runs_parquet_carries_the_couple_and_each_planes_unbalance() {
     }
     // A study without the table keeps its schema.
     let plain = plan(&study("", "two_support"));
-    let df = autobal::study::record::to_dataframe(&[run_one(&plain, 0)]).unwrap();
+    let df = autobal::study::results::record::to_dataframe(&[run_one(&plain, 0)]).unwrap();
     assert!(df.column(COUPLE_COLUMNS[0]).is_err());
 }
 
@@ -335,7 +335,7 @@ fn a_single_plane_rotor_needs_the_loads_planes() {
 #[test]
 fn the_locked_response_to_static_plus_couple_is_the_closed_form() {
     use autobal::model::scene::Scene;
-    use autobal::study::couple::{SampledCouple, apply, plane_unbalances};
+    use autobal::study::plan::couple::{SampledCouple, apply, plane_unbalances};
     let base = crate::fixtures::long_rotor(vec![-1.0, 1.0]);
     let (m, a, c, k, l, b) = (
         base.mass,
@@ -475,7 +475,7 @@ fn each_plane_reports_its_residual_and_the_far_end_of_a_single_balancer_whirls()
         assert!(b.plane_balancing_error.is_none());
     }
     let rows: Vec<_> = (0..2).map(|id| run_one(&one, id)).collect();
-    let df = autobal::study::record::to_dataframe(&rows).unwrap();
+    let df = autobal::study::results::record::to_dataframe(&rows).unwrap();
     let back = from_dataframe(&df).unwrap();
     for (x, y) in rows.iter().zip(&back) {
         assert_eq!(x.metrics.plane_residual_abs, y.metrics.plane_residual_abs);

@@ -2,10 +2,10 @@
 //! does not work (and why), failed runs never absorbed, divergence judged
 //! on a scale that covers the start, run-ups timed from the operating speed.
 
-use autobal::study::criterion::Criterion;
-use autobal::study::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
-use autobal::study::io::read_parquet;
-use autobal::study::verdict::{Favours, Shortfall, favoured};
+use autobal::decide::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
+use autobal::decide::verdict::{Favours, Shortfall, favoured};
+use autobal::study::plan::criterion::Criterion;
+use autobal::study::results::io::read_parquet;
 use std::path::Path;
 use std::process::{Command, Output};
 

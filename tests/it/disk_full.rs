@@ -53,7 +53,7 @@ fn run(study: &Path, extra: &[&str]) -> std::process::Output {
 
 /// A results table without the runs' wall times, which no two runs share.
 fn table_without_wall_time(path: &Path) -> polars::prelude::DataFrame {
-    let table = autobal::study::io::read_parquet(path).unwrap();
+    let table = autobal::study::results::io::read_parquet(path).unwrap();
     match table.drop("wall_time_s") {
         Ok(runs) => runs,
         Err(_) => table,

@@ -96,7 +96,7 @@ pub fn shipped_plan(
     path: &std::path::Path,
     samples: u32,
     edit: impl FnOnce(&mut autobal::simulation::SolverSettings),
-) -> autobal::study::config::StudyPlan {
+) -> autobal::study::plan::config::StudyPlan {
     shipped_plan_edited(path, samples, |file| edit(&mut file.solver))
 }
 
@@ -104,11 +104,11 @@ pub fn shipped_plan(
 pub fn shipped_plan_edited(
     path: &std::path::Path,
     samples: u32,
-    edit: impl FnOnce(&mut autobal::study::config::StudyFile),
-) -> autobal::study::config::StudyPlan {
+    edit: impl FnOnce(&mut autobal::study::plan::config::StudyFile),
+) -> autobal::study::plan::config::StudyPlan {
     let text = std::fs::read_to_string(path).unwrap();
     let shown = path.display().to_string();
-    let mut file = autobal::study::config::StudyFile::parse(&text, &shown).unwrap();
+    let mut file = autobal::study::plan::config::StudyFile::parse(&text, &shown).unwrap();
     file.sampling.samples = samples;
     edit(&mut file);
     file.plan(&text, &shown).unwrap()

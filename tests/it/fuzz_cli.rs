@@ -414,10 +414,10 @@ fn every_path_flag_of_every_verb_refuses_folders_links_and_missing_or_read_only_
         "wall_time_s" => [0.01, 0.1],
     )
     .unwrap();
-    autobal::study::io::write_parquet(
+    autobal::study::results::io::write_parquet(
         &dir.join("tradeoff.parquet"),
         &mut table,
-        &autobal::study::io::Provenance::new("tradeoff fixture", 0, "all"),
+        &autobal::study::results::io::Provenance::new("tradeoff fixture", 0, "all"),
     )
     .unwrap();
     let keep: Vec<std::ffi::OsString> = std::fs::read_dir(dir)

@@ -13,8 +13,8 @@
 use autobal::integrate::Method;
 use autobal::scene_file::SceneFile;
 use autobal::simulation::{Fidelity, MethodChoice};
-use autobal::study::aggregate::summarize;
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
+use autobal::study::run::aggregate::summarize;
 use autobal::study::run::run_one;
 use polars::prelude::DataFrame;
 use sha2::{Digest, Sha256};

@@ -206,6 +206,6 @@ fn study_map_writes_the_grid_and_draws_it() {
     let picture: Vec<&str> = text.lines().skip(3).collect();
     // Top row: ε/R = 0.025 beyond the capacity; then stable except at the lowest speed.
     assert_eq!(picture, vec!["    ", ".###", ".###"], "{text}");
-    let df = autobal::study::io::read_parquet(&out).unwrap();
+    let df = autobal::study::results::io::read_parquet(&out).unwrap();
     assert_eq!(df.height(), 12);
 }

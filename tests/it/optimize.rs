@@ -8,7 +8,7 @@ use autobal::design::optimum::optimal_rho;
 use autobal::model::balancer::Kind;
 use autobal::optimize::evaluate::{Candidate, Evaluator};
 use autobal::optimize::optimize;
-use autobal::study::config::{StudyFile, StudyPlan};
+use autobal::study::plan::config::{StudyFile, StudyPlan};
 use std::path::Path;
 
 fn plan(output: &Path, designs: &str, sampling: &str, optimize: &str) -> StudyPlan {

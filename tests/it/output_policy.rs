@@ -156,7 +156,12 @@ fn overwrite_replaces_a_single_file_and_a_dead_writers_temporary_is_removed() {
     let done = study_cmd(&args);
     assert!(done.status.success(), "{}", stderr(&done));
     assert_ne!(std::fs::read(&out).unwrap(), b"earlier results");
-    assert!(autobal::study::io::read_parquet(&out).unwrap().height() == 2);
+    assert!(
+        autobal::study::results::io::read_parquet(&out)
+            .unwrap()
+            .height()
+            == 2
+    );
     assert!(
         !stale.exists(),
         "the killed writer's temporary is still there"
@@ -207,9 +212,12 @@ fn tradeoff_and_optimize_write_into_their_studys_folder_only_by_the_policy() {
     }
     std::fs::write(folder.join("study.toml"), &text).unwrap();
     for (mark, what) in [
-        (autobal::study::study_folder::SCRATCH_MARK, "scratch folder"),
         (
-            autobal::study::study_folder::BASELINE_MANIFEST,
+            autobal::study::run::study_folder::SCRATCH_MARK,
+            "scratch folder",
+        ),
+        (
+            autobal::study::run::study_folder::BASELINE_MANIFEST,
             "baseline folder",
         ),
     ] {
@@ -400,7 +408,7 @@ fn claims_rewrites_only_the_variant_folders_it_marked() {
         format!("name = \"claims\"\noutput = \"{}\"\n", tmp.path().display())
             + crate::fixtures::SI_SCENE
     );
-    let plan = autobal::study::config::StudyFile::parse(&text, "claims.toml")
+    let plan = autobal::study::plan::config::StudyFile::parse(&text, "claims.toml")
         .unwrap()
         .plan(&text, "claims.toml")
         .unwrap();
@@ -421,7 +429,7 @@ fn claims_rewrites_only_the_variant_folders_it_marked() {
     let marked = tmp
         .path()
         .join("claims/fastest_equal_mass")
-        .join(autobal::study::study_folder::CLAIMS_MARK);
+        .join(autobal::study::run::study_folder::CLAIMS_MARK);
     assert!(marked.exists());
     // Its own folders are recomputed.
     autobal::claims::run_claims(&plan, &autobal::study::run::NoProgress).unwrap();

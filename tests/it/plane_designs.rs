@@ -1,4 +1,4 @@
-//! `[[designs.per_plane]]` (src/study/plane_designs.rs): on a rotor with two
+//! `[[designs.per_plane]]` (src/study/plan/plane_designs.rs): on a rotor with two
 //! balancer planes each plane may have its own kind, n, ρ and drag; the grid
 //! is the product over the planes, the runs build each plane's balancer,
 //! the capacity is the weaker plane's, every design meets the same draws,
@@ -6,9 +6,9 @@
 //! entry is refused naming its key.
 
 use crate::couple_unbalance::LONG_ROTOR;
-use autobal::study::config::StudyFile;
-use autobal::study::io::read_parquet;
-use autobal::study::plane_designs::column_names;
+use autobal::study::plan::config::StudyFile;
+use autobal::study::plan::plane_designs::column_names;
+use autobal::study::results::io::read_parquet;
 use autobal::study::run::{NoProgress, RunOptions, run_one, run_study, sample_simulation};
 use std::path::Path;
 
@@ -47,7 +47,7 @@ hold_revs = 10
 
 const PLANE_ONE: &str = "[[designs.per_plane]]\nplane = 1\nn = [3, 4]\nrho = 0.12";
 
-fn plan(text: &str) -> Result<autobal::study::config::StudyPlan, String> {
+fn plan(text: &str) -> Result<autobal::study::plan::config::StudyPlan, String> {
     StudyFile::parse(text, "planes.toml")
         .and_then(|f| f.plan(text, "planes.toml"))
         .map_err(|e| e.to_string())
@@ -172,7 +172,7 @@ fn runs_and_summary_name_every_planes_design() {
         .unwrap()
         .clone();
     for p in 0..2 {
-        for name in autobal::study::plane_summary::column_names(p) {
+        for name in autobal::decide::plane_summary::column_names(p) {
             assert!(summary.column(&name).is_ok(), "{name}");
         }
         let plane = summary

@@ -14,10 +14,10 @@ use autobal::plot::study::{
 use autobal::plot::tradeoff::{TradeoffPoint, plot_work_precision, read_tradeoff};
 use autobal::plot::{Format, PlotError};
 use autobal::scene_file::SceneFile;
-use autobal::study::aggregate::summarize;
-use autobal::study::config::StudyFile;
-use autobal::study::io::{Provenance, write_parquet};
-use autobal::study::record::{RunRecord, to_dataframe};
+use autobal::study::plan::config::StudyFile;
+use autobal::study::results::io::{Provenance, write_parquet};
+use autobal::study::results::record::{RunRecord, to_dataframe};
+use autobal::study::run::aggregate::summarize;
 use polars::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -220,7 +220,7 @@ samples = 40
 unbalance = { distribution = "uniform", min = 0.1, max = 0.9, relative_to = "capacity" }
 "#;
 
-fn study_plan() -> autobal::study::config::StudyPlan {
+fn study_plan() -> autobal::study::plan::config::StudyPlan {
     StudyFile::parse(STUDY_TOML, "fixture.toml")
         .unwrap()
         .plan(STUDY_TOML, "fixture.toml")
@@ -228,7 +228,7 @@ fn study_plan() -> autobal::study::config::StudyPlan {
 }
 
 /// Synthetic runs for the plan: settling time grows with the unbalance; a few do not settle.
-fn study_runs(plan: &autobal::study::config::StudyPlan, samples: u32) -> Vec<RunRecord> {
+fn study_runs(plan: &autobal::study::plan::config::StudyPlan, samples: u32) -> Vec<RunRecord> {
     let mut runs = Vec::new();
     for design in &plan.designs {
         for s in 0..samples {
@@ -310,7 +310,11 @@ fn write_study(dir: &Path) {
     let plan = study_plan();
     let runs = study_runs(&plan, 40);
     // The fixture's runs belong to the study.toml beside them, as a run's do.
-    let provenance = Provenance::new(STUDY_TOML, autobal::study::config::DEFAULT_SEED, "all");
+    let provenance = Provenance::new(
+        STUDY_TOML,
+        autobal::study::plan::config::DEFAULT_SEED,
+        "all",
+    );
     let mut summary = summarize(&plan, &runs).unwrap();
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance).unwrap();
     write_parquet(
@@ -869,10 +873,10 @@ fn stability_map_is_drawn_from_the_map_table() {
     }
     let table = tmp.path().join("map.parquet");
     let mut df = to_dataframe(&points).unwrap();
-    autobal::study::io::write_parquet(
+    autobal::study::results::io::write_parquet(
         &table,
         &mut df,
-        &autobal::study::io::Provenance::new("", 0, "test"),
+        &autobal::study::results::io::Provenance::new("", 0, "test"),
     )
     .unwrap();
     let back = read_map(&table).unwrap();

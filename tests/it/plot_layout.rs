@@ -23,7 +23,7 @@ use autobal::plot::study::{DesignStats, StudyData, StudyFigure};
 use autobal::plot::style::{SeriesStyle, legend_styles};
 use autobal::plot::tradeoff::{TradeoffPoint, plot_work_precision};
 use autobal::stats::survival::Observation;
-use autobal::study::record::RunRecord;
+use autobal::study::results::record::RunRecord;
 use autobal::study::stability_map::MapPoint;
 use std::path::{Path, PathBuf};
 

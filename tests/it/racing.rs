@@ -2,16 +2,16 @@
 //! the leader, the same decision as the full study with fewer runs, and
 //! the same results whatever the threads or shards.
 
+use autobal::decide::decision::{Crown, Recommendation, StudyDecision};
+use autobal::decide::verdict::ranking;
 use autobal::stats::survival::Observation;
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::decision::{Crown, Recommendation, StudyDecision};
-use autobal::study::io::read_parquet;
-use autobal::study::measured_runs::DesignRuns;
-use autobal::study::merge::merge;
-use autobal::study::racing::{LOOKS, SPENDING, significantly_worse};
-use autobal::study::record::deterministic_columns;
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::io::read_parquet;
+use autobal::study::results::measured_runs::DesignRuns;
+use autobal::study::results::record::deterministic_columns;
+use autobal::study::run::merge::merge;
+use autobal::study::run::racing::{LOOKS, SPENDING, significantly_worse};
 use autobal::study::run::{NoProgress, RunOptions, Shard, run_study};
-use autobal::study::verdict::ranking;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::Path;
@@ -145,7 +145,7 @@ fn racing_drops_a_design_no_worse_than_the_leader_at_most_alpha_of_the_time() {
         let (mut spent_hit, mut naive_hit) = (false, false);
         for (k, level) in levels.iter().enumerate().take(LOOKS as usize - 1) {
             let so_far: Vec<DesignRuns> = all.iter().map(|d| d.first((k + 1) * batch)).collect();
-            let scale = autobal::study::design_runs::measure_scale(&plan);
+            let scale = autobal::study::results::design_runs::measure_scale(&plan);
             let leader = &so_far[ranking(&so_far, plan.file.summary.rank_by, &scale)[0]];
             spent_hit |= !significantly_worse(&plan, &so_far, leader, *level, k).is_empty();
             naive_hit |= !significantly_worse(&plan, &so_far, leader, alpha, k).is_empty();

@@ -102,15 +102,15 @@ fn a_damaged_folder_is_refused_naming_the_file_and_what_is_missing() {
     finished(dir, &|t| t, &[]);
     let folder = dir.join("results/corpus");
     let summary_path = folder.join("summary.parquet");
-    let summary = autobal::study::io::read_parquet(&summary_path).unwrap();
+    let summary = autobal::study::results::io::read_parquet(&summary_path).unwrap();
     let stored = std::fs::read_to_string(folder.join("study.toml")).unwrap();
     // A column every summary has, and one only the ranking reads.
     for column in ["rank_by", "vs_best_verdict"] {
         let mut damaged = summary.drop(column).unwrap();
-        autobal::study::io::write_parquet(
+        autobal::study::results::io::write_parquet(
             &summary_path,
             &mut damaged,
-            &autobal::study::io::Provenance::new(&stored, 5, "all"),
+            &autobal::study::results::io::Provenance::new(&stored, 5, "all"),
         )
         .unwrap();
         let (code, err, page) = report(dir, "results/corpus", "r.html");
@@ -125,10 +125,10 @@ fn a_damaged_folder_is_refused_naming_the_file_and_what_is_missing() {
     // A summary in place of the runs: both named, with what the file is.
     std::fs::copy(folder.join("runs.parquet"), dir.join("runs.keep")).unwrap();
     let mut summary = summary;
-    autobal::study::io::write_parquet(
+    autobal::study::results::io::write_parquet(
         &summary_path,
         &mut summary,
-        &autobal::study::io::Provenance::new(&stored, 5, "all"),
+        &autobal::study::results::io::Provenance::new(&stored, 5, "all"),
     )
     .unwrap();
     std::fs::copy(&summary_path, folder.join("runs.parquet")).unwrap();
@@ -183,7 +183,8 @@ fn a_study_where_nothing_settled_is_reported_with_a_sentence_for_each_figure_it_
         &[],
     );
     let summary =
-        autobal::study::io::read_parquet(&dir.join("results/corpus/summary.parquet")).unwrap();
+        autobal::study::results::io::read_parquet(&dir.join("results/corpus/summary.parquet"))
+            .unwrap();
     let settled: u64 = summary
         .column("settled")
         .unwrap()

@@ -4,7 +4,7 @@
 //! index written `{p}`) must be exactly the names the doc's tables give for
 //! that file.
 
-use autobal::study::io::read_parquet;
+use autobal::study::results::io::read_parquet;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -4,7 +4,7 @@
 //! with the holder's name. Each case exits 2 and leaves the results as they
 //! were.
 
-use autobal::study::lock::FolderLock;
+use autobal::study::run::lock::FolderLock;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -155,7 +155,7 @@ fn the_folders_copy_of_the_study_leaves_out_the_schema_line_and_still_resumes_an
         .unwrap();
     assert!(merged.status.success(), "{}", stderr(&merged));
     let sha = |p: &Path| {
-        autobal::study::io::read_metadata(p)
+        autobal::study::results::io::read_metadata(p)
             .unwrap()
             .into_iter()
             .find(|(k, _)| k == "study_sha256")
@@ -203,7 +203,7 @@ fn resume_after_the_study_changed_advises_overwrite_and_that_advice_works() {
     // Following the advice runs the changed study.
     let replaced = study(&path, &["--overwrite"]);
     assert!(replaced.status.success(), "{}", stderr(&replaced));
-    let runs = autobal::study::io::read_parquet(&folder.join("runs.parquet")).unwrap();
+    let runs = autobal::study::results::io::read_parquet(&folder.join("runs.parquet")).unwrap();
     assert_eq!(runs.height(), 3);
 }
 
@@ -243,7 +243,7 @@ fn an_empty_shard_is_a_shard_and_merges() {
         .collect();
     // Every column but the wall time, which no two runs share.
     let rows = |p: &Path| {
-        autobal::study::io::read_parquet(p)
+        autobal::study::results::io::read_parquet(p)
             .unwrap()
             .drop("wall_time_s")
             .unwrap()

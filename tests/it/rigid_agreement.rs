@@ -8,7 +8,7 @@
 use crate::fixtures::shipped_plan_edited;
 use autobal::metrics::RunMetrics;
 use autobal::model::effect::contact::ContactModel;
-use autobal::study::config::StudyPlan;
+use autobal::study::plan::config::StudyPlan;
 use autobal::study::run::run_one;
 use std::path::PathBuf;
 

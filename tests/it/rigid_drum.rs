@@ -15,7 +15,7 @@ use autobal::model::effect::contact::ContactModel;
 use autobal::stats::ks::ks_two_sample;
 use autobal::stats::proportion::fisher_two_proportions;
 use autobal::stats::survival::{KaplanMeier, Observation, log_rank};
-use autobal::study::config::StudyPlan;
+use autobal::study::plan::config::StudyPlan;
 use autobal::study::run::run_one;
 use rayon::prelude::*;
 use std::path::PathBuf;

@@ -4,7 +4,7 @@
 //! them, and they reject what the parser rejects.
 
 use autobal::scene_file::SceneFile;
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
 use serde_json::Value;
 use std::path::PathBuf;
 use std::process::Command;

@@ -1,12 +1,12 @@
 //! `study sensitivity`: Sobol indices of a study's measures over its
 //! sampled inputs, by pick-freeze runs of the study's own streams.
 
-use autobal::study::config::{StudyFile, StudyPlan};
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::plan::stream::Sequence;
 use autobal::study::run::run_one;
 use autobal::study::sensitivity::{
     Measure, SensitivityRow, SensitivitySettings, estimate, inputs, run_pick_freeze,
 };
-use autobal::study::stream::Sequence;
 
 /// Two- and three-ball designs on the main job's rotor, with the rotor's
 /// inertia (unused at constant speed) and its damping uncertain.
@@ -130,8 +130,8 @@ fn a_dummy_input_gets_no_index_and_the_unbalance_does() {
 /// best in two of the three thirds, and design 0 wins the lowest.
 #[test]
 fn robustness_names_the_third_where_the_decision_turns() {
+    use autobal::decide::robustness::robustness;
     use autobal::metrics::Outcome;
-    use autobal::study::robustness::robustness;
     use autobal::uncertain::UncertainValue;
     let p = plan("random");
     let mut runs = Vec::new();
@@ -157,7 +157,7 @@ fn robustness_names_the_third_where_the_decision_turns() {
             runs.push(r);
         }
     }
-    let df = autobal::study::record::to_dataframe(&runs).unwrap();
+    let df = autobal::study::results::record::to_dataframe(&runs).unwrap();
     let r = robustness(&p, &df, 1).unwrap().unwrap();
     let bx: Vec<_> = r.parts.iter().filter(|p| p.key == "rotor.bx").collect();
     assert_eq!(bx.iter().map(|p| p.winner).collect::<Vec<_>>(), [0, 1, 1]);
@@ -213,7 +213,7 @@ fn the_cli_writes_the_indices_and_refuses_bad_flags() {
         "{stderr}"
     );
     let written = dir.path().join("sens/sensitivity.parquet");
-    let df = autobal::study::io::read_parquet(&written).unwrap();
+    let df = autobal::study::results::io::read_parquet(&written).unwrap();
     assert_eq!(df.height(), 3 * 4);
     assert_eq!(
         study(&["--rows", "8", "--designs", "1"]).status.code(),

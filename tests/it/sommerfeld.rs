@@ -172,7 +172,7 @@ const MOTOR: &str = "mode = \"motor\"\nstall_torque = 20.0\nomega_sync = 300.0";
 #[test]
 fn a_stall_torque_list_is_one_more_design_axis_applied_to_the_motor() {
     use autobal::model::speed::SpeedLaw;
-    use autobal::study::config::StudyFile;
+    use autobal::study::plan::config::StudyFile;
     let text = torque_study("[2.0, 8.0, 12.0]", MOTOR);
     let plan = StudyFile::parse(&text, "s.toml")
         .and_then(|f| f.plan(&text, "s.toml"))
@@ -244,10 +244,13 @@ fn study_run_prints_the_stall_torque_and_the_passage_table() {
 }
 
 /// The pendulum design of `studies/sommerfeld.toml` at the given stall torque.
-fn shipped_pendulums(torque: f64, tolerances: &str) -> (autobal::study::config::StudyPlan, u32) {
+fn shipped_pendulums(
+    torque: f64,
+    tolerances: &str,
+) -> (autobal::study::plan::config::StudyPlan, u32) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/studies/sommerfeld.toml");
     let text = std::fs::read_to_string(path).unwrap() + tolerances;
-    let plan = autobal::study::config::StudyFile::parse(&text, path)
+    let plan = autobal::study::plan::config::StudyFile::parse(&text, path)
         .unwrap()
         .plan(&text, path)
         .unwrap();

@@ -183,7 +183,7 @@ fn the_stepped_verb_warns_records_and_refuses_by_flag() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("[[cargo]] weights are point masses"), "{err}");
-    let df = autobal::study::io::read_parquet(&series).unwrap();
+    let df = autobal::study::results::io::read_parquet(&series).unwrap();
     assert_eq!(
         df.get_column_names()
             .iter()

@@ -1,6 +1,6 @@
 //! Bad study input: a clear message naming the key and why, exit code 2, nothing written.
 
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
 use proptest::prelude::*;
 use std::path::Path;
 use std::process::Command;

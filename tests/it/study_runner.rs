@@ -1,8 +1,8 @@
 //! The study runner: determinism, sharding, resume, statistics, bad input.
 
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::io::read_parquet;
-use autobal::study::record::deterministic_columns;
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::io::read_parquet;
+use autobal::study::results::record::deterministic_columns;
 use autobal::study::run::{NoProgress, RunOptions, Shard, run_study};
 use polars::prelude::*;
 use std::path::Path;
@@ -106,14 +106,14 @@ fn sharded_and_merged_equals_whole() {
         dirs.push(out.dir);
     }
     // Shards are disjoint and together hold every run.
-    let merged = autobal::study::merge::merge(&dirs, None, false).unwrap();
+    let merged = autobal::study::run::merge::merge(&dirs, None, false).unwrap();
     // A second merge into the same folder needs to say it replaces the first.
-    let again = autobal::study::merge::merge(&dirs, None, false).unwrap_err();
+    let again = autobal::study::run::merge::merge(&dirs, None, false).unwrap_err();
     assert!(
         again.to_string().contains("already holds results"),
         "{again}"
     );
-    autobal::study::merge::merge(&dirs, None, true).unwrap();
+    autobal::study::run::merge::merge(&dirs, None, true).unwrap();
     assert_eq!(merged.runs, 20);
     assert_eq!(merged.load_runs().unwrap().len(), 20);
     assert!(
@@ -126,7 +126,7 @@ fn sharded_and_merged_equals_whole() {
     );
     // Merging an incomplete set fails and names what is missing.
     let err =
-        autobal::study::merge::merge(&dirs[..2], Some(&sharded.path().join("partial")), false)
+        autobal::study::run::merge::merge(&dirs[..2], Some(&sharded.path().join("partial")), false)
             .unwrap_err();
     assert!(err.to_string().contains("missing"), "{err}");
 }
@@ -302,7 +302,8 @@ fn a_killed_and_resumed_shard_merges_into_the_whole() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    let merged = autobal::study::merge::merge(&[shard_dir(1), shard_dir(2)], None, false).unwrap();
+    let merged =
+        autobal::study::run::merge::merge(&[shard_dir(1), shard_dir(2)], None, false).unwrap();
     let p = plan(&small_study(whole.path(), 150, ""));
     let dir = run_study(&p, &RunOptions::default(), &NoProgress)
         .unwrap()
@@ -376,7 +377,7 @@ fn provenance_is_stored_in_the_parquet_metadata() {
     let tmp = tempfile::tempdir().unwrap();
     let text = small_study(tmp.path(), 2, "");
     let out = run_study(&plan(&text), &RunOptions::default(), &NoProgress).unwrap();
-    let meta = autobal::study::io::read_metadata(&out.dir.join("runs.parquet")).unwrap();
+    let meta = autobal::study::results::io::read_metadata(&out.dir.join("runs.parquet")).unwrap();
     let get = |k: &str| {
         meta.iter()
             .find(|(key, _)| key == k)
@@ -391,7 +392,10 @@ fn provenance_is_stored_in_the_parquet_metadata() {
     );
     assert_eq!(get("seed"), "7");
     assert_eq!(get("shard"), "all");
-    assert_eq!(get("study_sha256"), autobal::study::io::sha256_hex(&text));
+    assert_eq!(
+        get("study_sha256"),
+        autobal::study::results::io::sha256_hex(&text)
+    );
     assert_eq!(get("autobal_version"), env!("CARGO_PKG_VERSION"));
     // The build that ran, as `study --version` says it.
     assert_eq!(get("build"), autobal::build_info::VERSION_LINE);
@@ -442,7 +446,7 @@ fn runs_spanning_several_windows_are_the_same_however_split() {
             run_study(&p, &opts, &NoProgress).unwrap().dir
         })
         .collect();
-    let merged = autobal::study::merge::merge(&dirs, None, false).unwrap();
+    let merged = autobal::study::run::merge::merge(&dirs, None, false).unwrap();
     assert!(reference.equals_missing(&stable(&merged.dir.join("runs.parquet"))));
 }
 

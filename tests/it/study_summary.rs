@@ -1,18 +1,19 @@
 //! Per-design statistics against hand computations on a small fixture.
 
 use crate::fixtures::SI_SCENE;
+use autobal::decide::verdict::{DesignRuns, Verdict, best_versus_rest, settling_horizon};
 use autobal::metrics::{Outcome, RunMetrics};
 use autobal::stats::bootstrap;
 use autobal::stats::interval::wilson_interval;
 use autobal::stats::survival::Observation;
-use autobal::study::aggregate::summarize;
-use autobal::study::config::StudyFile;
-use autobal::study::criterion::{Criterion, Scale};
-use autobal::study::record::RunRecord;
-use autobal::study::sample::{Purpose, stream};
-use autobal::study::verdict::{DesignRuns, Verdict, best_versus_rest, settling_horizon};
+use autobal::study::plan::config::StudyFile;
+use autobal::study::plan::criterion::Criterion;
+use autobal::study::plan::sample::{Purpose, stream};
+use autobal::study::results::measured_runs::Scale;
+use autobal::study::results::record::RunRecord;
+use autobal::study::run::aggregate::summarize;
 
-fn plan() -> autobal::study::config::StudyPlan {
+fn plan() -> autobal::study::plan::config::StudyPlan {
     let text = &[
         SI_SCENE,
         r#"

@@ -216,7 +216,7 @@ fn study_sweep_writes_one_row_per_speed() {
     );
     let text = String::from_utf8_lossy(&status.stdout);
     assert!(text.contains("closed form of seed 003"), "{text}");
-    let df = autobal::study::io::read_parquet(&out).unwrap();
+    let df = autobal::study::results::io::read_parquet(&out).unwrap();
     assert_eq!(df.height(), 3);
     for name in [
         "omega",

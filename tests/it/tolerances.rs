@@ -4,9 +4,9 @@
 use autobal::model::balancer::Kind;
 use autobal::optimize::evaluate::{Candidate, Evaluator};
 use autobal::optimize::spec::OptimizeSpec;
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::io::read_parquet;
-use autobal::study::record::{RunRecord, WEIGHT_COLUMNS, deterministic_columns};
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::io::read_parquet;
+use autobal::study::results::record::{RunRecord, WEIGHT_COLUMNS, deterministic_columns};
 use autobal::study::run::{NoProgress, RunOptions, Shard, run_one, run_study};
 use polars::prelude::*;
 use std::path::Path;
@@ -145,7 +145,7 @@ fn weight_columns_are_written_and_identical_for_threads_and_shards() {
     let shards: Vec<_> = (1..=2)
         .map(|k| run(c.path(), 2, Some(Shard { index: k, count: 2 })))
         .collect();
-    let merged = autobal::study::merge::merge(&shards, None, false).unwrap();
+    let merged = autobal::study::run::merge::merge(&shards, None, false).unwrap();
     assert!(whole.equals_missing(&stable(&merged.dir.join("runs.parquet"))));
     // Read back: the records carry the weights they were built with.
     let runs = merged.load_runs().unwrap();
@@ -260,7 +260,7 @@ fn p_residual_below_needs_its_spec_and_other_objectives_refuse_it() {
 
 #[test]
 fn race_eccentricity_is_drawn_per_run_recorded_and_leaves_r_at_the_offset() {
-    use autobal::study::record::RACE_COLUMNS;
+    use autobal::study::results::record::RACE_COLUMNS;
     let a = tempfile::tempdir().unwrap();
     let b = tempfile::tempdir().unwrap();
     let table = "[sampling.tolerances]\neccentricity = { sigma = 2e-6 }";

@@ -3,7 +3,7 @@
 use crate::fixtures::SI_SCENE;
 use autobal::model::effect::contact::ContactModel;
 use autobal::simulation::Fidelity;
-use autobal::study::config::StudyFile;
+use autobal::study::plan::config::StudyFile;
 use autobal::tradeoff::{measure, recommend, rows_frame, settings, spread_runs, summarize};
 
 /// The designs of both studies here, up to their drag.

@@ -2,8 +2,8 @@
 //! their own, written into the run's scene, recorded as `scene.<key>`
 //! columns, and refused up front where they cannot take effect.
 
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::record::{RunRecord, to_dataframe};
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::record::{RunRecord, to_dataframe};
 use autobal::study::run::{run_one, sample_simulation};
 use autobal::uncertain::{apply, read};
 use polars::prelude::*;

@@ -185,7 +185,7 @@ fn write_lean_inputs(
     bench::lean_inputs::write_csv(&rows, &mut text)
         .map_err(|e| UserError::internal(e.to_string()))?;
     let text = String::from_utf8(text).map_err(|e| UserError::internal(e.to_string()))?;
-    autobal::study::io::write_text(path, &text)
+    autobal::study::results::io::write_text(path, &text)
         .map_err(|e| UserError::internal(format!("--lean-inputs {}: {e}", path.display())))?;
     eprintln!(
         "wrote {} runs of {} to {}",

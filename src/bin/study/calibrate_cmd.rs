@@ -11,7 +11,7 @@ use autobal::calibrate::rig_file::{RigFile, RigFileError, Use};
 use autobal::calibrate::tables::{coverage_frame, draws_frame, estimates_frame, points_frame};
 use autobal::output_file::{WhenExists, prepare, prepare_folder};
 use autobal::scene_file::SceneFile;
-use autobal::study::io::{Provenance, write_parquet};
+use autobal::study::results::io::{Provenance, write_parquet};
 use clap::Args;
 use polars::prelude::DataFrame;
 use std::path::{Path, PathBuf};

@@ -6,7 +6,7 @@ use crate::output::{dropped_note, fitted_table, text_width, wrap};
 use autobal::check::baseline::default_dir;
 use autobal::check::compare::{CheckReport, DEFAULT_ALPHA, Metric};
 use autobal::check::study::{CheckError, CheckOptions, check_study, record_baseline};
-use autobal::study::config::load;
+use autobal::study::plan::config::load;
 use autobal::study::run::{NoProgress, RunOptions};
 use clap::Args;
 use std::path::PathBuf;

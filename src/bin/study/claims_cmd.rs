@@ -3,7 +3,7 @@
 use crate::UserError;
 use autobal::claims::{report::render, run_claims};
 use autobal::output_file::{WhenExists, prepare};
-use autobal::study::config::load;
+use autobal::study::plan::config::load;
 use autobal::study::run::NoProgress;
 use clap::Args;
 use std::path::PathBuf;
@@ -26,7 +26,7 @@ pub struct ClaimsArgs {
     /// The measure the verdicts rest on (default: the study's `[summary] rank_by`):
     /// median, mean, p90, settled_fraction, settled_by:<X>rev|s, residual_p95, p_residual_below:<X>m.
     #[arg(long, value_parser = crate::completion_values::CriterionParser, hide_possible_values = true, value_name = "CRITERION")]
-    rank_by: Option<autobal::study::criterion::Criterion>,
+    rank_by: Option<autobal::study::plan::criterion::Criterion>,
 }
 
 /// Run `study claims`.
@@ -54,7 +54,7 @@ pub fn run(args: &ClaimsArgs) -> Result<(), UserError> {
     let text = render(&plan, &out, &command);
     match &args.report {
         Some(path) => {
-            autobal::study::io::write_text(path, &text)
+            autobal::study::results::io::write_text(path, &text)
                 .map_err(|e| UserError::internal(format!("--report {}: {e}", path.display())))?;
             eprintln!("wrote {}", path.display());
         }

@@ -4,13 +4,13 @@
 use crate::UserError;
 use crate::output::{p_value_text, say, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
-use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
-use autobal::study::compare_designs::{
+use autobal::decide::compare_designs::{
     PairVerdict, Pairing, Side, common_scale, compare_sides, median_with_interval,
 };
-use autobal::study::criterion::Criterion;
-use autobal::study::plane_summary::PlaneStats;
-use autobal::study::verdict::Favours;
+use autobal::decide::plane_summary::PlaneStats;
+use autobal::decide::verdict::Favours;
+use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
+use autobal::study::plan::criterion::Criterion;
 use clap::Args;
 use std::path::{Path, PathBuf};
 

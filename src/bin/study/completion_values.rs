@@ -3,7 +3,7 @@
 //! `settled_by:`, for the user to finish), carried by the flags' value
 //! parsers so that every completion script clap_complete writes has them.
 
-use autobal::study::criterion::Criterion;
+use autobal::study::plan::criterion::Criterion;
 use clap::builder::{PossibleValue, TypedValueParser};
 
 /// `--rank-by`: parsed by [`parse_criterion`], completed

@@ -59,10 +59,10 @@ pub(crate) fn parse_counts(text: &str) -> Result<Counts, String> {
             .map_err(|_| format!("'{s}' is not a whole number of weights"))?;
         if n == 0 {
             Err("n = 0: an auto-balancer needs at least one weight (n ≥ 1)".to_string())
-        } else if n > autobal::study::config::MAX_WEIGHTS {
+        } else if n > autobal::study::plan::config::MAX_WEIGHTS {
             Err(format!(
                 "n = {n}: at most {} weights per balancer",
-                autobal::study::config::MAX_WEIGHTS
+                autobal::study::plan::config::MAX_WEIGHTS
             ))
         } else {
             Ok(n)

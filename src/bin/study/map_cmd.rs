@@ -4,7 +4,7 @@
 use crate::UserError;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
-use autobal::study::io::{Provenance, write_parquet};
+use autobal::study::results::io::{Provenance, write_parquet};
 use autobal::study::stability_map::{ascii, stability_map, to_dataframe};
 use autobal::study::sweep::speed_grid;
 use clap::Args;

@@ -5,8 +5,8 @@ use crate::output::{dropped_note, fitted_table, say_err, text_width, wrap};
 use autobal::optimize::optimize;
 use autobal::optimize::spec::Objective;
 use autobal::output_file::WhenExists;
-use autobal::study::config::load;
-use autobal::study::study_folder::claim;
+use autobal::study::plan::config::load;
+use autobal::study::run::study_folder::claim;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -228,7 +228,7 @@ fn confirmation_lines(
 
 /// The overall pick as a part to build, in mm and g ("pick: 5 balls of …").
 fn pick_line(
-    plan: &autobal::study::config::StudyPlan,
+    plan: &autobal::study::plan::config::StudyPlan,
     out: &autobal::optimize::OptimizeOutput,
 ) -> String {
     let Some(spec) = plan.file.optimize.as_ref() else {

@@ -3,7 +3,7 @@
 //! Kubernetes log would otherwise show nothing until the end), nothing with
 //! `--quiet`.
 
-use autobal::study::record::RunRecord;
+use autobal::study::results::record::RunRecord;
 use autobal::study::run::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;

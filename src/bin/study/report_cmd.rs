@@ -5,11 +5,11 @@
 use crate::UserError;
 use crate::plot_cmd::plot_error;
 use crate::ranking::{ranking, robustness_findings};
+use autobal::decide::decision::StudyDecision;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::report::{Report, question, study_figures};
-use autobal::study::decision::StudyDecision;
-use autobal::study::io::{read_metadata, write_text};
-use autobal::study::results_table::{TableKind, read_table};
+use autobal::study::results::io::{read_metadata, write_text};
+use autobal::study::results::results_table::{TableKind, read_table};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -130,7 +130,7 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
             .collect()
     };
     // A study with uncertain keys: whether #1 survives them, as `study run` says.
-    let plan = autobal::study::config::load(&args.dir.join("study.toml"))?;
+    let plan = autobal::study::plan::config::load(&args.dir.join("study.toml"))?;
     let mut findings = lines(&parts.findings);
     findings.extend(robustness_findings(&plan, &args.dir, &summary)?);
     let report = Report {

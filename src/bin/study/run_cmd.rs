@@ -4,10 +4,10 @@ use crate::UserError;
 use crate::output::{text_width, wrap};
 use crate::progress::RunProgress;
 use crate::ranking::{ranked_table, robustness_lines};
-use autobal::study::config::load;
-use autobal::study::criterion::Criterion;
-use autobal::study::failures::failure_advice;
-use autobal::study::merge::merge;
+use autobal::decide::failures::failure_advice;
+use autobal::study::plan::config::load;
+use autobal::study::plan::criterion::Criterion;
+use autobal::study::run::merge::merge;
 use autobal::study::run::{AdaptiveOutcome, RunError, RunOptions, Shard, run_study};
 use clap::Args;
 use std::path::PathBuf;
@@ -140,7 +140,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
 /// Exit 1, after everything is written, when any run ended
 /// `budget_exceeded` or `solver_failed`, with the setting to change.
 fn fail_on_unfinished_runs(
-    plan: &autobal::study::config::StudyPlan,
+    plan: &autobal::study::plan::config::StudyPlan,
     dir: &std::path::Path,
 ) -> Result<(), UserError> {
     match failure_advice(plan, &dir.join("runs.parquet"))? {

@@ -4,13 +4,13 @@
 use crate::UserError;
 use crate::output::{dropped_note, fitted_table, say, say_err, text_width};
 use autobal::output_file::WhenExists;
-use autobal::study::config::load;
+use autobal::study::plan::config::load;
+use autobal::study::plan::stream::{SOBOL_MAX_SAMPLES, Sequence};
+use autobal::study::run::study_folder::claim;
 use autobal::study::sensitivity::{
     FILE, Measure, SensitivityRow, SensitivitySettings, estimate, inputs, run_pick_freeze,
     runs_needed, write,
 };
-use autobal::study::stream::{SOBOL_MAX_SAMPLES, Sequence};
-use autobal::study::study_folder::claim;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -123,13 +123,13 @@ pub fn run(args: &SensitivityArgs) -> Result<(), UserError> {
     for design in &plan.designs {
         print_design(
             design.id,
-            &autobal::study::plane_designs::describe(design),
+            &autobal::study::plan::plane_designs::describe(design),
             &rows,
         );
     }
     say(&format!(
         "(S_T: the total index, the share of the measure's variance that goes when the input is known, interactions included; S_1: the first-order index, the input alone; [95 % bootstrap interval]; shares shown within [0, 1], estimates beyond are noise and sensitivity.parquet keeps them; settling ≤ τ: the settling time capped at the horizon τ = {} rev, as the restricted mean counts it; {} draws)",
-        autobal::study::design_runs::settling_horizon(&plan),
+        autobal::study::results::design_runs::settling_horizon(&plan),
         if args.random {
             "pseudo-random"
         } else {

@@ -6,7 +6,7 @@ use autobal::model::critical_speeds::critical_speeds_in_range;
 use autobal::model::speed::{RAD_PER_RPM, SpeedLaw};
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
-use autobal::study::io::{Provenance, write_series};
+use autobal::study::results::io::{Provenance, write_series};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -37,7 +37,7 @@ pub struct SimulateArgs {
     #[arg(long, value_parser = crate::limits::draws, conflicts_with = "series")]
     draws: Option<u32>,
     /// Seed of the draws.
-    #[arg(long, default_value_t = autobal::study::config::DEFAULT_SEED)]
+    #[arg(long, default_value_t = autobal::study::plan::config::DEFAULT_SEED)]
     seed: u64,
 }
 

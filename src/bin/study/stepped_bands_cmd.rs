@@ -7,7 +7,7 @@ use crate::output::{say, say_err, text_table};
 use autobal::scene_file::SceneFile;
 use autobal::simulation::Simulation;
 use autobal::simulation::stepped::Direction;
-use autobal::study::io::{Provenance, write_parquet};
+use autobal::study::results::io::{Provenance, write_parquet};
 use autobal::study::stepped_bands::{
     BandRow, Quantity, bands, bands_frame, draws_frame, onset_spread, onsets, sweep_draws,
 };

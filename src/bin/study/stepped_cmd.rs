@@ -7,7 +7,7 @@ use autobal::scene_file::SceneFile;
 use autobal::simulation::stepped::{
     StepPoint, SteppedError, SweepSeries, check_dwell, stepped_speeds, to_dataframe,
 };
-use autobal::study::io::{Provenance, write_parquet};
+use autobal::study::results::io::{Provenance, write_parquet};
 use clap::Args;
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -62,7 +62,7 @@ pub struct SteppedArgs {
     #[arg(long, value_parser = crate::limits::draws)]
     draws: Option<u32>,
     /// Seed of the draws.
-    #[arg(long, default_value_t = autobal::study::config::DEFAULT_SEED)]
+    #[arg(long, default_value_t = autobal::study::plan::config::DEFAULT_SEED)]
     seed: u64,
     /// Write every draw's steps (mean bearing peak, ratio, onset, key values) to this Parquet file.
     #[arg(long)]

@@ -4,7 +4,7 @@
 use crate::UserError;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::scene_file::SceneFile;
-use autobal::study::io::{Provenance, write_parquet};
+use autobal::study::results::io::{Provenance, write_parquet};
 use autobal::study::sweep::{SweepPoint, ranges, run_sweep, speed_grid, to_dataframe};
 use clap::Args;
 use std::path::PathBuf;

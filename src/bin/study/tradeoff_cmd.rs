@@ -3,8 +3,8 @@
 use crate::UserError;
 use crate::output::text_table;
 use autobal::output_file::WhenExists;
-use autobal::study::config::load;
-use autobal::study::study_folder::claim;
+use autobal::study::plan::config::load;
+use autobal::study::run::study_folder::claim;
 use autobal::tradeoff::{measure, recommend, spread_runs, summarize, write};
 use clap::Args;
 use std::path::PathBuf;

@@ -19,8 +19,8 @@ pub use settling_vs_unbalance::plot_settling_vs_unbalance;
 
 use super::{Format, PlotError};
 use crate::stats::survival::Observation;
-use crate::study::record::{RunRecord, from_dataframe};
-use crate::study::results_table::{TableKind, read_table};
+use crate::study::results::record::{RunRecord, from_dataframe};
+use crate::study::results::results_table::{TableKind, read_table};
 use polars::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -138,7 +138,7 @@ pub fn design_stats(summary: &DataFrame) -> Result<Vec<DesignStats>, PlotError> 
 /// The operating speed of the study in `dir`, from its `study.toml`; a
 /// figure only marks it, so a folder without a readable plan goes without.
 fn operating_speed(dir: &Path) -> Option<f64> {
-    use crate::study::config::StudyFile;
+    use crate::study::plan::config::StudyFile;
     let shown = dir.display().to_string();
     let text = std::fs::read_to_string(dir.join("study.toml")).ok()?;
     let plan = StudyFile::parse(&text, &shown)
@@ -154,7 +154,8 @@ fn total_indices(dir: &Path) -> Result<Vec<TotalIndex>, PlotError> {
     if !path.is_file() {
         return Ok(Vec::new());
     }
-    let df = crate::study::io::read_parquet(&path).map_err(|e| PlotError::unreadable(&path, e))?;
+    let df = crate::study::results::io::read_parquet(&path)
+        .map_err(|e| PlotError::unreadable(&path, e))?;
     let settling = crate::study::sensitivity::Measure::RestrictedSettling.name();
     let (design, measure, input) = (
         df.column("design_id")?.u32()?.clone(),

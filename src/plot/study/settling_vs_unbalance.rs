@@ -5,7 +5,7 @@ use super::StudyData;
 use super::labels::{drives, geometries};
 use crate::plot::PlotError;
 use crate::plot::style::{self, Figure, Swatch, TICK, linear_label, log_ticks, point_style, text};
-use crate::study::record::RunRecord;
+use crate::study::results::record::RunRecord;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;

@@ -310,7 +310,7 @@ pub fn render(figure: &impl Figure, path: &Path) -> Result<(), PlotError> {
                 figure.draw(&root.margin(8, 4, 4, 4))?;
                 root.present()?;
             }
-            crate::study::io::write_text(path, &svg)?;
+            crate::study::results::io::write_text(path, &svg)?;
         }
         Format::Png => {
             // The encoder picks the format from the extension, so the
@@ -327,7 +327,7 @@ pub fn render(figure: &impl Figure, path: &Path) -> Result<(), PlotError> {
                 let _ = std::fs::remove_file(&tmp);
                 return Err(e);
             }
-            crate::study::io::move_into_place(&tmp, path)?;
+            crate::study::results::io::move_into_place(&tmp, path)?;
         }
     }
     Ok(())

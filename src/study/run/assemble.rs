@@ -3,7 +3,7 @@
 //! optimiser's candidates are).
 
 use super::*;
-use crate::study::stream::Matrix;
+use crate::study::plan::stream::Matrix;
 
 /// Execute one run of the plan. Never panics: a failed run is a row with a reason.
 pub fn run_one(plan: &StudyPlan, run_id: u64) -> RunRecord {
@@ -41,15 +41,17 @@ pub fn sample_simulation_in(
         sample.initial_angles = sample.initial_angles.repeat(planes);
     }
     if let Some(couple) = &sample.couple {
-        let planes =
-            super::super::couple::plane_unbalances((sample.unbalance, sample.direction), couple);
+        let planes = crate::study::plan::couple::plane_unbalances(
+            (sample.unbalance, sample.direction),
+            couple,
+        );
         let at = plan
             .file
             .sampling
             .couple
             .as_ref()
             .and_then(|c| c.at.map(|p| p.0));
-        super::super::couple::apply(&mut scene.rotor, at, &planes);
+        crate::study::plan::couple::apply(&mut scene.rotor, at, &planes);
     }
     sample.weights = draw_weights(plan, design, sample_id, matrix, &mut scene);
     if !sample.uncertain.is_empty() {

@@ -70,7 +70,7 @@ pub(super) fn execute(
             }
             buffer.sort_by_key(|r| r.run_id);
             let mut df = to_dataframe(buffer)?;
-            super::super::plane_designs::append_columns(&mut df, &plan.designs)?;
+            crate::study::plan::plane_designs::append_columns(&mut df, &plan.designs)?;
             write_chunk(
                 &chunks.join(format!("chunk-{next_chunk:06}.arrow")),
                 &mut df,

@@ -4,9 +4,9 @@
 //! a fresh start. Nothing here runs anything; a refusal changes nothing.
 
 use super::{PLAN_ID_FILE, RunError, RunOptions};
-use crate::study::config::StudyPlan;
-use crate::study::io::{Provenance, folder_copy, foreign_table, write_text};
-use crate::study::lock::FolderLock;
+use crate::study::plan::config::StudyPlan;
+use crate::study::results::io::{Provenance, folder_copy, foreign_table, write_text};
+use crate::study::run::lock::FolderLock;
 use std::path::{Path, PathBuf};
 
 /// The entries of a study's output folder.

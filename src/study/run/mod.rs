@@ -1,23 +1,34 @@
-//! The study executor: every pending run of the plan on all cores (rayon),
+//! The runner: every pending run of the plan on all cores (rayon),
 //! finished runs written in chunks as they complete, resumable, shardable.
+//! Uses the plan, the results and the decision (racing, the summary).
+//!
+//! - this file: the executor's entry points ([`run_study`], shards, options).
+//! - [`racing`]: designs dropped early once they cannot be #1.
+//! - [`adaptive`]: sampling in batches until a requested precision.
+//! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`merge`]: combining shard outputs.
+//! - [`lock`]: one writer per results folder.
+//! - [`study_folder`]: the study's folder as another verb's destination (tradeoff, optimize).
 //!
 //! Results never depend on the schedule: each run draws from its own stream
-//! ([`super::sample`]) and the final files are sorted by run index, so they
+//! ([`crate::study::plan::sample`]) and the final files are sorted by run index, so they
 //! are bit-identical (but for the wall-time column) for any thread count,
 //! any interruption and resumption, and any sharding followed by a merge.
 
-use super::adaptive::{Precision, batch_ids, batches, precision};
-use super::aggregate::summarize_table;
-use super::config::StudyPlan;
-use super::design::Design;
-use super::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet};
-use super::lock::LockError;
-use super::racing::{Departure, Race, only_running, races};
-use super::record::{RunRecord, from_dataframe, to_dataframe};
-use super::runs_file::{Piece, read_pieces_summary_columns, read_summary_columns, write_runs};
-use super::sample::{Sample, draw_sample_in, draw_weights};
 use crate::metrics::{Outcome, RunMetrics};
 use crate::simulation::Simulation;
+use crate::study::plan::config::StudyPlan;
+use crate::study::plan::design::Design;
+use crate::study::plan::sample::{Sample, draw_sample_in, draw_weights};
+use crate::study::results::io::{Provenance, read_parquet, sha256_hex, write_chunk, write_parquet};
+use crate::study::results::record::{RunRecord, from_dataframe, to_dataframe};
+use crate::study::results::runs_file::{
+    Piece, read_pieces_summary_columns, read_summary_columns, write_runs,
+};
+use crate::study::run::adaptive::{Precision, batch_ids, batches, precision};
+use crate::study::run::aggregate::summarize_table;
+use crate::study::run::lock::LockError;
+use crate::study::run::racing::{Departure, Race, only_running, races};
 use polars::prelude::{ChunkCompareIneq, DataFrame, PolarsError, PolarsResult};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -25,9 +36,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, mpsc};
 use std::time::{Duration, Instant};
 
+pub mod adaptive;
+pub mod aggregate;
 mod assemble;
 mod executor;
 mod folder;
+pub mod lock;
+pub mod merge;
+pub mod racing;
+pub mod study_folder;
 
 pub use assemble::{
     run_design_sample, run_design_sample_in, run_one, sample_simulation, sample_simulation_in,
@@ -317,7 +334,7 @@ impl RunError {
                 | RunError::NotOwned { .. }
                 | RunError::AdaptiveSharded
                 | RunError::Misshapen { .. }
-        ) || matches!(self, RunError::Polars(e) if super::io::is_not_parquet(e))
+        ) || matches!(self, RunError::Polars(e) if crate::study::results::io::is_not_parquet(e))
     }
 }
 
@@ -586,7 +603,7 @@ impl RunContext<'_> {
             // A shard whose slice of a small study holds no run is a shard all
             // the same: an empty table with the runs' columns, which `merge`
             // reads as such.
-            let mut empty = super::record::to_dataframe(&[])?;
+            let mut empty = crate::study::results::record::to_dataframe(&[])?;
             write_parquet(runs_path, &mut empty, provenance)?;
             0
         } else {

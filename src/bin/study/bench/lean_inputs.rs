@@ -15,7 +15,7 @@ use autobal::metrics::reference::a_ref;
 use autobal::model::effect::contact::Contact;
 use autobal::model::frame::RotatingSystem;
 use autobal::simulation::{Fidelity, Simulation, scaled_atol};
-use autobal::study::config::{Design, StudyPlan};
+use autobal::study::plan::config::{Design, StudyPlan};
 use autobal::study::run::{run_design_sample, sample_simulation};
 use std::f64::consts::PI;
 use std::io::Write;
@@ -140,7 +140,7 @@ pub fn lean_plan_of(path: &Path, samples: u32) -> Result<StudyPlan, String> {
     let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
     let shown = path.display().to_string();
     let mut file =
-        autobal::study::config::StudyFile::parse(&text, &shown).map_err(|e| e.to_string())?;
+        autobal::study::plan::config::StudyFile::parse(&text, &shown).map_err(|e| e.to_string())?;
     file.sampling.samples = samples.max(1);
     file.metrics.certified_hold = false;
     file.plan(&text, &shown).map_err(|e| e.to_string())

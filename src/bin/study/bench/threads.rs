@@ -2,8 +2,8 @@
 //! with the CPU time the study actually got (a shared machine lends cores).
 
 use super::median;
-use autobal::study::config::{StudyFile, StudyPlan};
-use autobal::study::record::RunRecord;
+use autobal::study::plan::config::{StudyFile, StudyPlan};
+use autobal::study::results::record::RunRecord;
 use autobal::study::run::{NoProgress, RunError, RunOptions, run_study};
 use serde::Serialize;
 use std::path::Path;

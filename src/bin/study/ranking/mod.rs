@@ -5,9 +5,9 @@
 
 use crate::UserError;
 use crate::output::{dropped_note, fitted_table, p_value_text, text_table, text_width, wrap};
-use autobal::study::criterion::Criterion;
-use autobal::study::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
-use autobal::study::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE};
+use autobal::decide::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
+use autobal::decide::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE};
+use autobal::study::plan::criterion::Criterion;
 use polars::prelude::DataFrame;
 
 mod findings;
@@ -20,7 +20,7 @@ use findings::{disagreement_line, recommendation_line, verdict_line};
 use notes::{contact_line, dead_band_line, merged_line, passage_table};
 
 /// The summary's columns by name (the library's reader).
-use autobal::study::summary_columns::SummaryColumns as Summary;
+use autobal::study::results::summary_columns::SummaryColumns as Summary;
 
 /// A parameter to four significant digits (`10`, `0.5`, not
 /// `0.05000000000000001`), or "–".

@@ -89,7 +89,7 @@ type PlaneBands = Vec<(Vec<Option<f64>>, Vec<Option<f64>>)>;
 fn plane_bands(sum: &Summary) -> Result<PlaneBands, UserError> {
     let mut out = Vec::new();
     for p in 0.. {
-        let [.., band, dead] = autobal::study::plane_summary::column_names(p);
+        let [.., band, dead] = autobal::decide::plane_summary::column_names(p);
         if sum.0.column(&dead).is_err() {
             break;
         }

@@ -3,10 +3,10 @@
 //! most of #1's settling time.
 
 use crate::UserError;
-use autobal::study::config::StudyPlan;
-use autobal::study::decision::StudyDecision;
-use autobal::study::io::read_parquet;
-use autobal::study::robustness::{PARTS, robustness};
+use autobal::decide::decision::StudyDecision;
+use autobal::decide::robustness::{PARTS, robustness};
+use autobal::study::plan::config::StudyPlan;
+use autobal::study::results::io::read_parquet;
 use autobal::study::sensitivity::{FILE as SENSITIVITY_FILE, Measure, read_totals};
 use polars::prelude::DataFrame;
 use std::path::Path;
@@ -99,7 +99,7 @@ pub fn robustness_findings(
                     "of the uncertain keys, {} explains most of #1's settling time capped at the horizon: {:.0} % of its variance (first-order, from {} equal-count bins of the study's runs, less what noise alone puts between them); `study sensitivity` gives every input's total index.",
                     top.key,
                     100.0 * top.share,
-                    autobal::study::robustness::BINS
+                    autobal::decide::robustness::BINS
                 ));
             }
         }

@@ -1,0 +1,184 @@
+//! A criterion measured on a design's runs, and two designs compared on it
+//! with the test that fits it (docs/statistics.md, "Ranking criteria").
+//! The criterion itself, as the study file states it, is the plan's
+//! (`crate::study::plan::criterion`).
+
+use crate::stats::paired::{Settling, SettlingComparison, compare_settling};
+use crate::stats::paired_measures::{
+    Difference, honest_p, mean_difference_bootstrap, paired_mean_difference, quantile_difference,
+    share_difference,
+};
+use crate::study::plan::criterion::{Criterion, Within};
+use crate::study::results::measured_runs::{DesignRuns, Scale};
+use rand::Rng;
+
+impl Criterion {
+    /// The design's value of this measure; `None` when it lies beyond the
+    /// run (a median or p90 no run reached) or there are no runs.
+    pub fn value(self, runs: &DesignRuns, scale: &Scale) -> Option<f64> {
+        match self {
+            Criterion::Median => runs.kaplan_meier()?.median(),
+            Criterion::Mean => Some(runs.kaplan_meier()?.restricted_mean(scale.tau).estimate),
+            Criterion::P90 => {
+                let q = quantile(&uncapped_times(runs), 0.9)?;
+                q.is_finite().then_some(q)
+            }
+            Criterion::ResidualP95 => quantile(
+                &runs.residual.iter().flatten().copied().collect::<Vec<_>>(),
+                0.95,
+            ),
+            _ => {
+                let yes = self.outcomes(runs, scale);
+                (!yes.is_empty())
+                    .then(|| yes.iter().filter(|&&y| y).count() as f64 / yes.len() as f64)
+            }
+        }
+    }
+
+    /// Per run: yes when the run meets a share criterion.
+    fn outcomes(self, runs: &DesignRuns, scale: &Scale) -> Vec<bool> {
+        let settled_by = |limit: f64| -> Vec<bool> {
+            runs.settling
+                .iter()
+                .map(|o| o.settled && o.time <= limit)
+                .collect()
+        };
+        match self {
+            Criterion::SettledFraction => runs.settling.iter().map(|o| o.settled).collect(),
+            Criterion::SettledBy(Within::Revs(x)) => settled_by(x),
+            Criterion::SettledBy(Within::Seconds(x)) => settled_by(x / scale.rev_seconds),
+            Criterion::ResidualBelow(m) => runs
+                .residual_abs
+                .iter()
+                .map(|r| r.is_some_and(|r| r <= m))
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Design A against design B on this measure (A − B), paired when
+    /// `paired` (the caller checked that they share samples).
+    pub fn compare(
+        self,
+        a: &DesignRuns,
+        b: &DesignRuns,
+        paired: bool,
+        scale: &Scale,
+        level: f64,
+        rng: &mut impl Rng,
+    ) -> Option<Difference> {
+        match self {
+            Criterion::Median if paired => {
+                let to = |d: &DesignRuns| -> Vec<Settling> {
+                    d.settling
+                        .iter()
+                        .map(|o| Settling::new(o.time, o.settled))
+                        .collect()
+                };
+                let c = compare_settling(&to(a), &to(b), level, rng)?;
+                let value = |d| self.value(d, scale).unwrap_or(f64::INFINITY);
+                Some(sign_difference(&c, value(a), value(b)))
+            }
+            Criterion::Median => quantile_difference(
+                &uncapped_times(a),
+                &uncapped_times(b),
+                0.5,
+                false,
+                level,
+                rng,
+            ),
+            Criterion::Mean => {
+                let (x, y) = (capped_times(a, scale.tau), capped_times(b, scale.tau));
+                let d = if paired {
+                    paired_mean_difference(&x, &y, level)
+                } else {
+                    mean_difference_bootstrap(&x, &y, level, rng)
+                };
+                d.map(|d| Difference {
+                    scale: settled_scale(a, b).unwrap_or(d.scale),
+                    ..d
+                })
+            }
+            Criterion::P90 => quantile_difference(
+                &capped_times(a, scale.tau),
+                &capped_times(b, scale.tau),
+                0.9,
+                paired,
+                level,
+                rng,
+            ),
+            Criterion::ResidualP95 => {
+                let (x, y): (Vec<f64>, Vec<f64>) = if paired {
+                    a.residual
+                        .iter()
+                        .zip(&b.residual)
+                        .filter_map(|(x, y)| x.zip(*y))
+                        .unzip()
+                } else {
+                    (
+                        a.residual.iter().flatten().copied().collect(),
+                        b.residual.iter().flatten().copied().collect(),
+                    )
+                };
+                quantile_difference(&x, &y, 0.95, paired, level, rng)
+            }
+            _ => share_difference(
+                &self.outcomes(a, scale),
+                &self.outcomes(b, scale),
+                paired,
+                level,
+            ),
+        }
+    }
+}
+
+/// The paired median comparison as a [`Difference`]: the Kaplan–Meier
+/// medians `a` and `b` (+∞ beyond the run), the median of t_A − t_B over
+/// pairs with its interval, and the sign test's p-value.
+pub fn sign_difference(c: &SettlingComparison, a: f64, b: f64) -> Difference {
+    Difference {
+        a,
+        b,
+        scale: a.abs().max(b.abs()),
+        difference: -c.median_difference,
+        interval: (
+            -c.median_difference_interval.1,
+            -c.median_difference_interval.0,
+        ),
+        p_value: honest_p(c.sign_test_p),
+        test: "sign",
+    }
+}
+
+/// The larger of two designs' mean settling times over their settled runs
+/// (`None` when neither settled): the scale of a restricted mean's
+/// difference, which the horizon does not move.
+pub fn settled_scale(a: &DesignRuns, b: &DesignRuns) -> Option<f64> {
+    let mean = |d: &DesignRuns| d.settled_mean();
+    match (mean(a), mean(b)) {
+        (Some(x), Some(y)) => Some(x.max(y)),
+        (x, y) => x.or(y),
+    }
+}
+
+/// Settling times with a run that did not settle counted as τ.
+fn capped_times(runs: &DesignRuns, tau: f64) -> Vec<f64> {
+    runs.settling
+        .iter()
+        .map(|o| if o.settled { o.time.min(tau) } else { tau })
+        .collect()
+}
+
+/// Settling times with a run that did not settle counted as +∞.
+fn uncapped_times(runs: &DesignRuns) -> Vec<f64> {
+    runs.settling
+        .iter()
+        .map(|o| if o.settled { o.time } else { f64::INFINITY })
+        .collect()
+}
+
+/// The q-quantile by linear interpolation (polars's rule); +∞ values are
+/// allowed and give +∞ when the quantile falls among them.
+fn quantile(values: &[f64], q: f64) -> Option<f64> {
+    crate::stats::quantile::quantile(values, q, crate::stats::quantile::Interpolation::Linear)
+}
