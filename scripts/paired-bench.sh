@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Paired speed comparison of two `study` binaries on this machine, in one run:
 # interleaved (ABBA) single-thread runs of the main job at 100 samples per
-# design, then `study bench --quick --json` ABBA; prints medians and the
-# after/before ratios. Build each binary from its commit and copy it aside:
-#   scripts/paired-bench.sh /tmp/study-before target/debug/study [rounds]
+# design, then `autobal-bench --quick --json` ABBA; prints medians and the
+# after/before ratios. Build each binary from its commit and copy it aside
+# with its `autobal-bench` beside it (the bench binary of the same build is
+# found in the same folder; a build from before the two binaries were split
+# answers `study bench` instead):
+#   scripts/paired-bench.sh /tmp/before/study target/debug/study [rounds]
 set -euo pipefail
 before=$(realpath "$1")
 after=$(realpath "$2")
@@ -25,7 +28,12 @@ for _ in $(seq "$rounds"); do
 done
 for which in before after after before; do
   bin=$before; [ "$which" = after ] && bin=$after
-  "$bin" bench --quick --json > "bench-$which-$RANDOM.json"
+  bench_bin=$(dirname "$bin")/autobal-bench
+  if [ -x "$bench_bin" ]; then
+    "$bench_bin" --quick --json > "bench-$which-$RANDOM.json"
+  else
+    "$bin" bench --quick --json > "bench-$which-$RANDOM.json"
+  fi
 done
 python3 - <<'EOF'
 import glob, json, statistics as st

@@ -7,7 +7,7 @@
 // The benchmark's reference problem lives in the `study` binary, which a
 // test cannot link against; its file uses the library only, so it is compiled in.
 #[allow(dead_code)]
-#[path = "../src/bin/study/bench/problem.rs"]
+#[path = "../src/bin/autobal-bench/bench/problem.rs"]
 mod problem;
 
 use autobal::integrate::{Method, OdeSystem, Status};

@@ -24,11 +24,12 @@ source "$here/../venv.sh"
 lean=$here/target/release/autobal-lean
 profile=${PROFILE:-debug}
 case "$profile" in
-    debug) (cd "$root" && cargo build --quiet --bin study) ;;
-    release) (cd "$root" && cargo build --quiet --release --bin study) ;;
+    debug) (cd "$root" && cargo build --quiet --bin study --bin autobal-bench) ;;
+    release) (cd "$root" && cargo build --quiet --release --bin study --bin autobal-bench) ;;
     *) echo "PROFILE must be debug or release, not '$profile'" >&2; exit 2 ;;
 esac
 study=${CARGO_TARGET_DIR:-$root/target}/$profile/study
+bench=${CARGO_TARGET_DIR:-$root/target}/$profile/autobal-bench
 
 out=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/autobal-peer.XXXXXX")}
 mkdir -p "$out"
@@ -43,7 +44,7 @@ for contact in on rigid off; do
         -e "s|^seed = \(.*\)\$|seed = \1\noutput = \"$out/study\"|" \
         "$here/peer.toml" >"$out/peer_$contact.toml"
 done
-"$study" bench --lean-inputs "$out/runs.csv" --lean-study "$out/peer_off.toml" --samples "$samples"
+"$bench" --lean-inputs "$out/runs.csv" --lean-study "$out/peer_off.toml" --samples "$samples"
 
 run_autobal() {
     for contact in on rigid off; do

@@ -26,15 +26,16 @@ source "$here/../venv.sh"
     cargo build --quiet --release && cargo build --quiet --profile full)
 lean_matched=$here/target/release/autobal-lean
 lean_full=$here/target/full/autobal-lean
-(cd "$root" && cargo build --quiet --bin study)
+(cd "$root" && cargo build --quiet --bin study --bin autobal-bench)
 study=${CARGO_TARGET_DIR:-$root/target}/debug/study
+bench=${CARGO_TARGET_DIR:-$root/target}/debug/autobal-bench
 
 out=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/autobal-lean.XXXXXX")}
 mkdir -p "$out"
 rm -f "$out"/autobal-*.parquet "$out"/lean-*.txt "$out"/walls.txt
 echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown))" >&2
 
-"$study" bench --lean-inputs "$out/runs.csv" --samples "$samples"
+"$bench" --lean-inputs "$out/runs.csv" --samples "$samples"
 # The same plan for `study run`: the main job with its samples cut down and
 # its output in $out (the draws depend on the seed, design and sample only).
 # Twice: by default (certified hold) and holding every window to its end,

@@ -11,7 +11,7 @@
 #   OUT              folder for the per-round JSON files (default: a fresh temp folder)
 #   CARGO_TARGET_DIR honoured as by cargo
 #
-# Each round runs autobal's solves (`study bench --peer-cases --json`) and then
+# Each round runs autobal's solves (`autobal-bench --peer-cases --json`) and then
 # SciPy's, alternating which goes first, so that load from other processes
 # hits both sides alike; the report pools all rounds (medians) and also gives
 # the median of the per-round ratios. Not part of the tests or CI.
@@ -28,8 +28,8 @@ scipy_rhs=${SCIPY_RHS:-auto}
 # shellcheck source=../venv.sh
 source "$here/../venv.sh"
 
-(cd "$root" && cargo build --release --quiet --bin study)
-study=${CARGO_TARGET_DIR:-$root/target}/release/study
+(cd "$root" && cargo build --release --quiet --bin autobal-bench)
+bench=${CARGO_TARGET_DIR:-$root/target}/release/autobal-bench
 
 out=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/autobal-scipy.XXXXXX")}
 mkdir -p "$out"
@@ -38,10 +38,10 @@ echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null
 
 # SciPy reads start, tolerances, RHS samples and autobal's final states from
 # here (all deterministic; only the times differ between autobal runs).
-"$study" bench --peer-cases --json --revolutions "$revolutions" --repeats 1 >"$out/input.json"
+"$bench" --peer-cases --json --revolutions "$revolutions" --repeats 1 >"$out/input.json"
 
 run_autobal() {
-    "$study" bench --peer-cases --json --revolutions "$revolutions" \
+    "$bench" --peer-cases --json --revolutions "$revolutions" \
         --repeats "$autobal_repeats" >"$out/autobal-$1.json"
 }
 run_scipy() {

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """SciPy's solve_ivp (DOP853, RK45) on autobal's reference problem.
 
-The peer of `study bench --peer-cases`: the same equations, scene, start,
+The peer of `autobal-bench --peer-cases`: the same equations, scene, start,
 tolerances and horizon, solved the way a Python user would solve them, so that
 `run.sh` can report SciPy's time per solve over autobal's.
 
@@ -457,7 +457,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="cmd", required=True)
     s = sub.add_parser("solve", help="time SciPy's solves of autobal's peer cases")
-    s.add_argument("--autobal", required=True, help="output of `study bench --peer-cases --json`")
+    s.add_argument("--autobal", required=True, help="output of `autobal-bench --peer-cases --json`")
     s.add_argument("--out", help="write the results as JSON here")
     s.add_argument("--repeats", type=int, default=3, help="timed solves per case")
     s.add_argument("--methods", nargs="+", default=METHODS, choices=METHODS)

@@ -27,14 +27,15 @@ rounds=${3:-3}
 # shellcheck source=../venv.sh
 source "$here/../venv.sh"
 
-(cd "$root" && cargo build --quiet --bin study)
+(cd "$root" && cargo build --quiet --bin study --bin autobal-bench)
 study=${CARGO_TARGET_DIR:-$root/target}/debug/study
+bench=${CARGO_TARGET_DIR:-$root/target}/debug/autobal-bench
 
 out=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/autobal-settling.XXXXXX")}
 mkdir -p "$out"
 echo "results: $out   (load average: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown))" >&2
 
-"$study" bench --lean-inputs "$out/runs.csv" --samples "$samples" >&2
+"$bench" --lean-inputs "$out/runs.csv" --samples "$samples" >&2
 sed -e "s/^samples = [0-9]*/samples = $samples/" \
     -e "s|^seed = \(.*\)\$|seed = \1\noutput = \"$out/study\"|" \
     "$root/studies/three_balls.toml" >"$out/three_balls.toml"

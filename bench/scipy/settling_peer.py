@@ -8,7 +8,7 @@ the main job as a study does: each run from its own start until r = |(u, v)|
 has stayed inside the band δ·A_ref for the hold window (or diverges, or
 reaches t_end), r read from the dense output on autobal's sample grid.
 
-Inputs: the CSV of `study bench --lean-inputs` (equations' constants, start,
+Inputs: the CSV of `autobal-bench --lean-inputs` (equations' constants, start,
 tolerances, sample step, band, window: the lean reference's inputs,
 bench/lean). The model is the lean program's rotating-frame right-hand side
 (bench/lean/src/main.rs, `Model::rhs`) on Python floats with `math` (at
@@ -178,7 +178,7 @@ def solve(run, method):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("runs_csv", help="`study bench --lean-inputs` output")
+    parser.add_argument("runs_csv", help="`autobal-bench --lean-inputs` output")
     parser.add_argument("--method", choices=sorted(METHODS), default="RK45")
     parser.add_argument("--runs", type=int, default=40, help="the first N runs (by id)")
     parser.add_argument("--stride", type=int, default=1, help="every k-th run")

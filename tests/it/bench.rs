@@ -1,26 +1,26 @@
-//! `study bench` through the command line: structure of its JSON output and
+//! `autobal-bench` through the command line: structure of its JSON output and
 //! its option checks. The measurements themselves are unit-tested in the
-//! binary (`src/bin/study/bench/`). Wall-clock figures are never asserted
+//! binary (`src/bin/autobal-bench/bench/`). Wall-clock figures are never asserted
 //! (the machine is shared and noisy).
 
 use autobal::integrate::Method;
 use std::process::Command;
 
-/// The benchmark's cargo counts and tolerances (`src/bin/study/bench/`,
+/// The benchmark's cargo counts and tolerances (`src/bin/autobal-bench/bench/`,
 /// whose unit tests check the report against its own constants).
 const CARGO_COUNTS: usize = 7;
 const RTOLS: usize = 2;
 
-fn study(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_study"))
+fn bench(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_autobal-bench"))
         .args(args)
         .output()
-        .expect("study runs")
+        .expect("autobal-bench runs")
 }
 
 #[test]
-fn study_bench_quick_json() {
-    let out = study(&["bench", "--quick", "--json", "--revolutions", "5"]);
+fn bench_quick_json() {
+    let out = bench(&["--quick", "--json", "--revolutions", "5"]);
     assert!(
         out.status.success(),
         "{}",
@@ -43,17 +43,17 @@ fn study_bench_quick_json() {
 }
 
 #[test]
-fn study_bench_rejects_bad_options_and_documents_itself() {
-    let out = study(&["bench", "--repeats", "0"]);
+fn bench_rejects_bad_options_and_documents_itself() {
+    let out = bench(&["--repeats", "0"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--repeats"));
-    let help = study(&["bench", "--help"]);
+    let help = bench(&["--help"]);
     assert!(String::from_utf8_lossy(&help.stdout).contains("Examples:"));
 }
 
 #[test]
-fn study_bench_peer_cases_and_thread_scaling_json() {
-    let out = study(&["bench", "--peer-cases", "--quick", "--json"]);
+fn bench_peer_cases_and_thread_scaling_json() {
+    let out = bench(&["--peer-cases", "--quick", "--json"]);
     assert!(
         out.status.success(),
         "{}",
@@ -65,7 +65,7 @@ fn study_bench_peer_cases_and_thread_scaling_json() {
     }
     assert_eq!(v["cases"][0]["method"], "dp5");
 
-    let out = study(&["bench", "--thread-scaling", "--quick", "--json"]);
+    let out = bench(&["--thread-scaling", "--quick", "--json"]);
     assert!(
         out.status.success(),
         "{}",
@@ -75,21 +75,15 @@ fn study_bench_peer_cases_and_thread_scaling_json() {
     assert_eq!(v["identical_results"], true);
     assert_eq!(v["timings"].as_array().unwrap().len(), 2);
 
-    let both = study(&["bench", "--peer-cases", "--thread-scaling"]);
+    let both = bench(&["--peer-cases", "--thread-scaling"]);
     assert_eq!(both.status.code(), Some(2));
 }
 
 #[test]
-fn study_bench_lean_inputs_writes_one_row_per_run() {
+fn bench_lean_inputs_writes_one_row_per_run() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("runs.csv");
-    let out = study(&[
-        "bench",
-        "--lean-inputs",
-        path.to_str().unwrap(),
-        "--samples",
-        "1",
-    ]);
+    let out = bench(&["--lean-inputs", path.to_str().unwrap(), "--samples", "1"]);
     assert!(
         out.status.success(),
         "{}",
@@ -104,6 +98,25 @@ fn study_bench_lean_inputs_writes_one_row_per_run() {
     assert!(lines.iter().all(|l| l.split(',').count() == columns));
 
     // --samples means nothing on its own.
-    let alone = study(&["bench", "--samples", "3"]);
+    let alone = bench(&["--samples", "3"]);
     assert_eq!(alone.status.code(), Some(2));
+}
+
+#[test]
+fn the_designers_binary_lists_no_benchmark() {
+    let help = Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg("--help")
+        .output()
+        .expect("study runs");
+    let text = String::from_utf8_lossy(&help.stdout);
+    assert!(text.contains("run") && text.contains("simulate"), "{text}");
+    assert!(
+        !text.lines().any(|l| l.trim_start().starts_with("bench")),
+        "{text}"
+    );
+    let refused = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["bench", "--quick"])
+        .output()
+        .expect("study runs");
+    assert_eq!(refused.status.code(), Some(2));
 }

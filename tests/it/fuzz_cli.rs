@@ -91,8 +91,7 @@ fn options(verb: &[&str]) -> Vec<(String, bool)> {
         .take_while(|w| !w.contains('.'))
         .copied()
         .collect();
-    let help = Command::new(env!("CARGO_BIN_EXE_study"))
-        .args(&words)
+    let help = crate::fuzz_input::command_for(&words)
         .arg("--help")
         .output()
         .unwrap();
@@ -237,6 +236,10 @@ fn path_flags() -> Vec<(Vec<String>, String)> {
         let mut words = vec![verb];
         words.extend(word_after("__fish_seen_subcommand_from "));
         out.push((words, format!("--{flag}")));
+    }
+    // The benchmark binary writes no completions; its path flags by name.
+    for flag in ["--lean-inputs", "--lean-study"] {
+        out.push((vec!["bench".to_string()], flag.to_string()));
     }
     out
 }

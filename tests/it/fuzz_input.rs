@@ -95,13 +95,29 @@ fn run_boxed(args: &[&str]) -> (Option<i32>, String) {
 
 /// `study args…` in the folder `cwd`: (exit code, stderr); a run longer
 /// than `limit` is killed and counts as a hang (the test fails).
+/// The command a test's command line names: `bench …` is the benchmark
+/// binary's (the harness has a binary of its own), anything else `study`'s.
+pub(crate) fn command_for<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Command {
+    match args.split_first() {
+        Some((first, rest)) if first.as_ref() == "bench" => {
+            let mut c = Command::new(env!("CARGO_BIN_EXE_autobal-bench"));
+            c.args(rest);
+            c
+        }
+        _ => {
+            let mut c = Command::new(env!("CARGO_BIN_EXE_study"));
+            c.args(args);
+            c
+        }
+    }
+}
+
 pub(crate) fn run_boxed_in<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(
     cwd: &Path,
     args: &[S],
     limit: Duration,
 ) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_study"))
-        .args(args)
+    let mut child = command_for(args)
         .current_dir(cwd)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())

@@ -9,10 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn study_cmd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_study"))
-        .args(args)
-        .output()
-        .unwrap()
+    crate::fuzz_input::command_for(args).output().unwrap()
 }
 
 fn stderr(out: &Output) -> String {

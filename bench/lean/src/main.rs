@@ -1,6 +1,6 @@
 //! Lean reference for autobal's default path (issue 17, item 6).
 //!
-//! Reads the runs written by `study bench --lean-inputs FILE` and redoes each
+//! Reads the runs written by `autobal-bench --lean-inputs FILE` and redoes each
 //! one in the rotating frame with the least code that gives the same answer:
 //! a minimal Dormand–Prince 5(4) (Hairer's DOPRI5 coefficients, error norm,
 //! PI step control, initial step rule and 4th-order dense output, as in
@@ -430,7 +430,7 @@ fn solve(run: &Run) -> Answer {
     }
 }
 
-/// Parse the CSV of `study bench --lean-inputs` (no quoting: no cell holds a comma).
+/// Parse the CSV of `autobal-bench --lean-inputs` (no quoting: no cell holds a comma).
 fn read_runs(path: &str) -> Result<Vec<Run>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
     let mut lines = text.lines();

@@ -21,7 +21,7 @@ use std::time::Instant;
 const N: usize = 3;
 /// State dimension 2·(2 + N), fixed at compile time for nalgebra's SVector.
 const DIM: usize = 2 * (2 + N);
-/// Horizon in revolutions (as `study bench`).
+/// Horizon in revolutions (as `autobal-bench`).
 const REVOLUTIONS: f64 = 500.0;
 /// Scalar absolute tolerance as a fraction of rtol (scalar: not every peer takes a vector).
 const ATOL_PER_RTOL: f64 = 1e-2;

@@ -14,7 +14,7 @@ pub const MAX_POINTS: usize = 100_000;
 pub const MAX_MAP_POINTS: usize = 1_000_000;
 
 /// A number in `lo..=hi` of a flag, or the reason it is not.
-fn whole_in(text: &str, what: &str, lo: usize, hi: usize) -> Result<usize, String> {
+pub fn whole_in(text: &str, what: &str, lo: usize, hi: usize) -> Result<usize, String> {
     let n: usize = text
         .trim()
         .parse()
@@ -144,15 +144,13 @@ pub fn progress_seconds(text: &str) -> Result<f64, String> {
     )
 }
 
-/// Most repeats of a timed bench case.
-pub const MAX_REPEATS: usize = 10_000;
 /// Most samples per design a bench verb runs, or runs `study tradeoff` measures.
 pub const MAX_BENCH_RUNS: usize = 1_000_000;
 /// Longest horizon of a bench solve, in revolutions (as a study's `t_end_revs`).
 pub const MAX_BENCH_REVOLUTIONS: f64 = 1e7;
 
 /// A finite number in (0, `hi`], or the reason it is not.
-fn number_in(text: &str, what: &str, hi: f64) -> Result<f64, String> {
+pub fn number_in(text: &str, what: &str, hi: f64) -> Result<f64, String> {
     let v: f64 = text
         .trim()
         .parse()
@@ -177,20 +175,6 @@ pub fn budget_revs(text: &str) -> Result<f64, String> {
 /// `tradeoff --budget-residual`: a residual error in (0, 1e3] A_ref.
 pub fn budget_residual(text: &str) -> Result<f64, String> {
     number_in(text, "residual error in units of A_ref", 1e3)
-}
-
-/// `bench --revolutions`: a horizon in (0, [`MAX_BENCH_REVOLUTIONS`]].
-pub fn bench_revolutions(text: &str) -> Result<f64, String> {
-    number_in(
-        text,
-        "horizon of each solve in revolutions",
-        MAX_BENCH_REVOLUTIONS,
-    )
-}
-
-/// `bench --repeats`: 1 ..= [`MAX_REPEATS`].
-pub fn repeats(text: &str) -> Result<usize, String> {
-    whole_in(text, "timed repeats per case", 1, MAX_REPEATS)
 }
 
 /// `bench --samples`, `tradeoff --runs`: 1 ..= [`MAX_BENCH_RUNS`].
@@ -253,9 +237,8 @@ mod tests {
         for bad in ["-1", "nan", "inf", "0", "1e300"] {
             assert!(budget_residual(bad).is_err(), "{bad}");
             assert!(budget_revs(bad).is_err(), "{bad}");
-            assert!(bench_revolutions(bad).is_err(), "{bad}");
         }
-        assert!(repeats("0").is_err() && bench_runs("0").is_err());
+        assert!(bench_runs("0").is_err());
         assert!(
             bench_runs("4000000000")
                 .unwrap_err()

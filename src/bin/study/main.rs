@@ -2,8 +2,6 @@
 //! library, prints results on stdout and errors on stderr (exit code 2 for
 //! bad input).
 
-mod bench;
-mod bench_cmd;
 mod calibrate_cmd;
 mod check_cmd;
 mod claims_cmd;
@@ -29,9 +27,11 @@ mod stepped_bands_cmd;
 mod stepped_cmd;
 mod sweep_cmd;
 mod tradeoff_cmd;
+mod user_error;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
+pub use user_error::UserError;
 
 /// Design passive auto-balancers by virtual experiment.
 #[derive(Parser)]
@@ -106,9 +106,6 @@ enum Command {
     /// Stability map of the balanced state over speed and unbalance (Parquet and a character picture).
     #[command(after_help = map_cmd::EXAMPLES)]
     Map(map_cmd::MapArgs),
-    /// Time the ODE core: RHS cost per cargo count, solves per method and tolerance.
-    #[command(after_help = bench_cmd::EXAMPLES)]
-    Bench(bench_cmd::BenchArgs),
     /// Write one self-contained HTML report of a finished study: ranking, verdicts, figures, provenance.
     #[command(after_help = report_cmd::EXAMPLES)]
     Report(report_cmd::ReportArgs),
@@ -123,31 +120,8 @@ enum Command {
     Schema(meta_cmd::SchemaArgs),
 }
 
-/// An error: printed on stderr; exit code 2 for bad input, 1 for internal failures.
-pub struct UserError(pub String, pub u8);
-
-impl UserError {
-    /// A failure that is not the user's fault (exit code 1).
-    pub fn internal(message: String) -> Self {
-        UserError(message, 1)
-    }
-}
-
-impl<E: std::fmt::Display> From<E> for UserError {
-    fn from(e: E) -> Self {
-        UserError(e.to_string(), 2)
-    }
-}
-
 fn main() -> ExitCode {
-    // Rust ignores SIGPIPE, so printing to a closed pipe would panic; a
-    // filter such as `| head` should end the verb quietly instead. Every
-    // verb writes its files before it prints, so nothing is left half-written.
-    // SAFETY: setting a signal's disposition to its default before any
-    // thread starts has no other effect.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
+    user_error::end_quietly_on_closed_pipe();
     // Help text wraps at words to the terminal (80 columns off a terminal).
     let matches = Cli::command()
         .term_width(output::terminal_columns())
@@ -173,7 +147,6 @@ fn main() -> ExitCode {
         Command::Tradeoff(args) => tradeoff_cmd::run(&args),
         Command::Sensitivity(args) => sensitivity_cmd::run(&args),
         Command::Calibrate(args) => calibrate_cmd::run(&args),
-        Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
         Command::Report(args) => report_cmd::run(&args),
         Command::Check(args) => check_cmd::check(&args),
@@ -182,18 +155,5 @@ fn main() -> ExitCode {
         Command::Man => meta_cmd::man(Cli::command()),
         Command::Schema(args) => meta_cmd::schema(&args),
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(UserError(message, code)) => {
-            // Wrapped on a terminal; whole on one line in a log or a pipe,
-            // where scripts and tests search it.
-            let line = format!("error: {message}");
-            if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-                eprint!("{}", output::wrap(&line, output::text_width()));
-            } else {
-                eprintln!("{line}");
-            }
-            ExitCode::from(code)
-        }
-    }
+    user_error::exit_code(result)
 }

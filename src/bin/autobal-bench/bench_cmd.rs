@@ -1,4 +1,4 @@
-//! `study bench`: time the ODE core (RHS cost per cargo count, solves per
+//! The benchmark's options and reports: time the ODE core (RHS cost per cargo count, solves per
 //! method and tolerance), the solves `bench/scipy` repeats with SciPy, or a
 //! small study at 1 and 2 threads, and print the figures; or write the main
 //! job's runs for the lean reference `bench/lean`.
@@ -10,20 +10,20 @@ use crate::bench::{self, BenchConfig, BenchReport};
 use crate::output::text_table;
 use clap::Args;
 
-/// Examples shown under `study bench --help`.
+/// Examples shown under `autobal-bench --help`.
 pub const EXAMPLES: &str = "Examples:
-  cargo run --release -- bench
-  cargo run --release -- bench --json > bench.json
-  study bench --quick
-  study bench --revolutions 2000 --repeats 21
-  cargo run --release -- bench --peer-cases --json > autobal.json   # bench/scipy/run.sh does this
-  cargo run --release -- bench --thread-scaling --repeats 9
-  study bench --lean-inputs runs.csv --samples 20   # bench/lean/run.sh does this
+  cargo run --release --bin autobal-bench
+  cargo run --release --bin autobal-bench -- --json > bench.json
+  autobal-bench --quick
+  autobal-bench --revolutions 2000 --repeats 21
+  cargo run --release --bin autobal-bench -- --peer-cases --json > autobal.json   # bench/scipy/run.sh does this
+  cargo run --release --bin autobal-bench -- --thread-scaling --repeats 9
+  autobal-bench --lean-inputs runs.csv --samples 20   # bench/lean/run.sh does this
 
 Timings are only comparable within one run (cases are interleaved and the
 median is reported); build with --release, a debug build says so in the output.";
 
-/// Arguments of `study bench`.
+/// Arguments of `autobal-bench`.
 #[derive(Args)]
 pub struct BenchArgs {
     /// Few repeats and a short horizon: a smoke run of a second or so.
@@ -33,11 +33,11 @@ pub struct BenchArgs {
     #[arg(long)]
     json: bool,
     /// Horizon of each solve in revolutions (default 500; 20 with --quick).
-    #[arg(long, value_parser = crate::limits::bench_revolutions)]
+    #[arg(long, value_parser = crate::bench_limits::bench_revolutions)]
     revolutions: Option<f64>,
     /// Timed solves per case and RHS batches per n (default 11 and 21; 3 with --quick);
     /// studies per thread count with --thread-scaling (default 7; 1 with --quick).
-    #[arg(long, value_parser = crate::limits::repeats)]
+    #[arg(long, value_parser = crate::bench_limits::repeats)]
     repeats: Option<usize>,
     /// Only the solves `bench/scipy` repeats with SciPy (dp5 and dop853 at rtol
     /// 1e-6, 1e-8, 1e-9), with start, tolerances, RHS samples and final states.
@@ -70,7 +70,7 @@ pub struct BenchArgs {
     overwrite: bool,
 }
 
-/// Run `study bench`.
+/// Run the benchmark the arguments name.
 pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     if args.samples.is_some() && !(args.thread_scaling || args.lean_inputs.is_some()) {
         return Err(UserError(
@@ -118,7 +118,7 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     Ok(())
 }
 
-/// `study bench --fidelity`: the `full` and `rotating` fidelities side by side.
+/// `autobal-bench --fidelity`: the `full` and `rotating` fidelities side by side.
 fn run_fidelity(args: &BenchArgs) -> Result<(), UserError> {
     let revs = args
         .revolutions
@@ -220,7 +220,9 @@ fn run_peer_cases(args: &BenchArgs) -> Result<(), UserError> {
 fn describe_peers(r: &PeerReport) -> String {
     let mut out = String::new();
     if r.debug_build {
-        out.push_str("warning: debug build; use `cargo run --release -- bench` for timings\n\n");
+        out.push_str(
+            "warning: debug build; use `cargo run --release --bin autobal-bench` for timings\n\n",
+        );
     }
     let c = &r.config;
     out.push_str(&format!(
@@ -287,7 +289,9 @@ fn run_thread_scaling(args: &BenchArgs) -> Result<(), UserError> {
 fn describe_threads(r: &ThreadScaling) -> String {
     let mut out = String::new();
     if r.debug_build {
-        out.push_str("warning: debug build; use `cargo run --release -- bench` for timings\n\n");
+        out.push_str(
+            "warning: debug build; use `cargo run --release --bin autobal-bench` for timings\n\n",
+        );
     }
     out.push_str(&format!(
         "Study {}: {} designs × {} samples = {} runs, {} RHS calls; {} repeats per thread count (ABBA)\n",
@@ -348,7 +352,9 @@ fn describe_threads(r: &ThreadScaling) -> String {
 fn describe(r: &BenchReport) -> String {
     let mut out = String::new();
     if r.debug_build {
-        out.push_str("warning: debug build; use `cargo run --release -- bench` for timings\n\n");
+        out.push_str(
+            "warning: debug build; use `cargo run --release --bin autobal-bench` for timings\n\n",
+        );
     }
     out.push_str("Right-hand side (reference scene, n point cargoes)\n");
     let rows: Vec<Vec<String>> = r

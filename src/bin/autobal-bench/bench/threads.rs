@@ -122,7 +122,7 @@ pub fn edited_main_job(
     if file.metrics != bundled.metrics {
         note += &format!(", metrics = {:?}", file.metrics);
     }
-    let text = format!("{THREAD_STUDY}\n# study bench {verb}: {note}\n");
+    let text = format!("{THREAD_STUDY}\n# autobal-bench {verb}: {note}\n");
     file.plan(&text, path).expect("the bundled study is valid")
 }
 

@@ -1,4 +1,4 @@
-//! `study bench`'s measurements: performance benchmarks of the ODE core.
+//! `autobal-bench`'s measurements: performance benchmarks of the ODE core.
 //! Functions measure and return plain structs; `bench_cmd` prints them and
 //! `docs/benchmarks.md` explains them.
 //!
