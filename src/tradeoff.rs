@@ -239,7 +239,7 @@ fn study_contact(plan: &StudyPlan) -> Option<ContactModel> {
         .ok()?
         .iter()
         .any(|c| c.radius > 0.0);
-    (spec.enabled && sized).then_some(spec.model)
+    (spec.enabled && sized).then_some(spec.model())
 }
 
 /// Run `run_id` of the plan at a setting (early stop as the study says).
@@ -251,7 +251,7 @@ fn simulate(plan: &StudyPlan, run_id: u64, setting: Setting) -> (RunMetrics, f64
     sim.solver.method = setting.method;
     sim.solver.return_when_dearer = setting.return_when_dearer;
     if let (Some(model), Some(contact)) = (setting.contact, sim.scene.effects.contact.as_mut()) {
-        contact.model = model;
+        *contact = contact.switched_to(model);
     }
     if setting.rtol > 0.0 {
         sim.solver.rtol = setting.rtol;

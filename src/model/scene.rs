@@ -146,11 +146,10 @@ impl Scene {
     /// Rigid contact holds weights of finite size apart; point masses
     /// never touch, so asking for it cannot take effect.
     fn check_rigid_contact_has_sizes(&self) -> Result<(), SceneError> {
-        let rigid = self
-            .effects
-            .contact
-            .as_ref()
-            .is_some_and(|c| c.model == crate::model::effect::contact::ContactModel::Rigid);
+        let rigid =
+            self.effects.contact.as_ref().is_some_and(|c| {
+                c.model == Some(crate::model::effect::contact::ContactModel::Rigid)
+            });
         if rigid
             && self.balancer.is_none()
             && self.balancers.is_empty()

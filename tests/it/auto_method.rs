@@ -94,7 +94,8 @@ fn packed_chain(method: &str) -> String {
 }
 
 /// `n` balls at half-race fill started packed as in [`packed_chain`]: each
-/// touching the next, 180°/n apart.
+/// touching the next, 180°/n apart, with penalty contact (the stiff chain
+/// these tests are about; rigid contact holds the chain without stiffness).
 pub(crate) fn packed_chain_of(n: usize, method: &str) -> String {
     let spacing = 180.0 / n as f64;
     let angles: Vec<String> = (0..n)
@@ -118,6 +119,9 @@ rho = "half_race"
 race_radius = 0.05
 density = 7850.0
 drag = 10.0
+
+[effects.contact]
+model = "penalty"
 
 [speed]
 mode = "constant"

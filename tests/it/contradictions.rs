@@ -48,13 +48,51 @@ fn refused(out: &std::process::Output, keys: &[&str]) {
 
 #[test]
 fn restitution_with_penalty_contact_is_refused_naming_both_keys() {
-    let out = simulate_text(&scene_with_contact("restitution = 0.5"));
+    let out = simulate_text(&scene_with_contact(
+        "model = \"penalty\"\nrestitution = 0.5",
+    ));
     refused(
         &out,
         &["effects.contact.restitution", "effects.contact.model"],
     );
-    // With rigid contact it is the impact's rebound: accepted.
-    let ok = simulate_text(&scene_with_contact("model = \"rigid\"\nrestitution = 0.5"));
+    // With rigid contact, the default, it is the impact's rebound: accepted.
+    for contact in ["restitution = 0.5", "model = \"rigid\"\nrestitution = 0.5"] {
+        let ok = simulate_text(&scene_with_contact(contact));
+        assert!(
+            ok.status.success(),
+            "{contact}: {}",
+            String::from_utf8_lossy(&ok.stderr)
+        );
+    }
+}
+
+#[test]
+fn a_penalty_springs_keys_with_rigid_contact_are_refused_naming_both_keys() {
+    for (contact, key, default) in [
+        (
+            "frequency_ratio = 50",
+            "effects.contact.frequency_ratio",
+            true,
+        ),
+        ("damping_ratio = 0.5", "effects.contact.damping_ratio", true),
+        (
+            "model = \"rigid\"\nfrequency_ratio = 50",
+            "effects.contact.frequency_ratio",
+            false,
+        ),
+    ] {
+        let out = simulate_text(&scene_with_contact(contact));
+        refused(
+            &out,
+            &[key, "effects.contact.model", "set model = \"penalty\""],
+        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.contains("(the default)"), default, "{stderr}");
+    }
+    // With penalty contact they are its spring: accepted.
+    let ok = simulate_text(&scene_with_contact(
+        "model = \"penalty\"\nfrequency_ratio = 50\ndamping_ratio = 0.5",
+    ));
     assert!(
         ok.status.success(),
         "{}",

@@ -728,7 +728,7 @@ fn a_design_that_never_settles_prints_a_bound_not_a_zero_width_interval() {
     );
     // The contact line names how contact was modelled.
     assert!(
-        stdout.contains("contact between the weights: on (penalty contact)"),
+        stdout.contains("contact between the weights: on (rigid contact)"),
         "{stdout}"
     );
     assert!(!stdout.contains("[50.0, 50.0]"), "{stdout}");

@@ -212,7 +212,7 @@ fn constant_speed_runs_are_identical_for_balls_rollers_and_pendulums_of_equal_ka
     assert_eq!(b.metrics.min_gap_rad, None);
     assert_eq!(
         (a.metrics.contact_model, b.metrics.contact_model),
-        (Some("penalty"), None)
+        (Some("rigid"), None)
     );
     let sizeless = RunMetrics {
         min_gap_rad: None,
@@ -404,7 +404,7 @@ fn weights_in_contact_carry_the_capacity_of_seed_000() {
             rotor.eccentricity = 1.5 * f64::from(n) * ml / rotor.mass;
             let mut sim = simulation(rotor, cargo.clone(), 4.0, &start);
             sim.scene.effects.contact = contact.map(|model| ContactSpec {
-                model,
+                model: Some(model),
                 ..ContactSpec::default()
             });
             sim.metrics.t_end_revs = 300.0;

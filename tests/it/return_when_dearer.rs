@@ -4,10 +4,32 @@
 //! steps as short as DP5's stability bound holds DP5's, at five or more
 //! times the RHS calls per step. In the rotating frame, where a settling
 //! run tends to a fixed point that Radau5 strides over, no run returns.
+//! Penalty contact throughout: its stiff touches are what hand runs over
+//! to Radau5 (rigid contact, the default, keeps the drum on DP5).
 
-use crate::fixtures::shipped_plan;
+use crate::fixtures::shipped_plan_edited;
+use autobal::model::effect::contact::{ContactModel, ContactSpec};
+use autobal::simulation::SolverSettings;
+use autobal::study::plan::config::StudyPlan;
 use autobal::study::run::run_one;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// A shipped study with penalty contact (`frequency_ratio` and
+/// `damping_ratio` as given, else penalty's defaults) and its solver edited.
+fn penalty_plan(
+    path: &Path,
+    samples: u32,
+    spring: Option<(f64, f64)>,
+    edit: impl FnOnce(&mut SolverSettings),
+) -> StudyPlan {
+    shipped_plan_edited(path, samples, |file| {
+        let mut contact = ContactSpec::with_model(ContactModel::Penalty);
+        contact.frequency_ratio = spring.map(|s| s.0);
+        contact.damping_ratio = spring.map(|s| s.1);
+        file.scene.effects.contact = Some(contact);
+        edit(&mut file.solver);
+    })
+}
 
 fn drum() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("studies/drum.toml")
@@ -17,8 +39,8 @@ fn drum() -> PathBuf {
 /// the same run kept on Radau5; its RHS calls stay under the measured count.
 #[test]
 fn the_drum_returns_to_dp5_and_costs_less_than_half() {
-    let with_return = shipped_plan(&drum(), 1, |_| {});
-    let without = shipped_plan(&drum(), 1, |s| s.return_when_dearer = false);
+    let with_return = penalty_plan(&drum(), 1, None, |_| {});
+    let without = penalty_plan(&drum(), 1, None, |s| s.return_when_dearer = false);
     let (mut fresh, mut kept) = (0u64, 0u64);
     for id in 0..with_return.total_runs() {
         let new = run_one(&with_return, id).metrics;
@@ -52,11 +74,12 @@ const MEASURED_DRUM_RHS_PER_RUN: f64 = 144_527.0;
 /// The rotating frame never returns: paper_claims' rotating-frame runs
 /// that hand over end on Radau5 (without the frame's exception run 87 here
 /// returned when written; over the whole study 54 runs returned and cost
-/// 3.96 times the RHS calls they take on Radau5).
+/// 3.96 times the RHS calls they take on Radau5). With the penalty spring
+/// the study had when written (10 × ω, ζ = 0.5).
 #[test]
 fn a_rotating_frame_run_stays_on_radau5() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("studies/paper_claims.toml");
-    let plan = shipped_plan(&path, 25, |_| {});
+    let plan = penalty_plan(&path, 25, Some((10.0, 0.5)), |_| {});
     let mut handed_over = 0;
     for id in 0..plan.total_runs() {
         let m = run_one(&plan, id).metrics;
@@ -74,7 +97,7 @@ fn a_rotating_frame_run_stays_on_radau5() {
 /// end `budget_exceeded`.
 #[test]
 fn a_returned_run_out_of_steps_goes_back_to_radau5() {
-    let plan = shipped_plan(&drum(), 1, |s| s.max_steps = MAX_STEPS);
+    let plan = penalty_plan(&drum(), 1, None, |s| s.max_steps = MAX_STEPS);
     let mut again = 0;
     for id in 0..plan.total_runs() {
         let m = run_one(&plan, id).metrics;

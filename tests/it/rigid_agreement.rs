@@ -20,7 +20,7 @@ fn peer(rtol: f64) -> StudyPlan {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("bench/lean/peer.toml");
     shipped_plan_edited(&path, SAMPLES, |file| {
         let contact = file.scene.effects.contact.as_mut().expect("contact is on");
-        contact.model = ContactModel::Rigid;
+        contact.model = Some(ContactModel::Rigid);
         file.solver.rtol = rtol;
     })
 }

@@ -58,7 +58,7 @@ fn touching() -> f64 {
 
 fn contact(model: ContactModel, restitution: f64) -> ContactSpec {
     ContactSpec {
-        model,
+        model: Some(model),
         restitution,
         ..Default::default()
     }
@@ -748,8 +748,8 @@ fn a_stiff_penalty_contact_converges_to_the_rigid_impact_of_its_own_restitution(
     let mut position_errors = Vec::new();
     for ratio in [50.0, 200.0, 800.0] {
         let spec = ContactSpec {
-            frequency_ratio: ratio,
-            damping_ratio: zeta,
+            frequency_ratio: Some(ratio),
+            damping_ratio: Some(zeta),
             ..contact(ContactModel::Penalty, 0.0)
         };
         let report = solve(

@@ -28,7 +28,7 @@ fn drum(samples: u32, model: ContactModel) -> StudyPlan {
             .effects
             .contact
             .get_or_insert_with(Default::default);
-        contact.model = model;
+        contact.model = Some(model);
     })
 }
 

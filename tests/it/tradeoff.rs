@@ -41,25 +41,25 @@ t_end_revs = 300
     let rows = measure(&plan, &runs);
     assert_eq!(rows.len(), runs.len() * all.len());
     let summary = summarize(&rows);
-    // The other contact model is measured too (these balls touch): rigid
+    // The other contact model is measured too (these balls touch): penalty
     // contact in the rotating frame, at the study's tolerance and at 1e-10.
-    let rigid: Vec<_> = summary
+    let penalty: Vec<_> = summary
         .iter()
-        .filter(|s| s.setting.contact == Some(ContactModel::Rigid))
+        .filter(|s| s.setting.contact == Some(ContactModel::Penalty))
         .collect();
-    assert_eq!(rigid.len(), 2);
+    assert_eq!(penalty.len(), 2);
     assert!(
-        rigid
+        penalty
             .iter()
             .all(|s| s.setting.fidelity == Fidelity::Rotating
-                && s.setting.label().ends_with("/rigid contact")
-                && s.setting.keys().contains("model = \"rigid\""))
+                && s.setting.label().ends_with("/penalty contact")
+                && s.setting.keys().contains("model = \"penalty\""))
     );
-    // Against the penalty reference it differs by the model (the penalty
+    // Against the rigid reference it differs by the model (the penalty
     // contact rebounds, rigid contact's impacts are dead), not by the
     // integration, so it agrees on the outcomes but not to a fraction of a
     // revolution.
-    for s in &rigid {
+    for s in &penalty {
         assert_eq!(s.outcome_agreement, 1.0, "{}", s.setting.label());
     }
     // The tightest integrations of the study's own model agree with the

@@ -2,7 +2,10 @@
 //!
 //! The analytic theory lets weights pass through each other; real balls and
 //! rollers cannot come closer than 2α = 2 arcsin(r/l) (centre to centre, as an
-//! angle about the race centre). This effect adds a stiff, damped penalty
+//! angle about the race centre). By default contact is rigid: the system
+//! holds touching weights together as constraints
+//! ([`crate::model::rigid_contact`]) and this effect adds no force. With
+//! `model = "penalty"` this effect adds a stiff, damped penalty
 //! between every pair in the same plane that overlaps: torque k_θ δ + c_θ δ̇
 //! (never pulling), with δ the angular overlap. The stiffness puts the contact
 //! frequency at `frequency_ratio` × the nominal speed, so the weights' packing
@@ -29,18 +32,19 @@ pub struct ContactSpec {
     /// this to false, and then the outputs say so.
     #[serde(default = "enabled_by_default")]
     pub enabled: bool,
-    /// Contact natural frequency as a multiple of the nominal spin speed.
-    #[serde(default = "default_ratio")]
-    pub frequency_ratio: f64,
-    /// Damping ratio of a contact.
-    #[serde(default = "default_damping")]
-    pub damping_ratio: f64,
-    /// How contact is modelled: `penalty` (a stiff spring and damper
-    /// between overlapping weights, the default) or `rigid` (weights that
-    /// touch move as one until the force between them would pull: no
-    /// overlap, no stiffness).
-    #[serde(default)]
-    pub model: ContactModel,
+    /// Penalty contact: its natural frequency as a multiple of the nominal
+    /// spin speed (default 20).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequency_ratio: Option<f64>,
+    /// Penalty contact: the damping ratio of a contact (default 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_ratio: Option<f64>,
+    /// How contact is modelled: `rigid` (weights that touch move as one
+    /// until the force between them would pull: no overlap, no stiffness;
+    /// the default) or `penalty` (a stiff spring and damper between
+    /// overlapping weights).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<ContactModel>,
     /// Rigid contact: the ratio of parting to closing speed in an impact,
     /// 0 (a dead impact in oil, the default) to below 1. Unused by `penalty`,
     /// whose `damping_ratio` sets the rebound.
@@ -53,10 +57,12 @@ pub struct ContactSpec {
 #[serde(rename_all = "snake_case")]
 pub enum ContactModel {
     /// A stiff, damped spring between overlapping weights (never pulling).
-    #[default]
     Penalty,
     /// Touching weights move as one cluster; impacts and partings are
-    /// located as events ([`crate::model::rigid_contact`]).
+    /// located as events ([`crate::model::rigid_contact`]). The default:
+    /// on every shipped study it gives the same decisions as penalty
+    /// contact at less cost, with no overlap and no stiffness to choose.
+    #[default]
     Rigid,
 }
 
@@ -80,22 +86,75 @@ fn enabled_by_default() -> bool {
 /// below 2 % of 2α on every shipped study (worst: 1.3 % on the low-speed
 /// gravity study; tests/it/contact.rs), at no measurable cost. The former
 /// 10 × ω, ζ = 0.5 let balls sink 6 % into each other under gravity.
-fn default_ratio() -> f64 {
-    20.0
-}
+const DEFAULT_RATIO: f64 = 20.0;
 
-fn default_damping() -> f64 {
-    2.0
-}
+const DEFAULT_DAMPING: f64 = 2.0;
 
 impl Default for ContactSpec {
     fn default() -> Self {
         ContactSpec {
             enabled: true,
-            frequency_ratio: default_ratio(),
-            damping_ratio: default_damping(),
-            model: ContactModel::Penalty,
+            frequency_ratio: None,
+            damping_ratio: None,
+            model: None,
             restitution: 0.0,
+        }
+    }
+}
+
+impl ContactSpec {
+    /// Contact on, with the model asked for.
+    pub fn with_model(model: ContactModel) -> Self {
+        ContactSpec {
+            enabled: true,
+            model: Some(model),
+            ..ContactSpec::default()
+        }
+    }
+
+    /// The model in force: the file's, or rigid.
+    pub fn model(&self) -> ContactModel {
+        self.model.unwrap_or_default()
+    }
+
+    /// Penalty contact's frequency over the nominal speed.
+    pub fn frequency_ratio(&self) -> f64 {
+        self.frequency_ratio.unwrap_or(DEFAULT_RATIO)
+    }
+
+    /// Penalty contact's damping ratio.
+    pub fn damping_ratio(&self) -> f64 {
+        self.damping_ratio.unwrap_or(DEFAULT_DAMPING)
+    }
+
+    /// The same contact with another model, its other model's keys dropped.
+    pub fn switched_to(&self, model: ContactModel) -> Self {
+        let mut spec = self.clone();
+        spec.model = Some(model);
+        match model {
+            ContactModel::Rigid => {
+                spec.frequency_ratio = None;
+                spec.damping_ratio = None;
+            }
+            ContactModel::Penalty => spec.restitution = 0.0,
+        }
+        spec
+    }
+
+    /// A key given for the other model than the one in force, as (key, the model it belongs to).
+    fn other_models_key(&self) -> Option<(&'static str, f64, ContactModel)> {
+        match self.model() {
+            ContactModel::Rigid => self
+                .frequency_ratio
+                .map(|v| ("frequency_ratio", v, ContactModel::Penalty))
+                .or(self
+                    .damping_ratio
+                    .map(|v| ("damping_ratio", v, ContactModel::Penalty))),
+            ContactModel::Penalty => (self.restitution != 0.0).then_some((
+                "restitution",
+                self.restitution,
+                ContactModel::Rigid,
+            )),
         }
     }
 }
@@ -105,17 +164,17 @@ impl EffectSpec for ContactSpec {
         // Below 1 the contact is softer than the whirl it must stop (weights
         // pass through each other); far above, every touch costs steps
         // for no change in the result.
-        if !(1.0..=1e4).contains(&self.frequency_ratio) {
+        if !(1.0..=1e4).contains(&self.frequency_ratio()) {
             return Err(invalid(
                 &format!("{key}.frequency_ratio"),
-                self.frequency_ratio,
+                self.frequency_ratio(),
                 "contact frequency over the nominal speed: 1 to 10000 (default 20)",
             ));
         }
-        if !(0.0..=1e3).contains(&self.damping_ratio) {
+        if !(0.0..=1e3).contains(&self.damping_ratio()) {
             return Err(invalid(
                 &format!("{key}.damping_ratio"),
-                self.damping_ratio,
+                self.damping_ratio(),
                 "a damping ratio from 0 to 1000 (default 2: a dead impact)",
             ));
         }
@@ -127,16 +186,24 @@ impl EffectSpec for ContactSpec {
             ));
         }
         // A setting that cannot take effect is refused, naming both keys.
-        if self.restitution != 0.0 && self.model == ContactModel::Penalty {
+        if let Some((name, value, belongs)) = self.other_models_key() {
+            let model = self.model().name();
+            let default = if self.model.is_none() {
+                " (the default)"
+            } else {
+                ""
+            };
             return Err(invalid(
-                &format!("{key}.restitution"),
-                self.restitution,
+                &format!("{key}.{name}"),
+                value,
                 &format!(
-                    "is used by rigid contact only, and {key}.model is \"penalty\" (whose {key}.damping_ratio sets the rebound): set model = \"rigid\" or remove restitution"
+                    "is used by {} contact only, and {key}.model is \"{model}\"{default}: set model = \"{}\" or remove {name}",
+                    belongs.name(),
+                    belongs.name()
                 ),
             ));
         }
-        if !self.enabled && self.model == ContactModel::Rigid {
+        if !self.enabled && self.model == Some(ContactModel::Rigid) {
             return Err(SceneError::Invalid {
                 field: format!("{key}.model"),
                 value: "rigid".into(),
@@ -151,7 +218,7 @@ impl EffectSpec for ContactSpec {
     fn build(&self, setup: &BuildSetup<'_>) -> Option<Box<dyn Effect>> {
         // Rigid contact is no force: the system holds it as constraints
         // (and a system that cannot is refused rigid contact up front).
-        if setup.rigid_contact || self.model == ContactModel::Rigid {
+        if setup.rigid_contact || self.model() == ContactModel::Rigid {
             return None;
         }
         Contact::new(self, setup.cargo, setup.omega).map(|c| Box::new(c) as Box<dyn Effect>)
@@ -160,10 +227,10 @@ impl EffectSpec for ContactSpec {
 
 impl ContactSpec {
     /// The rigid contact of these cargoes for a system that can hold it,
-    /// when the file asks for it and a weight has a size; `omega` sets the
-    /// scale of its force tolerance.
+    /// when it is the model in force and a weight has a size; `omega` sets
+    /// the scale of its force tolerance.
     pub fn rigid(&self, cargo: &[Cargo], omega: f64) -> Option<RigidContact> {
-        let wanted = self.model == ContactModel::Rigid;
+        let wanted = self.model() == ContactModel::Rigid;
         (self.enabled && wanted && cargo.iter().any(|c| c.radius > 0.0))
             .then(|| RigidContact::new(cargo, omega, self.restitution))
     }
@@ -188,13 +255,13 @@ impl Contact {
         if !spec.enabled || cargo.iter().all(|c| c.radius <= 0.0) {
             return None;
         }
-        let w = spec.frequency_ratio * omega;
+        let w = spec.frequency_ratio() * omega;
         let half_angle = cargo.iter().map(Cargo::contact_half_angle).collect();
         // Two equal inertias I in contact through k: the relative mode has k·2/I.
         let stiffness = cargo.iter().map(|c| 0.5 * c.inertia() * w * w).collect();
         let damping = cargo
             .iter()
-            .map(|c| spec.damping_ratio * c.inertia() * w)
+            .map(|c| spec.damping_ratio() * c.inertia() * w)
             .collect();
         Some(Contact {
             half_angle,

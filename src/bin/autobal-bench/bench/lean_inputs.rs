@@ -12,7 +12,7 @@
 
 use super::threads::edited_main_job;
 use autobal::metrics::reference::a_ref;
-use autobal::model::effect::contact::Contact;
+use autobal::model::effect::contact::{Contact, ContactModel, ContactSpec};
 use autobal::model::frame::RotatingSystem;
 use autobal::simulation::{Fidelity, Simulation, scaled_atol};
 use autobal::study::plan::config::{Design, StudyPlan};
@@ -128,9 +128,11 @@ pub struct LeanRow {
 /// The main job with `samples` samples per design (output folder unused),
 /// holding every window to its end as the lean program does: autobal's
 /// answers in the rows are the full hold's (`metrics.certified_hold` off).
+/// With penalty contact, the one contact model the lean program has.
 pub fn lean_plan(samples: u32) -> StudyPlan {
     edited_main_job(samples, Path::new("results"), "--lean-inputs", |file| {
         file.metrics.certified_hold = false;
+        file.scene.effects.contact = Some(ContactSpec::with_model(ContactModel::Penalty));
     })
 }
 
@@ -195,6 +197,16 @@ pub fn lean_row(
     let (s, c) = autobal::model::trig::sin_cos(rotor.unbalance_angle);
     let unbalance_force = (me * omega * omega * c, me * omega * omega * s);
 
+    let rigid = scene
+        .effects
+        .contact
+        .as_ref()
+        .is_some_and(|spec| spec.enabled && spec.model() == ContactModel::Rigid);
+    if rigid && cargo.iter().any(|c| c.radius > 0.0) {
+        return Err(format!(
+            "run {run_id}: rigid contact; the lean program has penalty contact only (set [scene.effects.contact] model = \"penalty\" or enabled = false)"
+        ));
+    }
     let contact = scene
         .effects
         .contact
