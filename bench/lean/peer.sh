@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 31's peer design (bench/lean/peer.toml) against the lean reference:
 # runs/s per core and RHS calls per run of `study run --threads 1` with
-# contact on (as shipped: the penalty model), on as rigid contact, and
+# contact on as the penalty model, on as rigid contact (the default), and
 # off, and of the lean program (a careful DP5
 # of this one design, full hold, contact off like the issue's peer) on the
 # same runs. Rounds alternate which side goes first; per run the fastest

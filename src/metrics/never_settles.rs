@@ -34,6 +34,14 @@
 //! the RMS of r over the last hold window, by at most [`RESIDUAL_SHARE`]
 //! (the window then repeats the last [`LAG`] revolutions).
 //!
+//! On a rotor with several watched planes (two supports), the state is
+//! each plane's body-frame position and velocity, each scaled by the
+//! plane's own A_ref, and r is compared per plane too: one plane whose
+//! whirl leaves its own band every [`LAG`] revolutions keeps the hold from
+//! completing. The watch runs only where the planes' displacements fix the
+//! rotor's whole position (the two-support rigid rotor), so that no mode
+//! of the rotor escapes the comparison.
+//!
 //! Like the certified hold, this is a checked bound, not a proof: a slower
 //! mode the last revolutions have not excited, or a basin left later, would
 //! escape it. `tests/it/never_settles.rs` compares it run by run with the
@@ -71,6 +79,30 @@ pub struct Stroboscope {
     pub angles: Vec<f64>,
     /// r / A_ref at every sample of the revolution that ends here.
     pub r: Vec<f64>,
+    /// On a rotor with several watched planes, each plane's r over its own
+    /// A_ref at the same samples (each plane has its own band); empty on a
+    /// plane rotor.
+    pub plane_r: Vec<Vec<f64>>,
+}
+
+/// The largest sample-by-sample difference of two series (∞ when their
+/// lengths differ).
+fn series_change(a: &[f64], b: &[f64]) -> f64 {
+    if a.len() == b.len() {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The peak and the RMS of one series of scaled whirls.
+fn peak_and_rms(r: &[f64]) -> (f64, f64) {
+    let peak = r.iter().copied().fold(0.0, f64::max);
+    let mean_square = r.iter().map(|r| r * r).sum::<f64>() / r.len().max(1) as f64;
+    (peak, mean_square.sqrt())
 }
 
 /// What the watch certified: the run will not settle before its horizon.
@@ -121,15 +153,17 @@ fn change(a: &Stroboscope, b: &Stroboscope) -> f64 {
         .zip(&b.angles)
         .map(|(x, y)| crate::model::effect::contact::wrapped(x - y).abs())
         .fold(0.0, f64::max);
-    let r = if a.r.len() == b.r.len() {
-        a.r.iter()
-            .zip(&b.r)
-            .map(|(x, y)| (x - y).abs())
+    let r = series_change(&a.r, &b.r);
+    let planes = if a.plane_r.len() == b.plane_r.len() {
+        a.plane_r
+            .iter()
+            .zip(&b.plane_r)
+            .map(|(x, y)| series_change(x, y))
             .fold(0.0, f64::max)
     } else {
         f64::INFINITY
     };
-    smooth.max(angles).max(r)
+    smooth.max(angles).max(r).max(planes)
 }
 
 impl RepeatWatch {
@@ -174,21 +208,33 @@ impl RepeatWatch {
         }
         let steps_left = (criteria.remaining_revs / LAG as f64).max(1.0);
         let tail = GROWTH * largest * steps_left;
-        let peak = state.r.iter().copied().fold(0.0, f64::max);
-        let mean_square = state.r.iter().map(|r| r * r).sum::<f64>() / state.r.len().max(1) as f64;
-        let rms = mean_square.sqrt();
-        // r moves by at most `tail` per sample, the RMS likewise.
-        if tail.is_nan() || tail > RESIDUAL_SHARE * rms {
+        let (peak, rms) = peak_and_rms(&state.r);
+        let planes: Vec<(f64, f64)> = state.plane_r.iter().map(|r| peak_and_rms(r)).collect();
+        // r moves by at most `tail` per sample, the RMS likewise: every
+        // residual reported (the rotor's and each plane's) must stay put.
+        if tail.is_nan()
+            || tail > RESIDUAL_SHARE * rms
+            || planes.iter().any(|&(_, rms)| tail > RESIDUAL_SHARE * rms)
+        {
             return None;
         }
         let limit = (1.0 + MARGIN) * criteria.delta;
         let why = if criteria.operating {
-            (peak - tail > limit).then(|| {
+            // The hold needs r and every plane inside their bands: one
+            // leaving its band every LAG revolutions is enough.
+            let outside_plane = planes.iter().position(|&(peak, _)| peak - tail > limit);
+            if peak - tail > limit {
                 format!(
                     "r reaches {peak:.4} A_ref every {LAG} revolutions, outside the band {}",
                     criteria.delta
                 )
-            })?
+            } else {
+                let p = outside_plane?;
+                format!(
+                    "plane {p}'s whirl reaches {:.4} of its A_ref every {LAG} revolutions, outside the band {}",
+                    planes[p].0, criteria.delta
+                )
+            }
         } else {
             let off = (criteria.spin_ratio - 1.0).abs();
             (off - tail > limit).then(|| {
@@ -211,6 +257,7 @@ mod tests {
             smooth: vec![offset, 0.5],
             angles: vec![1.0 + offset, 2.0 * std::f64::consts::PI + 3.0],
             r: vec![r + offset; 8],
+            plane_r: Vec::new(),
         }
     }
 
@@ -272,6 +319,35 @@ mod tests {
         // residual share over the steps left.
         let circulating: Vec<f64> = (0..100).map(|k| 1e-3 * f64::from(k)).collect();
         assert!(watch(&circulating, 0.3, 400.0).is_none());
+    }
+
+    #[test]
+    fn one_plane_outside_its_band_is_enough_and_each_plane_is_compared() {
+        // The rotor's r inside its band, plane 1 outside its own: certified,
+        // naming the plane.
+        let mut watch = RepeatWatch::default();
+        let mut verdict = None;
+        for k in 0..80 {
+            let x = 1e-3 * 0.5f64.powi(k / 2);
+            let mut s = state(x, 0.01);
+            s.plane_r = vec![vec![0.01 + x; 8], vec![0.3 + x; 8]];
+            verdict = verdict.or(watch.observe(s, at_speed(400.0)));
+        }
+        assert!(verdict.expect("certified").why.contains("plane 1"));
+        // Every plane inside its band: never.
+        let mut watch = RepeatWatch::default();
+        for k in 0..80 {
+            let x = 1e-3 * 0.5f64.powi(k / 2);
+            let mut s = state(x, 0.01);
+            s.plane_r = vec![vec![0.01 + x; 8], vec![0.02 + x; 8]];
+            assert!(watch.observe(s, at_speed(400.0)).is_none());
+        }
+        // A plane's series that keeps changing is a change like any other.
+        let a = state(0.0, 0.3);
+        let (mut b, mut c) = (a.clone(), a.clone());
+        b.plane_r = vec![vec![0.1; 8]];
+        c.plane_r = vec![vec![0.2; 8]];
+        assert!((change(&b, &c) - 0.1).abs() < 1e-12);
     }
 
     #[test]

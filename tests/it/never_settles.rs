@@ -19,6 +19,7 @@ const SAMPLES: u32 = 3;
 fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study() {
     let (mut runs, mut certified) = (0usize, 0usize);
     let (mut worst_residual, mut full_calls, mut early_calls) = (0.0f64, 0u64, 0u64);
+    let mut multi_plane_certified = 0usize;
     // The uncertain study's calls, guarded apart (see LATE_STUDY).
     let (mut late_full, mut late_early) = (0u64, 0u64);
     for path in &shipped_studies() {
@@ -49,6 +50,16 @@ fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study
                 a.residual_rel
             );
             worst_residual = worst_residual.max(off);
+            // Each watched plane's residual too (rotors on two supports).
+            if let (Some(pa), Some(pb)) = (&a.plane_residual_abs, &b.plane_residual_abs) {
+                for (plane, (x, y)) in pa.iter().zip(pb).enumerate() {
+                    assert!(
+                        (y / x - 1.0).abs() <= 0.01,
+                        "{what}: plane {plane}'s residual {y} against {x} of the full run"
+                    );
+                }
+                multi_plane_certified += 1;
+            }
             assert_eq!(a.settling_time_eps, b.settling_time_eps, "{what}");
             assert_eq!(a.censoring_revs, b.censoring_revs, "{what}");
             assert_eq!(a.t_final, b.t_final, "{what}");
@@ -77,7 +88,7 @@ fn certified_not_settled_agrees_with_the_full_integration_on_every_shipped_study
     }
     let late_share = late_early as f64 / late_full.max(1) as f64;
     eprintln!(
-        "{certified} of {runs} runs certified not to settle, at {:.3} of the full runs' RHS calls \
+        "{certified} of {runs} runs certified not to settle ({multi_plane_certified} on rotors with several planes), at {:.3} of the full runs' RHS calls \
          ({LATE_STUDY}: {late_share:.3}); largest residual change {worst_residual:.2e}",
         early_calls as f64 / full_calls.max(1) as f64
     );
@@ -109,3 +120,106 @@ const LATE_STUDY: &str = "three_balls_uncertain";
 
 /// [`LATE_STUDY`]'s certified runs' RHS calls over the same runs' in full.
 const LATE_CALL_SHARE: f64 = 0.949;
+
+/// A rotor on two supports whose balls stick in their dead band (rolling
+/// resistance μ = 0.05) from the start: its state repeats every revolution
+/// while both planes whirl far outside their bands. The watch, which sees
+/// each plane's body-frame state and whirl, certifies it early; the full
+/// run to the horizon must agree (outcome, the rotor's and each plane's
+/// residual within 1 %, the final angles within the certificate's bound).
+#[test]
+fn a_two_support_rotor_with_stuck_balls_is_certified_and_agrees_with_the_full_run() {
+    let text = |certify: bool| {
+        format!(
+            r#"
+[rotor]
+model = "two_support"
+mass = 4.0
+transverse_inertia = 0.02
+polar_inertia = 0.004
+k1 = 2.0e4
+l1 = 0.08
+k2 = 2.0e4
+l2 = 0.08
+b1 = 400.0
+b2 = 400.0
+planes = [-0.12, 0.12]
+static_unbalance = 8.0e-5
+moment_unbalance = 4.0e-6
+
+[speed]
+mode = "constant"
+rpm = 3000
+
+[effects.gravity]
+g = 9.81
+
+[effects.rolling_resistance]
+coefficient = 0.05
+static_ratio = 1.5
+
+[[balancers]]
+plane = 0
+kind = "ball"
+n = 2
+rho = 0.1
+race_radius = 0.05
+density = 7850.0
+drag = 0.5
+
+[[balancers]]
+plane = 1
+kind = "ball"
+n = 2
+rho = 0.1
+race_radius = 0.05
+density = 7850.0
+drag = 0.5
+
+[metrics]
+t_end_revs = 400
+hold_revs = 50
+certified_not_settled = {certify}
+"#
+        )
+    };
+    let run = |certify: bool| {
+        autobal::scene_file::SceneFile::parse(&text(certify), "scene.toml")
+            .expect("valid scene")
+            .simulation("scene.toml")
+            .expect("simulation")
+            .run(false)
+            .expect("runs")
+            .metrics
+    };
+    let (full, early) = (run(false), run(true));
+    assert_eq!(full.outcome, Outcome::Censored, "{}", full.reason);
+    assert_eq!(early.outcome, Outcome::NotSettled, "{}", early.reason);
+    assert!(
+        early.rhs_calls * 3 < full.rhs_calls,
+        "{} against {}",
+        early.rhs_calls,
+        full.rhs_calls
+    );
+    assert_eq!(full.t_final, early.t_final);
+    assert!((early.residual_rel / full.residual_rel - 1.0).abs() <= 0.01);
+    let (pa, pb) = (
+        full.plane_residual_abs.expect("planes"),
+        early.plane_residual_abs.expect("planes"),
+    );
+    for (x, y) in pa.iter().zip(&pb) {
+        assert!(
+            (y / x - 1.0).abs() <= 0.01,
+            "plane residual {y} against {x}"
+        );
+    }
+    let bound = RESIDUAL_SHARE * early.residual_rel * 1.01;
+    for (x, y) in full
+        .final_rel_angles_deg
+        .iter()
+        .zip(&early.final_rel_angles_deg)
+    {
+        let d = ((x - y + 180.0).rem_euclid(360.0) - 180.0).to_radians();
+        assert!(d.abs() <= bound, "final angle {y} against {x}");
+    }
+}

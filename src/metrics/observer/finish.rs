@@ -153,10 +153,17 @@ impl SettlingObserver<'_> {
             final_spin_rate: Some(self.system.spin(t_final, y_final).1),
             balance_angle_error_deg: None,
             plane_a_ref: self.planes.as_ref().map(|p| p.a_ref.clone()),
-            plane_residual_abs: self
-                .planes
-                .as_ref()
-                .map(|p| p.rings.iter().map(SquareRing::rms).collect()),
+            // A run certified never to settle: each plane's last LAG
+            // revolutions repeat to the horizon, as the rotor's do.
+            plane_residual_abs: self.planes.as_ref().map(|p| {
+                p.rings
+                    .iter()
+                    .map(|ring| match &self.never {
+                        Some(_) => ring.latest_rms(LAG * self.per_rev() as usize),
+                        None => ring.rms(),
+                    })
+                    .collect()
+            }),
             // Measured after the run, by the simulation (it needs the solver).
             bearing_orbit_peak: None,
             bearing_orbit_rms: None,

@@ -175,12 +175,14 @@ impl<'a> SettlingObserver<'a> {
 
     /// End a run that will not settle once its state repeats every
     /// revolution, contracting, outside the band or below the operating
-    /// speed (plane rotors; see [`super::never_settles`]).
+    /// speed (plane rotors, and rotors whose watched planes fix their whole
+    /// position; see [`super::never_settles`]).
     pub fn certify_not_settled(mut self) -> Self {
         let whole = (self.options.t_end_revs - self.options.t_end_revs.round()).abs() < 1e-9;
         // The horizon must fall on a revolution boundary: the run's final
         // state is then the boundary state the watch saw.
-        if self.plane && whole {
+        let watched = self.plane || (self.planes.is_some() && planes_fix_the_rotor(self.system));
+        if watched && whole {
             self.repeats = Some(RepeatWatch::default());
         }
         self
@@ -451,4 +453,40 @@ impl StepObserver for SettlingObserver<'_> {
             }
         }
     }
+}
+
+/// Whether the watched planes' displacements (u, v) determine every one of
+/// the rotor's coordinates: the maps, stacked, have full column rank. Only
+/// then does a repeat of the planes' states mean a repeat of the rotor's.
+fn planes_fix_the_rotor(system: &RotorSystem) -> bool {
+    let k = system.rotor().dof();
+    let mut rows: Vec<Vec<f64>> = system
+        .watch_maps()
+        .iter()
+        .flat_map(|[gu, gv]| [gu[..k].to_vec(), gv[..k].to_vec()])
+        .collect();
+    // Gaussian elimination with partial pivoting, relative to the largest
+    // entry: a rank test on at most a few rows, not worth a crate.
+    let scale = rows.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 {
+        return false;
+    }
+    let mut rank = 0;
+    for col in 0..k {
+        let Some(pivot) = (rank..rows.len())
+            .max_by(|&a, &b| rows[a][col].abs().total_cmp(&rows[b][col].abs()))
+            .filter(|&r| rows[r][col].abs() > 1e-9 * scale)
+        else {
+            continue;
+        };
+        rows.swap(rank, pivot);
+        for r in rank + 1..rows.len() {
+            let f = rows[r][col] / rows[rank][col];
+            for c in col..k {
+                rows[r][c] -= f * rows[rank][c];
+            }
+        }
+        rank += 1;
+    }
+    rank == k
 }

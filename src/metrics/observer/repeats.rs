@@ -3,6 +3,7 @@
 //! (`metrics::never_settles`).
 
 use super::*;
+use crate::model::rotor::DofVec;
 
 impl SettlingObserver<'_> {
     /// The part that, once per revolution, asks the watch whether the state
@@ -42,8 +43,10 @@ impl SettlingObserver<'_> {
 
     /// The scratch state at a revolution boundary, as the watch compares
     /// it: the rotor's position and velocity in its body frame (scaled by
-    /// A_ref and A_ref·ω), the weights' angles and rates (rates over ω), the
-    /// spin rate over ω; and r/A_ref over the [`LAG`] revolutions that end here.
+    /// A_ref and A_ref·ω; on a rotor with several watched planes, each
+    /// plane's, scaled by the plane's A_ref), the weights' angles and rates
+    /// (rates over ω), the spin rate over ω; and r/A_ref (and each plane's
+    /// r over its A_ref) over the [`LAG`] revolutions that end here.
     pub(super) fn stroboscope(&self, t: f64) -> Stroboscope {
         let lay = self.system.layout();
         let nq = lay.nq();
@@ -56,17 +59,45 @@ impl SettlingObserver<'_> {
             None => (-angle).sin_cos(),
         };
         let turn = |a: f64, b: f64| (a * c - b * s, a * s + b * c);
-        let (u, v) = turn(y[0], y[1]);
-        let (ud, vd) = turn(y[nq], y[nq + 1]);
-        let (a, w) = (self.a_ref, self.omega);
-        let mut smooth = vec![u / a, v / a, ud / (a * w), vd / (a * w)];
+        let w = self.omega;
+        let count = LAG * self.per_rev() as usize;
+        let scaled_series = |ring: &SquareRing, a: f64| -> Vec<f64> {
+            let (older, newer) = ring.latest(count);
+            older.iter().chain(newer).map(|r2| r2.sqrt() / a).collect()
+        };
+        let mut smooth = Vec::new();
+        let mut plane_r = Vec::new();
+        match &self.planes {
+            None => {
+                let (u, v) = turn(y[0], y[1]);
+                let (ud, vd) = turn(y[nq], y[nq + 1]);
+                let a = self.a_ref;
+                smooth.extend([u / a, v / a, ud / (a * w), vd / (a * w)]);
+            }
+            Some(pw) => {
+                let k = self.system.rotor().dof();
+                let along = |g: &DofVec, x: &[f64]| (0..k).map(|i| g[i] * x[i]).sum::<f64>();
+                for (([gu, gv], &a), ring) in self
+                    .system
+                    .watch_maps()
+                    .iter()
+                    .zip(&pw.a_ref)
+                    .zip(&pw.rings)
+                {
+                    let (u, v) = turn(along(gu, y), along(gv, y));
+                    let (ud, vd) = turn(along(gu, &y[nq..]), along(gv, &y[nq..]));
+                    smooth.extend([u / a, v / a, ud / (a * w), vd / (a * w)]);
+                    plane_r.push(scaled_series(ring, a));
+                }
+            }
+        }
         smooth.extend(y[nq + lay.head()..2 * nq].iter().map(|rate| rate / w));
         smooth.push(rate / w);
-        let (older, newer) = self.ring.latest(LAG * self.per_rev() as usize);
         Stroboscope {
             smooth,
             angles: y[lay.head()..nq].to_vec(),
-            r: older.iter().chain(newer).map(|r2| r2.sqrt() / a).collect(),
+            r: scaled_series(&self.ring, self.a_ref),
+            plane_r,
         }
     }
 

@@ -43,6 +43,14 @@ impl SquareRing {
         older.iter().chain(newer).sum()
     }
 
+    /// The root of the mean of the `count` most recent values (all there
+    /// are, if fewer): the RMS whirl over them when the values are r².
+    pub(super) fn latest_rms(&self, count: usize) -> f64 {
+        let (older, newer) = self.latest(count);
+        let n = older.len() + newer.len();
+        (older.iter().chain(newer).sum::<f64>() / n.max(1) as f64).sqrt()
+    }
+
     /// The `count` most recent values (all there are, if fewer), as the
     /// older and the newer part of the storage.
     pub(super) fn latest(&self, count: usize) -> (&[f64], &[f64]) {
