@@ -412,116 +412,157 @@ fn outcome_from(name: &str) -> PolarsResult<Outcome> {
 
 /// Read records back from a DataFrame written by [`to_dataframe`].
 pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
-    let f64s = |name: &str| -> PolarsResult<Vec<Option<f64>>> {
-        Ok(df.column(name)?.f64()?.iter().collect())
-    };
-    let req = |name: &str| -> PolarsResult<Vec<f64>> {
-        f64s(name)?
+    let columns = Columns { df };
+    let core = CoreColumns::read(&columns)?;
+    let optional = OptionalColumns::read(&columns)?;
+    let mut uncertain = uncertain_from(df)?.into_iter();
+    let mut out = Vec::with_capacity(df.height());
+    for i in 0..df.height() {
+        out.push(RunRecord {
+            run_id: core.run_id[i],
+            design_id: core.design_id[i],
+            sample_id: core.sample_id[i],
+            kind: core.kind[i].clone(),
+            n: core.n[i],
+            rho: core.rho[i],
+            race_radius: core.race_radius[i],
+            weight_mass: core.weight_mass[i],
+            capacity: core.capacity[i],
+            drag: core.drag[i],
+            unbalance: core.unbalance[i],
+            unbalance_fraction: core.fraction[i],
+            direction_deg: core.direction[i],
+            initial_angles_deg: core.initial[i].clone(),
+            metrics: metrics_at(&core, &optional, i)?,
+            contact: core.contact[i],
+            method: core.method[i].clone(),
+            stall_torque: optional.stall[i],
+            wall_time_s: core.wall[i],
+            weights: optional.weights.as_ref().map(|w| w[i].clone()),
+            couple: optional.couple.as_ref().map(|c| c[i]),
+            uncertain: uncertain.next().unwrap_or_default(),
+        });
+    }
+    Ok(out)
+}
+
+/// Typed reads of one runs table's columns, so every group reads a column
+/// the same way and a missing or mistyped column fails with polars' error.
+struct Columns<'a> {
+    df: &'a DataFrame,
+}
+
+impl Columns<'_> {
+    /// A float column, nulls kept (a run that never settled has no time).
+    fn f64s(&self, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+        Ok(self.df.column(name)?.f64()?.iter().collect())
+    }
+
+    /// A float column every run fills: a null is a damaged file.
+    fn req(&self, name: &str) -> PolarsResult<Vec<f64>> {
+        self.f64s(name)?
             .into_iter()
             .map(|v| v.ok_or_else(|| polars_err!(ComputeError: "null in column {name}")))
             .collect()
-    };
-    let u64s = |name: &str| -> PolarsResult<Vec<u64>> {
-        Ok(df.column(name)?.u64()?.into_no_null_iter().collect())
-    };
-    let u32s = |name: &str| -> PolarsResult<Vec<u32>> {
-        Ok(df.column(name)?.u32()?.into_no_null_iter().collect())
-    };
-    let bools = |name: &str| -> PolarsResult<Vec<bool>> {
-        Ok(df
+    }
+
+    /// A u64 column (run ids and solver counts).
+    fn u64s(&self, name: &str) -> PolarsResult<Vec<u64>> {
+        Ok(self.df.column(name)?.u64()?.into_no_null_iter().collect())
+    }
+
+    /// A u32 column (design and sample indices, weight counts).
+    fn u32s(&self, name: &str) -> PolarsResult<Vec<u32>> {
+        Ok(self.df.column(name)?.u32()?.into_no_null_iter().collect())
+    }
+
+    /// A boolean column; a null reads as false, as the writer never emits one.
+    fn bools(&self, name: &str) -> PolarsResult<Vec<bool>> {
+        Ok(self
+            .df
             .column(name)?
             .bool()?
             .iter()
             .map(|v| v.unwrap_or(false))
             .collect())
-    };
-    let strs = |name: &str| -> PolarsResult<Vec<String>> {
-        Ok(df
+    }
+
+    /// A string column; a null reads as the empty string.
+    fn strs(&self, name: &str) -> PolarsResult<Vec<String>> {
+        Ok(self
+            .df
             .column(name)?
             .str()?
             .iter()
             .map(|v| v.unwrap_or_default().to_string())
             .collect())
-    };
-    let lists = |name: &str| -> PolarsResult<Vec<Vec<f64>>> {
-        let list = df.column(name)?.list()?;
+    }
+
+    /// A list-of-float column, one vector per row, nulls inside dropped.
+    fn lists(&self, name: &str) -> PolarsResult<Vec<Vec<f64>>> {
+        let list = self.df.column(name)?.list()?;
         (0..list.len())
             .map(|i| match list.get_as_series(i) {
                 Some(s) => Ok(s.f64()?.no_null_iter().collect()),
                 None => Ok(Vec::new()),
             })
             .collect()
-    };
-    let (run_id, design_id, sample_id, n) = (
-        u64s("run_id")?,
-        u32s("design_id")?,
-        u32s("sample_id")?,
-        u32s("n")?,
-    );
-    let (kind, outcome, reason, method) = (
-        strs("kind")?,
-        strs("outcome")?,
-        strs("reason")?,
-        strs("method")?,
-    );
-    let (rho, race_radius, weight_mass, capacity, drag) = (
-        req("rho")?,
-        req("race_radius")?,
-        req("weight_mass")?,
-        req("capacity")?,
-        req("drag")?,
-    );
-    let (unbalance, fraction, direction) = (
-        req("unbalance")?,
-        req("unbalance_fraction")?,
-        req("direction_deg")?,
-    );
-    let (initial, finals) = (lists("initial_angles_deg")?, lists("final_rel_angles_deg")?);
-    let (settled, hold) = (bools("settled")?, bools("hold_complete")?);
-    let (ts, tr, te, teps) = (
-        f64s("settling_time")?,
-        f64s("settling_revs")?,
-        req("settling_time_err")?,
-        f64s("settling_time_eps")?,
-    );
-    let (ra, rr, aref, be, peak, pf, tf) = (
-        req("residual_abs")?,
-        req("residual_rel")?,
-        req("a_ref")?,
-        req("balancing_error")?,
-        req("peak_r")?,
-        req("p_final")?,
-        req("t_final")?,
-    );
-    let (steps, rhs, wall) = (u64s("steps")?, u64s("rhs_calls")?, req("wall_time_s")?);
-    let fidelity = strs("fidelity")?;
-    let contact = bools("contact")?;
-    // Absent from tables written before rigid contact existed (all penalty).
-    let contact_model: Vec<Option<&'static str>> = match df.column("contact_model") {
-        Ok(c) => c
-            .str()?
-            .iter()
-            .map(|v| match v {
-                Some("rigid") => Some("rigid"),
-                Some(_) => Some("penalty"),
-                None => None,
-            })
-            .collect(),
-        Err(_) => contact.iter().map(|&on| on.then_some("penalty")).collect(),
-    };
-    // Absent from tables written before the certified hold existed.
-    let certified = match df.column("hold_certified") {
-        Ok(_) => bools("hold_certified")?,
-        Err(_) => vec![false; df.height()],
-    };
-    let (min_gap, final_gap) = (f64s("min_gap_rad")?, f64s("final_min_gap_rad")?);
-    let censoring = f64s("censoring_revs")?;
-    let weights: Option<Vec<SampledWeights>> = if df.column(WEIGHT_COLUMNS[0]).is_ok() {
+    }
+
+    /// A float column absent from tables written before the Sommerfeld
+    /// columns existed: all nulls then.
+    fn optional(&self, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+        match self.df.column(name) {
+            Ok(_) => self.f64s(name),
+            Err(_) => Ok(vec![None; self.df.height()]),
+        }
+    }
+
+    /// A list column written only by rotors with several planes.
+    fn optional_lists(&self, name: &str) -> PolarsResult<Option<Vec<Vec<f64>>>> {
+        match self.df.column(name) {
+            Ok(_) => self.lists(name).map(Some),
+            Err(_) => Ok(None),
+        }
+    }
+
+    /// The contact model per run; `None` for tables written before rigid
+    /// contact existed, whose runs with contact on were all penalty.
+    fn contact_models(&self) -> PolarsResult<Option<Vec<Option<&'static str>>>> {
+        match self.df.column("contact_model") {
+            Ok(c) => Ok(Some(
+                c.str()?
+                    .iter()
+                    .map(|v| match v {
+                        Some("rigid") => Some("rigid"),
+                        Some(_) => Some("penalty"),
+                        None => None,
+                    })
+                    .collect(),
+            )),
+            Err(_) => Ok(None),
+        }
+    }
+
+    /// Whether each hold was certified; false for tables written before the
+    /// certified hold existed.
+    fn certified(&self) -> PolarsResult<Vec<bool>> {
+        match self.df.column("hold_certified") {
+            Ok(_) => self.bools("hold_certified"),
+            Err(_) => Ok(vec![false; self.df.height()]),
+        }
+    }
+
+    /// The weights as built, when the study sampled tolerances.
+    fn weights(&self) -> PolarsResult<Option<Vec<SampledWeights>>> {
+        if self.df.column(WEIGHT_COLUMNS[0]).is_err() {
+            return Ok(None);
+        }
         let [masses, radii, tracks] = WEIGHT_COLUMNS;
-        let (m, r, l) = (lists(masses)?, lists(radii)?, lists(tracks)?);
+        let (m, r, l) = (self.lists(masses)?, self.lists(radii)?, self.lists(tracks)?);
         let [offset, angle] = RACE_COLUMNS;
-        let (offsets, angles) = (f64s(offset)?, f64s(angle)?);
-        Some(
+        let (offsets, angles) = (self.f64s(offset)?, self.f64s(angle)?);
+        Ok(Some(
             m.into_iter()
                 .zip(r)
                 .zip(l)
@@ -533,136 +574,225 @@ pub fn from_dataframe(df: &DataFrame) -> PolarsResult<Vec<RunRecord>> {
                     race: race.0.zip(race.1),
                 })
                 .collect(),
-        )
-    } else {
-        None
-    };
-    // Absent from tables written before the Sommerfeld columns existed.
-    let optional = |name: &str| -> PolarsResult<Vec<Option<f64>>> {
-        match df.column(name) {
-            Ok(_) => f64s(name),
-            Err(_) => Ok(vec![None; df.height()]),
+        ))
+    }
+
+    /// The couple part of each unbalance, when the study sampled one.
+    fn couples(&self) -> PolarsResult<Option<Vec<SampledCouple>>> {
+        if self.df.column(COUPLE_COLUMNS[0]).is_err() {
+            return Ok(None);
         }
-    };
-    let (stall, t_op, spin) = (
-        optional("stall_torque")?,
-        optional("operating_time_s")?,
-        optional("final_spin_rate")?,
-    );
-    let angle_error = optional("balance_angle_error_deg")?;
-    // Written only by rotors with several planes.
-    let optional_lists = |name: &str| -> PolarsResult<Option<Vec<Vec<f64>>>> {
-        match df.column(name) {
-            Ok(_) => lists(name).map(Some),
-            Err(_) => Ok(None),
-        }
-    };
-    let plane_a_ref = optional_lists(PLANE_COLUMNS[0])?;
-    let plane_residual = optional_lists(PLANE_COLUMNS[1])?;
-    let plane_eps = optional_lists(PLANE_COLUMNS[3])?;
-    let bearing_peak = optional_lists(BEARING_COLUMNS[0])?;
-    let bearing_rms = optional_lists(BEARING_COLUMNS[1])?;
-    // Nulls inside: a plane that did not settle.
-    let plane_settling = nullable_lists(df, PLANE_COLUMNS[2])?;
-    let couple: Option<Vec<SampledCouple>> = if df.column(COUPLE_COLUMNS[0]).is_ok() {
         let (u, fraction, direction) = (
-            f64s(COUPLE_COLUMNS[0])?,
-            f64s(COUPLE_COLUMNS[1])?,
-            f64s(COUPLE_COLUMNS[2])?,
+            self.f64s(COUPLE_COLUMNS[0])?,
+            self.f64s(COUPLE_COLUMNS[1])?,
+            self.f64s(COUPLE_COLUMNS[2])?,
         );
-        Some(
-            (0..df.height())
+        Ok(Some(
+            (0..self.df.height())
                 .map(|i| SampledCouple {
                     unbalance: u[i].unwrap_or(f64::NAN),
                     fraction: fraction[i].unwrap_or(f64::NAN),
                     direction_deg: direction[i].unwrap_or(f64::NAN),
                 })
                 .collect(),
-        )
-    } else {
-        None
-    };
-    let mut uncertain = uncertain_from(df)?.into_iter();
-    let mut out = Vec::with_capacity(df.height());
-    for i in 0..df.height() {
-        out.push(RunRecord {
-            run_id: run_id[i],
-            design_id: design_id[i],
-            sample_id: sample_id[i],
-            kind: kind[i].clone(),
-            n: n[i],
-            rho: rho[i],
-            race_radius: race_radius[i],
-            weight_mass: weight_mass[i],
-            capacity: capacity[i],
-            drag: drag[i],
-            unbalance: unbalance[i],
-            unbalance_fraction: fraction[i],
-            direction_deg: direction[i],
-            initial_angles_deg: initial[i].clone(),
-            metrics: RunMetrics {
-                settled: settled[i],
-                settling_time: ts[i],
-                settling_revs: tr[i],
-                settling_time_err: te[i],
-                settling_time_eps: teps[i],
-                hold_complete: hold[i],
-                hold_certified: certified[i],
-                residual_abs: ra[i],
-                residual_rel: rr[i],
-                a_ref: aref[i],
-                balancing_error: be[i],
-                peak_r: peak[i],
-                final_rel_angles_deg: finals[i].clone(),
-                p_final: pf[i],
-                outcome: outcome_from(&outcome[i])?,
-                reason: reason[i].clone(),
-                t_final: tf[i],
-                steps: steps[i],
-                rhs_calls: rhs[i],
-                method: method[i].clone(),
-                fidelity: fidelity[i].clone(),
-                contact_model: contact_model[i],
-                min_gap_rad: min_gap[i],
-                final_min_gap_rad: final_gap[i],
-                censoring_revs: censoring[i],
-                operating_time: t_op[i],
-                final_spin_rate: spin[i],
-                balance_angle_error_deg: angle_error[i],
-                // An empty list: a run with no per-plane values (not integrated).
-                plane_a_ref: plane_a_ref
-                    .as_ref()
-                    .map(|v| v[i].clone())
-                    .filter(|v| !v.is_empty()),
-                plane_residual_abs: plane_residual
-                    .as_ref()
-                    .map(|v| v[i].clone())
-                    .filter(|v| !v.is_empty()),
-                plane_settling_revs: plane_settling
-                    .as_ref()
-                    .map(|v| v[i].clone())
-                    .filter(|v| !v.is_empty()),
-                plane_balancing_error: plane_eps
-                    .as_ref()
-                    .map(|v| v[i].clone())
-                    .filter(|v| !v.is_empty()),
-                bearing_orbit_peak: bearing_peak
-                    .as_ref()
-                    .map(|v| v[i].clone())
-                    .filter(|v| !v.is_empty()),
-                bearing_orbit_rms: bearing_rms
-                    .as_ref()
-                    .map(|v| v[i].clone())
-                    .filter(|v| !v.is_empty()),
-            },
-            contact: contact[i],
-            method: method[i].clone(),
-            stall_torque: stall[i],
-            wall_time_s: wall[i],
-            weights: weights.as_ref().map(|w| w[i].clone()),
-            couple: couple.as_ref().map(|c| c[i]),
-            uncertain: uncertain.next().unwrap_or_default(),
-        });
+        ))
     }
-    Ok(out)
+}
+
+/// The columns every runs table has (a few read as defaults from older
+/// tables). Fields are read in declaration order of the literal in
+/// [`CoreColumns::read`], which fixes which missing column is reported first.
+struct CoreColumns {
+    run_id: Vec<u64>,
+    design_id: Vec<u32>,
+    sample_id: Vec<u32>,
+    n: Vec<u32>,
+    kind: Vec<String>,
+    outcome: Vec<String>,
+    reason: Vec<String>,
+    method: Vec<String>,
+    rho: Vec<f64>,
+    race_radius: Vec<f64>,
+    weight_mass: Vec<f64>,
+    capacity: Vec<f64>,
+    drag: Vec<f64>,
+    unbalance: Vec<f64>,
+    fraction: Vec<f64>,
+    direction: Vec<f64>,
+    initial: Vec<Vec<f64>>,
+    finals: Vec<Vec<f64>>,
+    settled: Vec<bool>,
+    hold: Vec<bool>,
+    ts: Vec<Option<f64>>,
+    tr: Vec<Option<f64>>,
+    te: Vec<f64>,
+    teps: Vec<Option<f64>>,
+    ra: Vec<f64>,
+    rr: Vec<f64>,
+    aref: Vec<f64>,
+    be: Vec<f64>,
+    peak: Vec<f64>,
+    pf: Vec<f64>,
+    tf: Vec<f64>,
+    steps: Vec<u64>,
+    rhs: Vec<u64>,
+    wall: Vec<f64>,
+    fidelity: Vec<String>,
+    contact: Vec<bool>,
+    contact_model: Option<Vec<Option<&'static str>>>,
+    certified: Vec<bool>,
+    min_gap: Vec<Option<f64>>,
+    final_gap: Vec<Option<f64>>,
+    censoring: Vec<Option<f64>>,
+}
+
+impl CoreColumns {
+    /// Reads the always-present columns first, in the order the table was
+    /// always read, so the same damaged file reports the same column.
+    fn read(c: &Columns) -> PolarsResult<Self> {
+        Ok(Self {
+            run_id: c.u64s("run_id")?,
+            design_id: c.u32s("design_id")?,
+            sample_id: c.u32s("sample_id")?,
+            n: c.u32s("n")?,
+            kind: c.strs("kind")?,
+            outcome: c.strs("outcome")?,
+            reason: c.strs("reason")?,
+            method: c.strs("method")?,
+            rho: c.req("rho")?,
+            race_radius: c.req("race_radius")?,
+            weight_mass: c.req("weight_mass")?,
+            capacity: c.req("capacity")?,
+            drag: c.req("drag")?,
+            unbalance: c.req("unbalance")?,
+            fraction: c.req("unbalance_fraction")?,
+            direction: c.req("direction_deg")?,
+            initial: c.lists("initial_angles_deg")?,
+            finals: c.lists("final_rel_angles_deg")?,
+            settled: c.bools("settled")?,
+            hold: c.bools("hold_complete")?,
+            ts: c.f64s("settling_time")?,
+            tr: c.f64s("settling_revs")?,
+            te: c.req("settling_time_err")?,
+            teps: c.f64s("settling_time_eps")?,
+            ra: c.req("residual_abs")?,
+            rr: c.req("residual_rel")?,
+            aref: c.req("a_ref")?,
+            be: c.req("balancing_error")?,
+            peak: c.req("peak_r")?,
+            pf: c.req("p_final")?,
+            tf: c.req("t_final")?,
+            steps: c.u64s("steps")?,
+            rhs: c.u64s("rhs_calls")?,
+            wall: c.req("wall_time_s")?,
+            fidelity: c.strs("fidelity")?,
+            contact: c.bools("contact")?,
+            contact_model: c.contact_models()?,
+            certified: c.certified()?,
+            min_gap: c.f64s("min_gap_rad")?,
+            final_gap: c.f64s("final_min_gap_rad")?,
+            censoring: c.f64s("censoring_revs")?,
+        })
+    }
+
+    /// Run `i`'s contact model: the column's value, or penalty wherever
+    /// contact was on in a table older than the column.
+    fn contact_model(&self, i: usize) -> Option<&'static str> {
+        match &self.contact_model {
+            Some(models) => models[i],
+            None => self.contact[i].then_some("penalty"),
+        }
+    }
+}
+
+/// The columns only some studies write (tolerances, couples, several planes,
+/// a swept motor); absent ones read as empty.
+struct OptionalColumns {
+    weights: Option<Vec<SampledWeights>>,
+    stall: Vec<Option<f64>>,
+    t_op: Vec<Option<f64>>,
+    spin: Vec<Option<f64>>,
+    angle_error: Vec<Option<f64>>,
+    plane_a_ref: Option<Vec<Vec<f64>>>,
+    plane_residual: Option<Vec<Vec<f64>>>,
+    plane_eps: Option<Vec<Vec<f64>>>,
+    bearing_peak: Option<Vec<Vec<f64>>>,
+    bearing_rms: Option<Vec<Vec<f64>>>,
+    plane_settling: Option<Vec<Vec<Option<f64>>>>,
+    couple: Option<Vec<SampledCouple>>,
+}
+
+impl OptionalColumns {
+    /// Reads the optional columns after the core ones, in their old order.
+    fn read(c: &Columns) -> PolarsResult<Self> {
+        Ok(Self {
+            weights: c.weights()?,
+            stall: c.optional("stall_torque")?,
+            t_op: c.optional("operating_time_s")?,
+            spin: c.optional("final_spin_rate")?,
+            angle_error: c.optional("balance_angle_error_deg")?,
+            plane_a_ref: c.optional_lists(PLANE_COLUMNS[0])?,
+            plane_residual: c.optional_lists(PLANE_COLUMNS[1])?,
+            plane_eps: c.optional_lists(PLANE_COLUMNS[3])?,
+            bearing_peak: c.optional_lists(BEARING_COLUMNS[0])?,
+            bearing_rms: c.optional_lists(BEARING_COLUMNS[1])?,
+            // Nulls inside: a plane that did not settle.
+            plane_settling: nullable_lists(c.df, PLANE_COLUMNS[2])?,
+            couple: c.couples()?,
+        })
+    }
+}
+
+/// Row `i` of a per-plane list column; an empty list is a run with no
+/// per-plane values (not integrated).
+fn plane_row<T: Clone>(column: &Option<Vec<Vec<T>>>, i: usize) -> Option<Vec<T>> {
+    column
+        .as_ref()
+        .map(|v| v[i].clone())
+        .filter(|v| !v.is_empty())
+}
+
+/// Run `i`'s metrics, the one step of a row that can fail (an unknown
+/// outcome name).
+fn metrics_at(
+    core: &CoreColumns,
+    optional: &OptionalColumns,
+    i: usize,
+) -> PolarsResult<RunMetrics> {
+    Ok(RunMetrics {
+        settled: core.settled[i],
+        settling_time: core.ts[i],
+        settling_revs: core.tr[i],
+        settling_time_err: core.te[i],
+        settling_time_eps: core.teps[i],
+        hold_complete: core.hold[i],
+        hold_certified: core.certified[i],
+        residual_abs: core.ra[i],
+        residual_rel: core.rr[i],
+        a_ref: core.aref[i],
+        balancing_error: core.be[i],
+        peak_r: core.peak[i],
+        final_rel_angles_deg: core.finals[i].clone(),
+        p_final: core.pf[i],
+        outcome: outcome_from(&core.outcome[i])?,
+        reason: core.reason[i].clone(),
+        t_final: core.tf[i],
+        steps: core.steps[i],
+        rhs_calls: core.rhs[i],
+        method: core.method[i].clone(),
+        fidelity: core.fidelity[i].clone(),
+        contact_model: core.contact_model(i),
+        min_gap_rad: core.min_gap[i],
+        final_min_gap_rad: core.final_gap[i],
+        censoring_revs: core.censoring[i],
+        operating_time: optional.t_op[i],
+        final_spin_rate: optional.spin[i],
+        balance_angle_error_deg: optional.angle_error[i],
+        plane_a_ref: plane_row(&optional.plane_a_ref, i),
+        plane_residual_abs: plane_row(&optional.plane_residual, i),
+        plane_settling_revs: plane_row(&optional.plane_settling, i),
+        plane_balancing_error: plane_row(&optional.plane_eps, i),
+        bearing_orbit_peak: plane_row(&optional.bearing_peak, i),
+        bearing_orbit_rms: plane_row(&optional.bearing_rms, i),
+    })
 }
