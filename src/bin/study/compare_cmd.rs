@@ -5,12 +5,13 @@ use crate::UserError;
 use crate::output::{p_value_text, say, text_table};
 use crate::plot_cmd::{check_figure_path, plot_error};
 use autobal::decide::compare_designs::{
-    PairVerdict, Pairing, Side, common_scale, compare_sides, median_with_interval,
+    DesignComparison, PairVerdict, Pairing, Side, common_scale, compare_sides, median_with_interval,
 };
 use autobal::decide::plane_summary::PlaneStats;
-use autobal::decide::verdict::Favours;
+use autobal::decide::verdict::{Comparison, Favours};
 use autobal::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use autobal::study::plan::criterion::Criterion;
+use autobal::study::results::measured_runs::Scale;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -71,53 +72,30 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
     let criterion = args.rank_by.unwrap_or(a.default_criterion);
     let scale = common_scale(&a, &b);
     let result = compare_sides(&a, &b, 0, criterion);
-    let c = &result.comparison;
-    let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |x| format!("{x:.d$}"));
-    let end = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
-    let column = |side: &Side| -> Vec<String> {
-        let (settled, runs, (lo, hi)) = side.settled();
-        let km = side.kaplan_meier();
-        let (median, (m_lo, m_hi)) = km
-            .as_ref()
-            .map_or((None, (None, None)), median_with_interval);
-        let rmst = km.map(|k| k.restricted_mean(scale.tau));
-        let residual_values: Vec<f64> = side.runs.residual.iter().flatten().copied().collect();
-        let residual = autobal::stats::quantile::median(&residual_values);
-        let p90 = Criterion::P90.value(&side.runs, &scale);
-        let residual_p95 = Criterion::ResidualP95.value(&side.runs, &scale);
-        vec![
-            side.label.clone(),
-            format!("{runs}"),
-            format!(
-                "{:.3} [{lo:.2}, {hi:.2}]",
-                settled as f64 / runs.max(1) as f64
-            ),
-            match median {
-                Some(m) => format!("{m:.1} [{}, {}]", end(m_lo), end(m_hi)),
-                None => "beyond the run".into(),
-            },
-            rmst.map_or("–".into(), |r| {
-                // The same bounded interval as summary.parquet's.
-                let i = r.bounded_interval(0.95);
-                format!("{:.1} [{:.1}, {:.1}]", r.estimate, i.lower, i.upper)
-            }),
-            p90.map_or("beyond the run".into(), |x| format!("{x:.1}")),
-            f(residual, 4),
-            f(residual_p95, 4),
-            {
-                let mut abs: Vec<f64> = side.runs.residual_abs.iter().flatten().copied().collect();
-                abs.sort_by(f64::total_cmp);
-                autobal::stats::quantile::quantile_sorted(
-                    &abs,
-                    0.95,
-                    autobal::stats::quantile::Interpolation::Linear,
-                )
-                .map_or("–".into(), |r| format!("{:.2}", r * 1e6))
-            },
-            side.dir.display().to_string(),
-        ]
-    };
-    let (ca, cb) = (column(&a), column(&b));
+    print_side_table(&a, &b, &scale);
+    say_settling_test(&a, &result);
+    // Every measure of this one pair, Holm-adjusted over the measures; the
+    // verdict is the library's (DesignComparison::verdict).
+    let verdict = result.verdict(args.alpha);
+    say_measures(&result.comparison, &verdict);
+    say(&format!(
+        "verdict: {}",
+        verdict_text(&verdict, criterion, args.alpha)
+    ));
+    for line in disagreement_lines(&verdict) {
+        say(&line);
+    }
+    if let Some(path) = &args.plot {
+        plot_sides(&a, &b, path)?;
+        say(&format!("wrote {}", path.display()));
+    }
+    Ok(())
+}
+
+/// The side-by-side table first, so the reader sees both designs before any
+/// test; the clock and horizon note says how its times were counted.
+fn print_side_table(a: &Side, b: &Side, scale: &Scale) {
+    let (ca, cb) = (side_column(a, scale), side_column(b, scale));
     let names = [
         "design",
         "runs",
@@ -137,7 +115,7 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         .collect();
     // Before the folder row, which closes the table.
     let folder = rows.pop();
-    rows.extend(plane_rows(&a, &b));
+    rows.extend(plane_rows(a, b));
     rows.extend(folder);
     print!("{}", text_table(&["", "A", "B"], &rows));
     say(&format!(
@@ -145,6 +123,61 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         a.clock.describe(),
         scale.tau
     ));
+}
+
+/// One design's column of the side-by-side table, on the pair's common
+/// horizon so both columns measure the same thing.
+fn side_column(side: &Side, scale: &Scale) -> Vec<String> {
+    let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |x| format!("{x:.d$}"));
+    let end = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+    let (settled, runs, (lo, hi)) = side.settled();
+    let km = side.kaplan_meier();
+    let (median, (m_lo, m_hi)) = km
+        .as_ref()
+        .map_or((None, (None, None)), median_with_interval);
+    let rmst = km.map(|k| k.restricted_mean(scale.tau));
+    let residual_values: Vec<f64> = side.runs.residual.iter().flatten().copied().collect();
+    let residual = autobal::stats::quantile::median(&residual_values);
+    let p90 = Criterion::P90.value(&side.runs, scale);
+    let residual_p95 = Criterion::ResidualP95.value(&side.runs, scale);
+    vec![
+        side.label.clone(),
+        format!("{runs}"),
+        format!(
+            "{:.3} [{lo:.2}, {hi:.2}]",
+            settled as f64 / runs.max(1) as f64
+        ),
+        match median {
+            Some(m) => format!("{m:.1} [{}, {}]", end(m_lo), end(m_hi)),
+            None => "beyond the run".into(),
+        },
+        rmst.map_or("–".into(), |r| {
+            // The same bounded interval as summary.parquet's.
+            let i = r.bounded_interval(0.95);
+            format!("{:.1} [{:.1}, {:.1}]", r.estimate, i.lower, i.upper)
+        }),
+        p90.map_or("beyond the run".into(), |x| format!("{x:.1}")),
+        f(residual, 4),
+        f(residual_p95, 4),
+        {
+            let mut abs: Vec<f64> = side.runs.residual_abs.iter().flatten().copied().collect();
+            abs.sort_by(f64::total_cmp);
+            autobal::stats::quantile::quantile_sorted(
+                &abs,
+                0.95,
+                autobal::stats::quantile::Interpolation::Linear,
+            )
+            .map_or("–".into(), |r| format!("{:.2}", r * 1e6))
+        },
+        side.dir.display().to_string(),
+    ]
+}
+
+/// The settling test the pairing allowed: paired sign test (and the paired
+/// residual test) when the runs met the same draws, else why not and the
+/// log-rank test.
+fn say_settling_test(a: &Side, result: &DesignComparison) {
+    let c = &result.comparison;
     let rev = |x: f64| {
         if x.is_finite() {
             format!("{x:.1}")
@@ -202,9 +235,11 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
         }
         (None, Pairing::Paired) => say("nothing to compare: no runs"),
     }
-    // Every measure of this one pair, Holm-adjusted over the measures; the
-    // verdict is the library's (DesignComparison::verdict).
-    let verdict = result.verdict(args.alpha);
+}
+
+/// One line per measure with its own test and its Holm-adjusted p-value, so
+/// the verdict below can be checked against every measure.
+fn say_measures(c: &Comparison, verdict: &PairVerdict) {
     for (m, p_holm) in c.measures.iter().zip(&verdict.p_holm) {
         let Some(d) = m.difference else {
             say(&format!("{}: nothing to compare", m.criterion.label()));
@@ -249,35 +284,30 @@ pub fn run(args: &CompareArgs) -> Result<(), UserError> {
             p_value_text(*p_holm)
         ));
     }
-    let verdict_text = match verdict.criterion_favours {
+}
+
+/// The verdict sentence on the criterion alone, naming the level it was
+/// reached at.
+fn verdict_text(verdict: &PairVerdict, criterion: Criterion, alpha: f64) -> String {
+    match verdict.criterion_favours {
         Some(Favours::A) => format!(
             "A is better than B on the {} (α = {})",
             criterion.label(),
-            args.alpha
+            alpha
         ),
         Some(Favours::B) => format!(
             "B is better than A on the {} (α = {})",
             criterion.label(),
-            args.alpha
+            alpha
         ),
         None => format!(
             "not distinguishable on the {} at α = {}",
             criterion.label(),
-            args.alpha
+            alpha
         ),
-    };
-    say(&format!("verdict: {verdict_text}"));
-    for line in disagreement_lines(&verdict) {
-        say(&line);
     }
-    if let Some(path) = &args.plot {
-        plot_sides(&a, &b, path)?;
-        say(&format!("wrote {}", path.display()));
-    }
-    Ok(())
 }
 
-/// Draw the Kaplan–Meier curves of both sides into `path`.
 /// How one plane statistic is shown ("–" where it is missing).
 type PlaneCell = dyn Fn(&PlaneStats) -> Option<String>;
 
@@ -337,6 +367,7 @@ fn compare_title(a: &Side, b: &Side) -> String {
     format!("{studies}: fraction of runs settled by t")
 }
 
+/// Draw the Kaplan–Meier curves of both sides into `path`.
 fn plot_sides(a: &Side, b: &Side, path: &Path) -> Result<(), UserError> {
     let curve = |name: &str, side: &Side| KmCurve {
         label: format!("{name}: {}", side.figure_label),
