@@ -141,122 +141,11 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     let decision = StudyDecision::from_summary(summary)?;
     let criterion = decision.criterion;
     let order: Vec<usize> = decision.ranked.iter().map(|d| d.row).collect();
-    let ids: Vec<u32> = summary
-        .column("design_id")?
-        .u32()?
-        .iter()
-        .map(Option::unwrap_or_default)
-        .collect();
-    let kind = sum.s("kind")?;
-    let n: Vec<Option<u32>> = summary.column("n")?.u32()?.iter().collect();
-    let (rho, drag, frac) = (sum.f("rho")?, sum.f("drag")?, sum.f("settled_fraction")?);
-    let planes = PlaneCells::read(summary)?;
-    let (median, median_lo, median_hi) = (
-        sum.f("settling_revs_median_km")?,
-        sum.f("settling_revs_median_km_lo")?,
-        sum.f("settling_revs_median_km_hi")?,
-    );
-    let (rmst, rmst_lo, rmst_hi) = (
-        sum.f("settling_revs_rmst")?,
-        sum.f("settling_revs_rmst_lo")?,
-        sum.f("settling_revs_rmst_hi")?,
-    );
-    let (p90, res95, rank_value) = (
-        sum.f("settling_revs_p90_all_runs")?,
-        sum.f("residual_rel_p95")?,
-        sum.f("rank_value")?,
-    );
-    // Older summaries lack the absolute residual and the speed's period.
-    let res_abs95 = sum.f_or_none("residual_abs_p95")?;
-    let seconds_per_rev = sum
-        .f_or_none("seconds_per_rev")?
-        .into_iter()
-        .flatten()
-        .next();
-    let failed: Vec<u64> = sum
-        .u("solver_failed")?
-        .iter()
-        .zip(sum.u("budget_exceeded")?)
-        .map(|(a, b)| a + b)
-        .collect();
-    let p_holm = sum.f("vs_best_p_holm")?;
-    let crit_name = criterion.to_string();
-    let (crit_diff, crit_lo, crit_hi) = if Criterion::REPORTED.contains(&criterion) {
-        (
-            sum.f(&format!("vs_best_{crit_name}_diff"))?,
-            sum.f(&format!("vs_best_{crit_name}_diff_lo"))?,
-            sum.f(&format!("vs_best_{crit_name}_diff_hi"))?,
-        )
-    } else {
-        let none = vec![None; summary.height()];
-        (none.clone(), none.clone(), none)
-    };
-    let bound = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+    let cols = RankColumns::read(summary, criterion)?;
     let rows: Vec<Vec<String>> = order
         .iter()
         .enumerate()
-        .map(|(r, &i)| {
-            let (versus, p_versus) = match decision.ranked[r].verdict {
-                Some(StoredVerdict::Best) => ("#1".to_string(), "–".to_string()),
-                Some(StoredVerdict::NoDesignBalances) => {
-                    ("#1 (does not balance)".into(), "–".into())
-                }
-                Some(StoredVerdict::OnlyDesign) | None => ("–".into(), "–".into()),
-                Some(_) if crit_diff[i].is_some() => (
-                    format!(
-                        "{} [{}, {}]",
-                        diff_text(criterion, crit_diff[i]),
-                        diff_text(criterion, crit_lo[i]),
-                        diff_text(criterion, crit_hi[i]),
-                    ),
-                    p_text(p_holm[i]),
-                ),
-                Some(_) => ("–".into(), p_text(p_holm[i])),
-            };
-            let plane_cells = planes.as_ref().map(|p| p.row(i));
-            let mut row = vec![(r + 1).to_string(), ids[i].to_string()];
-            row.extend(plane_cells.unwrap_or_else(|| {
-                [
-                    kind[i].clone().unwrap_or_default(),
-                    n[i].map_or("–".into(), |v| v.to_string()),
-                    num(rho[i], 3),
-                    plain(drag[i]),
-                ]
-            }));
-            row.push(num(frac[i].map(|f| 100.0 * f), 1));
-            // The ranking criterion's own column carries its interval.
-            row.push(match (median[i], criterion) {
-                (Some(m), Criterion::Median) => {
-                    format!("{m:.1} [{}, {}]", bound(median_lo[i]), bound(median_hi[i]))
-                }
-                (Some(m), _) => format!("{m:.1}"),
-                (None, _) => "beyond".to_string(),
-            });
-            // With no run settled every run counts at the horizon τ: the
-            // restricted mean is τ itself, a bound (the mean is at least
-            // that), and its interval has no width to show.
-            let none_settled = frac[i] == Some(0.0);
-            row.push(match (criterion == Criterion::Mean, none_settled) {
-                (_, true) => format!("≥ {}, none settled", num(rmst[i], 1)),
-                (true, false) => format!(
-                    "{} [{}, {}]",
-                    num(rmst[i], 1),
-                    num(rmst_lo[i], 1),
-                    num(rmst_hi[i], 1)
-                ),
-                (false, false) => num(rmst[i], 1),
-            });
-            row.push(p90[i].map_or("beyond".into(), |x| format!("{x:.1}")));
-            row.push(res_abs95[i].map_or("–".into(), |r| format!("{:.2}", r * 1e6)));
-            row.push(num(res95[i], 4));
-            if !Criterion::REPORTED.contains(&criterion) {
-                row.push(measure_text(criterion, rank_value[i]));
-            }
-            row.push(failed[i].to_string());
-            row.push(p_versus);
-            row.push(versus);
-            row
-        })
+        .map(|(r, &i)| cols.row(&decision, r, i))
         .collect();
     // A stall-torque sweep gets its own column after β (designs differ by
     // it alone); other studies print without it.
@@ -273,6 +162,274 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     } else {
         rows
     };
+    let header = base_header(criterion, swept);
+    // A run-up ranks on the clock from the operating speed; the median
+    // from t = 0 (motor and balancer together) stands beside it.
+    let run_up = sum
+        .s("settling_from")?
+        .iter()
+        .flatten()
+        .any(|f| f != "from t = 0");
+    let (mut header, mut rows) = (header, rows);
+    if run_up {
+        let from_start = sum.f("settling_revs_median_km_from_start")?;
+        let after = header.iter().position(|h| h.starts_with("median"));
+        insert_column(
+            &mut header,
+            &mut rows,
+            after.unwrap_or(0) + 1,
+            "median\nfrom t = 0",
+            |k| from_start[order[k]].map_or("beyond".into(), |m| format!("{m:.1}")),
+        );
+    }
+    let raced = insert_runs_column(summary, &order, &mut header, &mut rows)?;
+    let runs_note = if raced {
+        "(runs: a design with fewer runs than the others left the race after that many samples, once #1 was significantly better and no other measure favoured it; its statistics, its flags (balances, the shortfalls) and its comparison with #1 rest on the runs it has, so the ranks below #1 are not those the full study would give; docs/statistics.md, \"Racing\")\n"
+    } else {
+        ""
+    };
+    let legend = legend_text(&sum, criterion, run_up)?;
+    let seconds_note = cols.seconds_note(&order, criterion, run_up);
+    let rho_note = rho_note(&sum, &cols)?;
+    let plane_note = cols.planes.as_ref().map_or(String::new(), |p| {
+        format!(
+            "(kind, n, ρ, β: each balancer plane's, plane 0 to {} joined by “/”, one value where every plane has it; the planes' designs are columns kind_plane0 … of summary.parquet and runs.parquet)\n",
+            p.planes.len() - 1
+        )
+    });
+    let censoring_note = censoring_note(&sum, &order, &cols.ids)?;
+    let any_failed = cols.failed.iter().any(|&f| f > 0);
+    let priority: Vec<u8> = header
+        .iter()
+        .map(|h| column_priority(h, criterion, any_failed))
+        .collect();
+    let findings = verdict_line(&decision)
+        + &disagreement_line(&decision)
+        + &recommendation_line(&decision)
+        + &merged_line(&sum, &order)?
+        + &dead_band_line(&sum, &order)?
+        + &contact_line(summary)?;
+    Ok(Ranking {
+        header,
+        rows,
+        priority,
+        legend: legend
+            + runs_note
+            + &estimate_note(&sum)?
+            + &seconds_note
+            + &rho_note
+            + &plane_note
+            + &censoring_note,
+        findings,
+        passage: passage_table(summary)?,
+    })
+}
+
+/// The summary columns the ranking's rows print, one entry per summary row,
+/// read together (in the order they always were) before any row is built.
+struct RankColumns {
+    ids: Vec<u32>,
+    kind: Vec<Option<String>>,
+    n: Vec<Option<u32>>,
+    rho: Vec<Option<f64>>,
+    drag: Vec<Option<f64>>,
+    frac: Vec<Option<f64>>,
+    planes: Option<PlaneCells>,
+    median: Vec<Option<f64>>,
+    median_lo: Vec<Option<f64>>,
+    median_hi: Vec<Option<f64>>,
+    rmst: Vec<Option<f64>>,
+    rmst_lo: Vec<Option<f64>>,
+    rmst_hi: Vec<Option<f64>>,
+    p90: Vec<Option<f64>>,
+    res95: Vec<Option<f64>>,
+    rank_value: Vec<Option<f64>>,
+    /// Absent from older summaries.
+    res_abs95: Vec<Option<f64>>,
+    /// The operating speed's period (absent from older summaries).
+    seconds_per_rev: Option<f64>,
+    failed: Vec<u64>,
+    p_holm: Vec<Option<f64>>,
+    /// The criterion's difference from #1 with its interval (all empty when
+    /// the summary does not report the criterion's difference).
+    crit: [Vec<Option<f64>>; 3],
+}
+
+impl RankColumns {
+    /// Reads the columns in the order the ranking always read them, so a
+    /// damaged summary reports the same missing column.
+    fn read(summary: &DataFrame, criterion: Criterion) -> Result<Self, UserError> {
+        let sum = Summary(summary);
+        Ok(Self {
+            ids: summary
+                .column("design_id")?
+                .u32()?
+                .iter()
+                .map(Option::unwrap_or_default)
+                .collect(),
+            kind: sum.s("kind")?,
+            n: summary.column("n")?.u32()?.iter().collect(),
+            rho: sum.f("rho")?,
+            drag: sum.f("drag")?,
+            frac: sum.f("settled_fraction")?,
+            planes: PlaneCells::read(summary)?,
+            median: sum.f("settling_revs_median_km")?,
+            median_lo: sum.f("settling_revs_median_km_lo")?,
+            median_hi: sum.f("settling_revs_median_km_hi")?,
+            rmst: sum.f("settling_revs_rmst")?,
+            rmst_lo: sum.f("settling_revs_rmst_lo")?,
+            rmst_hi: sum.f("settling_revs_rmst_hi")?,
+            p90: sum.f("settling_revs_p90_all_runs")?,
+            res95: sum.f("residual_rel_p95")?,
+            rank_value: sum.f("rank_value")?,
+            res_abs95: sum.f_or_none("residual_abs_p95")?,
+            seconds_per_rev: sum
+                .f_or_none("seconds_per_rev")?
+                .into_iter()
+                .flatten()
+                .next(),
+            failed: sum
+                .u("solver_failed")?
+                .iter()
+                .zip(sum.u("budget_exceeded")?)
+                .map(|(a, b)| a + b)
+                .collect(),
+            p_holm: sum.f("vs_best_p_holm")?,
+            crit: criterion_differences(&sum, criterion, summary.height())?,
+        })
+    }
+
+    /// Summary row `i` printed as rank `r` (before the optional stall-torque,
+    /// run-up and runs columns are inserted).
+    fn row(&self, decision: &StudyDecision, r: usize, i: usize) -> Vec<String> {
+        let criterion = decision.criterion;
+        let bound = |v: Option<f64>| v.map_or("∞".to_string(), |x| format!("{x:.1}"));
+        let (versus, p_versus) = self.versus_cells(decision, r, i);
+        let plane_cells = self.planes.as_ref().map(|p| p.row(i));
+        let mut row = vec![(r + 1).to_string(), self.ids[i].to_string()];
+        row.extend(plane_cells.unwrap_or_else(|| {
+            [
+                self.kind[i].clone().unwrap_or_default(),
+                self.n[i].map_or("–".into(), |v| v.to_string()),
+                num(self.rho[i], 3),
+                plain(self.drag[i]),
+            ]
+        }));
+        row.push(num(self.frac[i].map(|f| 100.0 * f), 1));
+        // The ranking criterion's own column carries its interval.
+        row.push(match (self.median[i], criterion) {
+            (Some(m), Criterion::Median) => format!(
+                "{m:.1} [{}, {}]",
+                bound(self.median_lo[i]),
+                bound(self.median_hi[i])
+            ),
+            (Some(m), _) => format!("{m:.1}"),
+            (None, _) => "beyond".to_string(),
+        });
+        // With no run settled every run counts at the horizon τ: the
+        // restricted mean is τ itself, a bound (the mean is at least
+        // that), and its interval has no width to show.
+        let none_settled = self.frac[i] == Some(0.0);
+        row.push(match (criterion == Criterion::Mean, none_settled) {
+            (_, true) => format!("≥ {}, none settled", num(self.rmst[i], 1)),
+            (true, false) => format!(
+                "{} [{}, {}]",
+                num(self.rmst[i], 1),
+                num(self.rmst_lo[i], 1),
+                num(self.rmst_hi[i], 1)
+            ),
+            (false, false) => num(self.rmst[i], 1),
+        });
+        row.push(self.p90[i].map_or("beyond".into(), |x| format!("{x:.1}")));
+        row.push(self.res_abs95[i].map_or("–".into(), |r| format!("{:.2}", r * 1e6)));
+        row.push(num(self.res95[i], 4));
+        if !Criterion::REPORTED.contains(&criterion) {
+            row.push(measure_text(criterion, self.rank_value[i]));
+        }
+        row.push(self.failed[i].to_string());
+        row.push(p_versus);
+        row.push(versus);
+        row
+    }
+
+    /// The "Δ vs #1" and "Holm p" cells of row `i` at rank `r`: #1 and a
+    /// study's only design have nothing to be compared with.
+    fn versus_cells(&self, decision: &StudyDecision, r: usize, i: usize) -> (String, String) {
+        let criterion = decision.criterion;
+        let [crit_diff, crit_lo, crit_hi] = &self.crit;
+        match decision.ranked[r].verdict {
+            Some(StoredVerdict::Best) => ("#1".to_string(), "–".to_string()),
+            Some(StoredVerdict::NoDesignBalances) => ("#1 (does not balance)".into(), "–".into()),
+            Some(StoredVerdict::OnlyDesign) | None => ("–".into(), "–".into()),
+            Some(_) if crit_diff[i].is_some() => (
+                format!(
+                    "{} [{}, {}]",
+                    diff_text(criterion, crit_diff[i]),
+                    diff_text(criterion, crit_lo[i]),
+                    diff_text(criterion, crit_hi[i]),
+                ),
+                p_text(self.p_holm[i]),
+            ),
+            Some(_) => ("–".into(), p_text(self.p_holm[i])),
+        }
+    }
+
+    /// Revolutions of the operating speed are a clock: say what they are in
+    /// seconds (under a run-up, seconds after the rotor reached that speed).
+    fn seconds_note(&self, order: &[usize], criterion: Criterion, run_up: bool) -> String {
+        match (self.seconds_per_rev, order.first()) {
+            (Some(period), Some(&best)) => {
+                let value = match criterion {
+                    Criterion::Median => self.median[best],
+                    _ => self.rmst[best],
+                };
+                let (speed, since) = if run_up {
+                    ("at the operating speed", " after the rotor reached it")
+                } else {
+                    ("at the constant speed", "")
+                };
+                format!(
+                    "({speed} one revolution takes {:.2} ms{})\n",
+                    1e3 * period,
+                    value.map_or(String::new(), |v| format!(
+                        ": #1's {} {v:.1} rev is {:.3} s{since}",
+                        if criterion == Criterion::Median {
+                            "median"
+                        } else {
+                            "restricted mean"
+                        },
+                        v * period,
+                    ))
+                )
+            }
+            _ => String::new(),
+        }
+    }
+}
+
+/// The criterion's difference from #1 and its interval, read only when the
+/// summary reports that criterion (else empty cells, one per row).
+fn criterion_differences(
+    sum: &Summary,
+    criterion: Criterion,
+    height: usize,
+) -> Result<[Vec<Option<f64>>; 3], UserError> {
+    let crit_name = criterion.to_string();
+    Ok(if Criterion::REPORTED.contains(&criterion) {
+        [
+            sum.f(&format!("vs_best_{crit_name}_diff"))?,
+            sum.f(&format!("vs_best_{crit_name}_diff_lo"))?,
+            sum.f(&format!("vs_best_{crit_name}_diff_hi"))?,
+        ]
+    } else {
+        let none = vec![None; height];
+        [none.clone(), none.clone(), none]
+    })
+}
+
+/// The headers before the optional run-up and runs columns, which are
+/// inserted later by name.
+fn base_header(criterion: Criterion, swept: bool) -> Vec<String> {
     let mut header: Vec<String> = ["#", "id", "kind", "n", "ρ", "β\nN·s/m"]
         .map(String::from)
         .to_vec();
@@ -302,47 +459,39 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     header.push("failed".into());
     header.push("Holm p\nvs #1".into());
     header.push("Δ vs #1 (paired)\n[95% CI]".into());
-    // A run-up ranks on the clock from the operating speed; the median
-    // from t = 0 (motor and balancer together) stands beside it.
-    let run_up = sum
-        .s("settling_from")?
-        .iter()
-        .flatten()
-        .any(|f| f != "from t = 0");
-    let (mut header, mut rows) = (header, rows);
-    if run_up {
-        let from_start = sum.f("settling_revs_median_km_from_start")?;
-        let after = header.iter().position(|h| h.starts_with("median"));
-        insert_column(
-            &mut header,
-            &mut rows,
-            after.unwrap_or(0) + 1,
-            "median\nfrom t = 0",
-            |k| from_start[order[k]].map_or("beyond".into(), |m| format!("{m:.1}")),
-        );
-    }
-    // A raced study: designs that left the race have fewer runs, and say so.
+    header
+}
+
+/// A raced study: designs that left the race have fewer runs, and say so in
+/// a runs column after "settled". True when the study was raced.
+fn insert_runs_column(
+    summary: &DataFrame,
+    order: &[usize],
+    header: &mut Vec<String>,
+    rows: &mut [Vec<String>],
+) -> Result<bool, UserError> {
     let runs: Vec<Option<u64>> = summary.column("runs")?.u64()?.iter().collect();
     let raced = runs.iter().flatten().min() != runs.iter().flatten().max();
     if raced {
         let after = header.iter().position(|h| h.starts_with("settled"));
         let at = after.map_or(header.len(), |p| p + 1);
-        insert_column(&mut header, &mut rows, at, "runs", |k| {
+        insert_column(header, rows, at, "runs", |k| {
             runs[order[k]].map_or("–".into(), |r| r.to_string())
         });
     }
-    let runs_note = if raced {
-        "(runs: a design with fewer runs than the others left the race after that many samples, once #1 was significantly better and no other measure favoured it; its statistics, its flags (balances, the shortfalls) and its comparison with #1 rest on the runs it has, so the ranks below #1 are not those the full study would give; docs/statistics.md, \"Racing\")\n"
-    } else {
-        ""
-    };
+    Ok(raced)
+}
+
+/// What the columns mean, with the clock the settling times were counted on
+/// and the horizon the restricted mean stops at.
+fn legend_text(sum: &Summary, criterion: Criterion, run_up: bool) -> Result<String, UserError> {
     let from = sum
         .s("settling_from")?
         .into_iter()
         .flatten()
         .next()
         .unwrap_or_else(|| "from t = 0".into());
-    let legend = format!(
+    Ok(format!(
         "(ranked by the {}, designs that balance first; ρ = r/R, the weight's radius over the race's; settling times in revolutions counted {from}{}, over every run: a run that did not settle counts as censored (median: Kaplan–Meier; mean: the restricted mean, each run counted up to {}; p90: beyond the run when over 10 % did not settle); residual p95: 95th percentile of the RMS whirl over the last hold window, in µm and relative to A_ref (the whirl the same unbalance causes without a balancer); failed: runs that ended solver_failed or budget_exceeded, counted as not settled; Δ: this design minus #1, for the median the median of the paired differences)\n",
         criterion.label(),
         if run_up {
@@ -354,44 +503,18 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
             sum.f("settling_horizon_revs")?.first().copied().flatten(),
             0
         ))
-    );
-    // Revolutions of the operating speed are a clock: say what they are in
-    // seconds (under a run-up, seconds after the rotor reached that speed).
-    let seconds_note = match (seconds_per_rev, order.first()) {
-        (Some(period), Some(&best)) => {
-            let value = match criterion {
-                Criterion::Median => median[best],
-                _ => rmst[best],
-            };
-            let (speed, since) = if run_up {
-                ("at the operating speed", " after the rotor reached it")
-            } else {
-                ("at the constant speed", "")
-            };
-            format!(
-                "({speed} one revolution takes {:.2} ms{})\n",
-                1e3 * period,
-                value.map_or(String::new(), |v| format!(
-                    ": #1's {} {v:.1} rev is {:.3} s{since}",
-                    if criterion == Criterion::Median {
-                        "median"
-                    } else {
-                        "restricted mean"
-                    },
-                    v * period,
-                ))
-            )
-        }
-        _ => String::new(),
-    };
-    // Which ρ came from a rule rather than a number: the value alone does
-    // not say that 0.364 is the Table-1 optimum.
+    ))
+}
+
+/// Which ρ came from a rule rather than a number: the value alone does
+/// not say that 0.364 is the Table-1 optimum.
+fn rho_note(sum: &Summary, cols: &RankColumns) -> Result<String, UserError> {
     let rules = sum.s_or_none("rho_rule")?;
     let mut rule_notes = Vec::new();
     for rule in ["optimal", "half_race"] {
-        let mut with: Vec<(u32, Option<f64>)> = (0..summary.height())
+        let mut with: Vec<(u32, Option<f64>)> = (0..sum.0.height())
             .filter(|&i| rules[i].as_deref() == Some(rule))
-            .map(|i| (ids[i], rho[i]))
+            .map(|i| (cols.ids[i], cols.rho[i]))
             .collect();
         if with.is_empty() {
             continue;
@@ -408,42 +531,10 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
                 .join(", ")
         ));
     }
-    let rho_note = if rule_notes.is_empty() {
+    Ok(if rule_notes.is_empty() {
         String::new()
     } else {
         format!("({})\n", rule_notes.join("; "))
-    };
-    let plane_note = planes.as_ref().map_or(String::new(), |p| {
-        format!(
-            "(kind, n, ρ, β: each balancer plane's, plane 0 to {} joined by “/”, one value where every plane has it; the planes' designs are columns kind_plane0 … of summary.parquet and runs.parquet)\n",
-            p.planes.len() - 1
-        )
-    });
-    let censoring_note = censoring_note(&sum, &order, &ids)?;
-    let any_failed = failed.iter().any(|&f| f > 0);
-    let priority: Vec<u8> = header
-        .iter()
-        .map(|h| column_priority(h, criterion, any_failed))
-        .collect();
-    let findings = verdict_line(&decision)
-        + &disagreement_line(&decision)
-        + &recommendation_line(&decision)
-        + &merged_line(&sum, &order)?
-        + &dead_band_line(&sum, &order)?
-        + &contact_line(summary)?;
-    Ok(Ranking {
-        header,
-        rows,
-        priority,
-        legend: legend
-            + runs_note
-            + &estimate_note(&sum)?
-            + &seconds_note
-            + &rho_note
-            + &plane_note
-            + &censoring_note,
-        findings,
-        passage: passage_table(summary)?,
     })
 }
 
