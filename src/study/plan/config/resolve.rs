@@ -18,18 +18,37 @@ impl StudyFile {
 
     /// Validate every value and resolve the design grid.
     pub fn plan(self, text: &str, path: &str) -> Result<StudyPlan, StudyError> {
-        let invalid = |key: &str, value: String, reason: &str| StudyError::Invalid {
-            path: path.to_string(),
-            key: key.to_string(),
-            value,
-            reason: reason.to_string(),
+        let r = Refusal { path };
+        let name = self.checked_name(path, &r)?;
+        // Planes and weights first: every later check may walk the planes.
+        self.check_size_limits(&r)?;
+        self.check_statistics(&r)?;
+        self.check_sampling_counts(&r)?;
+        self.check_sampling_draws(&r)?;
+        self.check_metrics_and_solver(&r)?;
+        self.check_plane_designs(&r)?;
+        self.check_grid_size(&r)?;
+        let designs = self.resolve_designs().map_err(|e| r.refused(e))?;
+        self.check_tolerances(&designs, &r)?;
+        self.check_effects_balanceable(&designs, &r)?;
+        self.check_couple_balanceable(&designs, &r)?;
+        self.check_absolute_balanceable(&designs, &r)?;
+        unbalance_within_reason(&self.sampling, &designs).map_err(|e| r.refused(e))?;
+        self.check_total_runs(&designs, &r)?;
+        let plan = StudyPlan {
+            name,
+            file: self,
+            designs,
+            text: text.to_string(),
         };
-        let refused = |e: InvalidKey| StudyError::Invalid {
-            path: path.to_string(),
-            key: e.key,
-            value: e.value,
-            reason: e.reason,
-        };
+        plan.check_uncertain().map_err(|e| r.refused(e))?;
+        Ok(plan)
+    }
+
+    /// The study's name (given, or the file's stem). It becomes a folder and
+    /// a label: checked here, before any folder is made, so that a refusal
+    /// leaves nothing behind.
+    fn checked_name(&self, path: &str, r: &Refusal) -> Result<String, StudyError> {
         let name = match &self.name {
             Some(n) => n.clone(),
             None => std::path::Path::new(path)
@@ -38,8 +57,6 @@ impl StudyFile {
                 .unwrap_or("study")
                 .to_string(),
         };
-        // The name becomes a folder and a label: checked here, before any
-        // folder is made, so that a refusal leaves nothing behind.
         let bad_name = if name.trim().is_empty() {
             Some("must not be empty or blank")
         } else if name.chars().any(char::is_control) {
@@ -70,12 +87,17 @@ impl StudyFile {
             } else {
                 format!("{name:?}")
             };
-            return Err(invalid(key, shown, reason));
+            return Err(r.invalid(key, shown, reason));
         }
-        // Planes and weights first: every later check may walk the planes.
+        Ok(name)
+    }
+
+    /// The planes and weights a machine can carry, checked before anything
+    /// walks them.
+    fn check_size_limits(&self, r: &Refusal) -> Result<(), StudyError> {
         let planes = self.scene.rotor.as_rotor().planes();
         if planes > MAX_PLANES {
-            return Err(invalid(
+            return Err(r.invalid(
                 "scene.rotor.planes",
                 format!("{planes} planes"),
                 &format!(
@@ -90,7 +112,7 @@ impl StudyFile {
             .into_iter()
             .find(|&n| n > MAX_WEIGHTS)
         {
-            return Err(invalid(
+            return Err(r.invalid(
                 "designs.n",
                 n.to_string(),
                 &format!(
@@ -98,38 +120,50 @@ impl StudyFile {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// The significance level and the Pareto measures the summary needs.
+    fn check_statistics(&self, r: &Refusal) -> Result<(), StudyError> {
         let alpha = self.statistics.alpha;
         if !(alpha > 0.0 && alpha <= 0.5) {
-            return Err(invalid(
+            return Err(r.invalid(
                 "statistics.alpha",
                 alpha.to_string(),
                 "a significance level in (0, 0.5], e.g. 0.05",
             ));
         }
         if self.summary.pareto.is_empty() {
-            return Err(invalid(
+            return Err(r.invalid(
                 "summary.pareto",
                 "[]".into(),
                 "name at least one measure (median, mean, p90, residual_p95, …), or leave the key out for all four",
             ));
         }
+        Ok(())
+    }
+
+    /// How many samples are drawn and when sampling stops: the unbalance's
+    /// scale, the sample and batch counts (powers of two under Sobol), and
+    /// the stopping precision.
+    fn check_sampling_counts(&self, r: &Refusal) -> Result<(), StudyError> {
         let s = &self.sampling;
         if s.unbalance.relative_to.is_none() {
-            return Err(invalid(
+            return Err(r.invalid(
                 "sampling.unbalance.relative_to",
                 "(missing)".into(),
                 "required: \"capacity\" (the values are fractions of each design's balancing capacity, no unit) or \"absolute\" (the values are unbalances in kg·m)",
             ));
         }
         if s.samples == 0 {
-            return Err(invalid(
+            return Err(r.invalid(
                 "sampling.samples",
                 "0".into(),
                 "need at least one sample per design",
             ));
         }
         if s.batch == 0 {
-            return Err(invalid(
+            return Err(r.invalid(
                 "sampling.batch",
                 "0".into(),
                 "a batch holds at least one sample per design",
@@ -138,7 +172,7 @@ impl StudyFile {
         if s.sequence == crate::study::plan::stream::Sequence::Sobol {
             let max = crate::study::plan::stream::SOBOL_MAX_SAMPLES;
             if s.samples > max || !s.samples.is_power_of_two() {
-                return Err(invalid(
+                return Err(r.invalid(
                     "sampling.samples",
                     s.samples.to_string(),
                     &format!(
@@ -150,7 +184,7 @@ impl StudyFile {
                 ));
             }
             if s.stop_when.is_some() && !s.batch.is_power_of_two() {
-                return Err(invalid(
+                return Err(r.invalid(
                     "sampling.batch",
                     s.batch.to_string(),
                     &format!(
@@ -166,7 +200,7 @@ impl StudyFile {
                 ("win_share_halfwidth", stop.win_share_halfwidth),
             ];
             if keys.iter().all(|(_, v)| v.is_none()) {
-                return Err(invalid(
+                return Err(r.invalid(
                     "sampling.stop_when",
                     "{}".into(),
                     "name a precision: median_halfwidth_rel or win_share_halfwidth",
@@ -176,7 +210,7 @@ impl StudyFile {
                 if let Some(v) = value
                     && !(v > 0.0 && v < 1.0)
                 {
-                    return Err(invalid(
+                    return Err(r.invalid(
                         &format!("sampling.stop_when.{key}"),
                         v.to_string(),
                         "a half-width in (0, 1), e.g. 0.05",
@@ -184,54 +218,64 @@ impl StudyFile {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// What each sample draws: the unbalance's and the couple's
+    /// distributions, and a fixed direction or shift that must be finite.
+    fn check_sampling_draws(&self, r: &Refusal) -> Result<(), StudyError> {
+        let s = &self.sampling;
         crate::study::plan::distribution::check(&s.unbalance.distribution)
-            .map_err(|e| refused(e.under("sampling.unbalance")))?;
+            .map_err(|e| r.refused(e.under("sampling.unbalance")))?;
         if let Some(couple) = &s.couple {
             crate::study::plan::couple::validate(couple, &self.scene.rotor, |u| {
                 crate::study::plan::distribution::check(&u.distribution)
                     .map_err(|e| e.under("sampling.couple.unbalance"))
             })
-            .map_err(refused)?;
+            .map_err(|e| r.refused(e))?;
         }
         if let DirectionSpec::Fixed(d) = s.direction
             && !d.is_finite()
         {
-            return Err(invalid(
-                "sampling.direction.fixed",
-                d.to_string(),
-                "must be finite",
-            ));
+            return Err(r.invalid("sampling.direction.fixed", d.to_string(), "must be finite"));
         }
         if let InitialSpec::BalancedForShift(d) = s.initial
             && !d.is_finite()
         {
-            return Err(invalid(
+            return Err(r.invalid(
                 "sampling.initial.balanced_for_shift",
                 d.to_string(),
                 "must be finite",
             ));
         }
-        self.metrics.validate().map_err(refused)?;
-        self.solver.validate().map_err(refused)?;
+        Ok(())
+    }
+
+    /// The metrics' and solver's own keys, then the horizon against the
+    /// scene's speed.
+    fn check_metrics_and_solver(&self, r: &Refusal) -> Result<(), StudyError> {
+        self.metrics.validate().map_err(|e| r.refused(e))?;
+        self.solver.validate().map_err(|e| r.refused(e))?;
         if let Err(crate::model::validate::SceneError::Invalid {
             field,
             value,
             reason,
         }) = self.metrics.check_horizon(&self.scene.speed)
         {
-            return Err(invalid(&field, value, &reason));
+            return Err(r.invalid(&field, value, &reason));
         }
+        Ok(())
+    }
+
+    /// The planes' own designs, the weights over every plane, and the two
+    /// planes the optimiser can search.
+    fn check_plane_designs(&self, r: &Refusal) -> Result<(), StudyError> {
         crate::study::plan::plane_designs::validate(
             &self.designs.per_plane,
             self.scene.rotor.as_rotor().planes(),
         )
-        .map_err(
-            |InvalidKey {
-                 key: k,
-                 value: v,
-                 reason: r,
-             }| invalid(&k, v, &r),
-        )?;
+        .map_err(|e| r.refused(e))?;
+        let planes = self.scene.rotor.as_rotor().planes();
         let most_weights = self
             .designs
             .n
@@ -246,7 +290,7 @@ impl StudyFile {
             .max()
             .unwrap_or(0);
         if planes as u64 * u64::from(most_weights) > MAX_TOTAL_WEIGHTS as u64 {
-            return Err(invalid(
+            return Err(r.invalid(
                 "scene.rotor.planes",
                 format!("{planes} planes × {most_weights} weights"),
                 &format!(
@@ -254,16 +298,21 @@ impl StudyFile {
                 ),
             ));
         }
-        let planes = self.scene.rotor.as_rotor().planes();
         if !self.designs.per_plane.is_empty() && self.optimize.is_some() && planes != 2 {
             // The optimiser searches plane 0's and plane 1's radius ratios.
-            return Err(invalid(
+            return Err(r.invalid(
                 "optimize",
                 format!("{planes} balancer planes"),
                 "with designs.per_plane the optimiser searches two balancer planes' radius ratios; this rotor has another number: run the planes' designs as a grid",
             ));
         }
-        // The grid's size from its axes alone, before a design is built.
+        Ok(())
+    }
+
+    /// The grid's size from its axes alone, before a design is built, so a
+    /// grid too large to hold is refused before it is made.
+    fn check_grid_size(&self, r: &Refusal) -> Result<(), StudyError> {
+        let s = &self.sampling;
         let g = &self.designs;
         let mut grid = [
             g.kind.values().len(),
@@ -289,7 +338,7 @@ impl StudyFile {
             } else {
                 ("sampling.samples", s.samples.to_string())
             };
-            return Err(invalid(
+            return Err(r.invalid(
                 key,
                 value,
                 &format!(
@@ -298,26 +347,32 @@ impl StudyFile {
                 ),
             ));
         }
-        let designs = self.resolve_designs().map_err(
-            |InvalidKey {
-                 key: k,
-                 value: v,
-                 reason: r,
-             }| invalid(&k, v, &r),
-        )?;
-        if let Some(t) = &s.tolerances {
+        Ok(())
+    }
+
+    /// The sampled tolerances against the built designs and the scene's
+    /// facts (planes, prescribed speed).
+    fn check_tolerances(&self, designs: &[Design], r: &Refusal) -> Result<(), StudyError> {
+        if let Some(t) = &self.sampling.tolerances {
             let facts = crate::model::effect::SceneFacts {
                 planes: self.scene.rotor.as_rotor().planes(),
                 prescribed_speed: self.scene.speed.is_prescribed(),
             };
-            crate::study::plan::tolerance::validate(t, &designs, &facts).map_err(
+            crate::study::plan::tolerance::validate(t, designs, &facts).map_err(
                 |InvalidKey {
                      key: k,
                      value: v,
-                     reason: r,
-                 }| invalid(&format!("sampling.tolerances.{k}"), v, &r),
+                     reason: reason_text,
+                 }| r.invalid(&format!("sampling.tolerances.{k}"), v, &reason_text),
             )?;
         }
+        Ok(())
+    }
+
+    /// With require_balanceable, every design must hold the largest
+    /// unbalance drawn plus what the scene's effects ask of the weights.
+    fn check_effects_balanceable(&self, designs: &[Design], r: &Refusal) -> Result<(), StudyError> {
+        let s = &self.sampling;
         let demand = self.effects_capacity_demand();
         if demand > 0.0 && s.require_balanceable {
             // The weights must also hold the race centred: the unbalance they
@@ -328,7 +383,7 @@ impl StudyFile {
                 Scale::Capacity => upper * d.capacity,
             };
             if let Some(d) = designs.iter().find(|d| d.capacity < drawn(d) + demand) {
-                return Err(invalid(
+                return Err(r.invalid(
                     &format!(
                         "sampling.unbalance.{}",
                         s.unbalance.distribution.upper_key()
@@ -344,6 +399,13 @@ impl StudyFile {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// With require_balanceable and a couple in kg·m, every design must hold
+    /// the static and couple parts together in its worse plane.
+    fn check_couple_balanceable(&self, designs: &[Design], r: &Refusal) -> Result<(), StudyError> {
+        let s = &self.sampling;
         if let Some(couple) = &s.couple
             && s.require_balanceable
         {
@@ -371,7 +433,7 @@ impl StudyFile {
                     Some(u) => format!("sampling.couple.unbalance.{}", u.distribution.upper_key()),
                     None => "sampling.couple.follows_static".to_string(),
                 };
-                return Err(invalid(
+                return Err(r.invalid(
                     &key,
                     format!("{:.4e} kg·m in the worse plane", worst(d)),
                     &format!(
@@ -383,10 +445,21 @@ impl StudyFile {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// With require_balanceable and an unbalance in kg·m, every design must
+    /// hold the largest one drawn.
+    fn check_absolute_balanceable(
+        &self,
+        designs: &[Design],
+        r: &Refusal,
+    ) -> Result<(), StudyError> {
+        let s = &self.sampling;
         if s.unbalance.scale() == Scale::Absolute && s.require_balanceable {
             let upper = s.unbalance.distribution.upper();
             if let Some(d) = designs.iter().find(|d| d.capacity < upper) {
-                return Err(invalid(
+                return Err(r.invalid(
                     &format!(
                         "sampling.unbalance.{}",
                         s.unbalance.distribution.upper_key()
@@ -401,10 +474,16 @@ impl StudyFile {
                 ));
             }
         }
-        unbalance_within_reason(s, &designs).map_err(refused)?;
+        Ok(())
+    }
+
+    /// The runs the built designs make with the samples, against what one
+    /// study may hold in memory and on disk.
+    fn check_total_runs(&self, designs: &[Design], r: &Refusal) -> Result<(), StudyError> {
+        let s = &self.sampling;
         let total = designs.len() as u64 * u64::from(s.samples);
         if total > MAX_TOTAL_RUNS {
-            return Err(invalid(
+            return Err(r.invalid(
                 "sampling.samples",
                 s.samples.to_string(),
                 &format!(
@@ -414,14 +493,7 @@ impl StudyFile {
                 ),
             ));
         }
-        let plan = StudyPlan {
-            name,
-            file: self,
-            designs,
-            text: text.to_string(),
-        };
-        plan.check_uncertain().map_err(refused)?;
-        Ok(plan)
+        Ok(())
     }
 
     /// The unbalance (kg·m) the weights must add, besides cancelling the
@@ -758,4 +830,32 @@ fn unbalance_within_reason(s: &Sampling, designs: &[Design]) -> Result<(), Inval
         }
     }
     Ok(())
+}
+
+/// Builds the study file's refusals, each naming the file it came from and
+/// the dotted key a user edits.
+struct Refusal<'a> {
+    path: &'a str,
+}
+
+impl Refusal<'_> {
+    /// A value outside its domain.
+    fn invalid(&self, key: &str, value: String, reason: &str) -> StudyError {
+        StudyError::Invalid {
+            path: self.path.to_string(),
+            key: key.to_string(),
+            value,
+            reason: reason.to_string(),
+        }
+    }
+
+    /// A refusal already keyed by the check that made it.
+    fn refused(&self, e: InvalidKey) -> StudyError {
+        StudyError::Invalid {
+            path: self.path.to_string(),
+            key: e.key,
+            value: e.value,
+            reason: e.reason,
+        }
+    }
 }
