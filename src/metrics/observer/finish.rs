@@ -5,9 +5,41 @@ use super::*;
 use crate::metrics::Budget;
 use crate::metrics::reference::plane_whirls;
 
+/// Where the run ended and what the holds measured there, borrowed from the
+/// observer or the solver's report: the state that classifying the outcome
+/// and filling the metrics share, so neither copies it.
+struct Ending<'a> {
+    /// One revolution of the sampling clock (s).
+    rev: f64,
+    /// The run's end: the certifying sample, the horizon, or the solver's.
+    t_final: f64,
+    /// The state at `t_final`.
+    y_final: &'a [f64],
+    /// The weights' angles at `t_final`.
+    psi: &'a [f64],
+    /// Settling time of r ≤ δ A_ref, and whether its hold completed.
+    t_s: Option<f64>,
+    hold_complete: bool,
+    /// Settling time of the balancing error.
+    t_eps: Option<f64>,
+    /// RMS whirl over the last hold window.
+    rms: f64,
+}
+
 impl SettlingObserver<'_> {
     /// Turn the observations and the solver's report into the run's metrics.
     pub fn finish(self, report: &SolveReport) -> (RunMetrics, Option<Series>) {
+        let end = self.ending(report);
+        let merged_apart = self.merged_apart(&end);
+        let (outcome, reason) = self.classify(report, &end, merged_apart.as_deref());
+        let metrics = self.run_metrics(report, &end, outcome, reason);
+        (metrics, self.series)
+    }
+
+    /// The run's end state and the holds' readings there, the first step:
+    /// everything after reads them.
+    #[inline]
+    fn ending<'a>(&'a self, report: &'a SolveReport) -> Ending<'a> {
         let lay = self.system.layout();
         let rev = self.dt * f64::from(self.options.samples_per_rev.max(32));
         // The run's end as the integration computes it, to the last bit.
@@ -34,10 +66,27 @@ impl SettlingObserver<'_> {
             }
             None => self.ring.rms(),
         };
-        // Identical weights that met and are still one at the end: a result
-        // only if the pair is stable there (real weights would stay together
-        // too); where it is unstable, real weights would have parted.
-        let merged_apart = self.merged.and_then(|(i, j, t_met)| {
+        Ending {
+            rev,
+            t_final,
+            y_final,
+            psi,
+            t_s,
+            hold_complete,
+            t_eps,
+            rms,
+        }
+    }
+
+    /// Identical weights that met and are still one at the end: a result
+    /// only if the pair is stable there (real weights would stay together
+    /// too); where it is unstable, real weights would have parted, and this
+    /// says why the run is not a result.
+    #[inline]
+    fn merged_apart(&self, end: &Ending) -> Option<String> {
+        let (t_final, y_final) = (end.t_final, end.y_final);
+        let lay = self.system.layout();
+        self.merged.and_then(|(i, j, t_met)| {
             coincident_pair(&[(i, j)], lay, y_final)?;
             let rate = self.parting_rate(t_final, y_final, i, j);
             (rate > 1e-6 * self.omega).then(|| {
@@ -45,8 +94,19 @@ impl SettlingObserver<'_> {
                     "weights {i} and {j} (identical) coincided at t = {t_met:.4} and moved as one to the end, where the pair is unstable (once apart it would part at {rate:.3e} 1/s): the equations keep identical weights together for ever, real ones would separate; add [sampling.tolerances] to give them the differences real parts have"
                 )
             })
-        });
-        let (outcome, reason) = match (&self.diverged, &report.status) {
+        })
+    }
+
+    /// The run's outcome and its reason: failures of the integration first,
+    /// then merged weights, a certified "not settled", and last the holds.
+    #[inline]
+    fn classify(
+        &self,
+        report: &SolveReport,
+        end: &Ending,
+        merged_apart: Option<&str>,
+    ) -> (Outcome, String) {
+        match (&self.diverged, &report.status) {
             (Some(why), _) => (Outcome::Diverged, why.clone()),
             (None, Status::Failed(Failure::NonFinite { t })) => {
                 (Outcome::Diverged, format!("non-finite state at t = {t}"))
@@ -55,9 +115,10 @@ impl SettlingObserver<'_> {
                 (Outcome::BudgetExceeded, f.to_string())
             }
             (None, Status::Failed(f)) => (Outcome::SolverFailed, f.to_string()),
-            (None, _) if merged_apart.is_some() => {
-                (Outcome::Merged, merged_apart.clone().unwrap_or_default())
-            }
+            (None, _) if merged_apart.is_some() => (
+                Outcome::Merged,
+                merged_apart.unwrap_or_default().to_string(),
+            ),
             (None, _) if self.never.is_some() => {
                 let (never, t, _) = self.never.as_ref().expect("checked");
                 (
@@ -68,50 +129,72 @@ impl SettlingObserver<'_> {
                     ),
                 )
             }
-            (None, _) => match t_s {
-                Some(t) if hold_complete => (
-                    Outcome::Settled,
-                    match self.certified {
-                        // Say which part of the window was integrated.
-                        Some((t_end, _)) => format!(
-                            "r ≤ {} A_ref held for {} revolutions from t = {t:.4} (certified: integrated to t = {t_end:.4}, the last {:.1} revolutions bounded on the linearised flow)",
-                            self.options.delta,
-                            self.options.hold_revs,
-                            (t + self.window - t_end.min(t + self.window)) / rev
-                        ),
-                        None => format!(
-                            "r ≤ {} A_ref held for {} revolutions from t = {t:.4}",
-                            self.options.delta, self.options.hold_revs
-                        ),
-                    },
-                ),
-                Some(t) => (
-                    Outcome::Censored,
-                    format!(
-                        "censored: r ≤ {} A_ref from t = {t:.4} until the end of the run, shorter than the hold window of {} revolutions",
+            (None, _) => self.hold_outcome(end),
+        }
+    }
+
+    /// A run the integration finished and nothing else ended: settled if the
+    /// hold completed, else censored, saying how far from settled it was.
+    #[inline]
+    fn hold_outcome(&self, end: &Ending) -> (Outcome, String) {
+        let (rev, y_final, rms) = (end.rev, end.y_final, end.rms);
+        match end.t_s {
+            Some(t) if end.hold_complete => (
+                Outcome::Settled,
+                match self.certified {
+                    // Say which part of the window was integrated.
+                    Some((t_end, _)) => format!(
+                        "r ≤ {} A_ref held for {} revolutions from t = {t:.4} (certified: integrated to t = {t_end:.4}, the last {:.1} revolutions bounded on the linearised flow)",
+                        self.options.delta,
+                        self.options.hold_revs,
+                        (t + self.window - t_end.min(t + self.window)) / rev
+                    ),
+                    None => format!(
+                        "r ≤ {} A_ref held for {} revolutions from t = {t:.4}",
                         self.options.delta, self.options.hold_revs
                     ),
+                },
+            ),
+            Some(t) => (
+                Outcome::Censored,
+                format!(
+                    "censored: r ≤ {} A_ref from t = {t:.4} until the end of the run, shorter than the hold window of {} revolutions",
+                    self.options.delta, self.options.hold_revs
                 ),
-                None => (
-                    Outcome::Censored,
-                    match self.operating_since {
-                        Some(_) => format!(
-                            "censored: {}r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
-                            match self.planes_outside_text(y_final) {
-                                planes if planes.is_empty() => planes,
-                                planes => planes + "the whole rotor's ",
-                            },
-                            vibration(self.system, y_final) / self.a_ref,
-                            self.options.delta,
-                            rms / self.a_ref
-                        ),
-                        None => "censored: the speed never reached its operating value".to_string(),
-                    },
-                ),
-            },
-        };
+            ),
+            None => (
+                Outcome::Censored,
+                match self.operating_since {
+                    Some(_) => format!(
+                        "censored: {}r/A_ref = {:.3} at the end (band {}), residual {:.3} A_ref",
+                        match self.planes_outside_text(y_final) {
+                            planes if planes.is_empty() => planes,
+                            planes => planes + "the whole rotor's ",
+                        },
+                        vibration(self.system, y_final) / self.a_ref,
+                        self.options.delta,
+                        rms / self.a_ref
+                    ),
+                    None => "censored: the speed never reached its operating value".to_string(),
+                },
+            ),
+        }
+    }
+
+    /// The run's metrics from its end and outcome, the last step; the
+    /// simulation fills method, fidelity, contact and the bearing orbits.
+    #[inline]
+    fn run_metrics(
+        &self,
+        report: &SolveReport,
+        end: &Ending,
+        outcome: Outcome,
+        reason: String,
+    ) -> RunMetrics {
+        let (rev, t_final, y_final, psi) = (end.rev, end.t_final, end.y_final, end.psi);
+        let (t_s, hold_complete, rms) = (end.t_s, end.hold_complete, end.rms);
         let settled = outcome == Outcome::Settled;
-        let metrics = RunMetrics {
+        RunMetrics {
             settled,
             settling_time: if settled { t_s } else { None },
             settling_revs: if settled {
@@ -120,7 +203,7 @@ impl SettlingObserver<'_> {
                 None
             },
             settling_time_err: self.dt,
-            settling_time_eps: t_eps,
+            settling_time_eps: end.t_eps,
             hold_complete: settled && hold_complete,
             hold_certified: self.certified.is_some(),
             residual_abs: rms,
@@ -177,8 +260,7 @@ impl SettlingObserver<'_> {
                     .map(|h| h.met_at.map(|t| (t - self.t0) / rev))
                     .collect()
             }),
-        };
-        (metrics, self.series)
+        }
     }
 }
 
