@@ -18,7 +18,8 @@ use crate::stats::quantile::{Interpolation, quantile_sorted};
 use crate::stats::survival::Transform;
 use crate::study::plan::config::StudyPlan;
 use crate::study::plan::criterion::Criterion;
-use crate::study::results::measured_runs::DesignRuns;
+use crate::study::plan::design::Design;
+use crate::study::results::measured_runs::{DesignRuns, Scale};
 use crate::study::results::record::{RunRecord, to_dataframe};
 use polars::prelude::*;
 
@@ -48,54 +49,125 @@ pub fn summarize(plan: &StudyPlan, runs: &[RunRecord]) -> PolarsResult<DataFrame
 /// [`crate::study::results::runs_file::SUMMARY_COLUMNS`].
 pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFrame> {
     let design_col = df.column("design_id")?.u32()?.clone();
+    let study = StudyRuns::read(plan, df)?;
     let mut rows = SummaryColumns::default();
-    let scale = measure_scale(plan);
-    let clock = SettlingClock::of(plan);
-    let by_design = design_runs(df, scale.tau, clock)?;
-    // A run-up also reports the clock from t = 0, beside the one it ranks on.
-    let from_start = match clock {
-        SettlingClock::FromStart => None,
-        SettlingClock::FromOperatingSpeed(_) => {
-            Some(design_runs(df, scale.tau, SettlingClock::FromStart)?)
-        }
-    };
-    let criterion = plan.file.summary.rank_by;
-    // The analytic and linear rungs predict settling; they integrate nothing.
-    let estimated = plan.file.solver.fidelity.is_estimate();
-    // The planes every design's balancers fill (its own, or its spec in each).
-    let balancer_planes = plan.file.scene.rotor.as_rotor().planes() as u32;
-    let verdicts = best_versus_rest(
-        &by_design,
-        criterion,
-        &scale,
-        plan.file.statistics.alpha,
-        plan.file.sampling.common_random_numbers,
-        plan.file.seed,
-    );
-    let pareto = pareto_set(&by_design, &plan.file.summary.pareto, &scale);
-    // A raced design with fewer runs than the most any design has left the
-    // race after those samples (every run is a row, failed ones too).
-    let most_runs = by_design
-        .iter()
-        .map(|d| d.settling.len())
-        .max()
-        .unwrap_or(0);
-    let left_race_after = |id: u32| -> Option<u32> {
-        let runs = by_design.iter().find(|d| d.design_id == id)?.settling.len();
-        (crate::study::run::racing::races(plan) && runs < most_runs).then_some(runs as u32)
-    };
-    let rank_of = |id: u32| -> Option<u32> {
-        match &verdicts {
-            Some(v) => v.order.iter().position(|&d| d == id).map(|r| r as u32 + 1),
-            None => by_design.iter().any(|d| d.design_id == id).then_some(1),
-        }
-    };
     for design in &plan.designs {
         let mine = df.filter(&design_col.equal(design.id))?;
+        rows.push_design(&study, design, &mine)?;
+    }
+    let mut summary = rows.into_dataframe()?;
+    crate::study::plan::plane_designs::append_columns(&mut summary, &plan.designs)?;
+    crate::decide::plane_summary::append_columns(
+        &mut summary,
+        df,
+        plan,
+        study.scale.tau,
+        study.clock,
+    )?;
+    Ok(summary)
+}
+
+/// What every design's row is measured against: the designs' runs on the
+/// study's clock, the verdicts and the Pareto set over all of them.
+struct StudyRuns<'p> {
+    plan: &'p StudyPlan,
+    scale: Scale,
+    clock: SettlingClock,
+    by_design: Vec<DesignRuns>,
+    /// A run-up also reports the clock from t = 0, beside the one it ranks on.
+    from_start: Option<Vec<DesignRuns>>,
+    criterion: Criterion,
+    /// The analytic and linear rungs predict settling; they integrate nothing.
+    estimated: bool,
+    /// The planes every design's balancers fill (its own, or its spec in each).
+    balancer_planes: u32,
+    verdicts: Option<BestVersusRest>,
+    pareto: Vec<u32>,
+    /// The most runs any design has (every run is a row, failed ones too).
+    most_runs: usize,
+}
+
+impl<'p> StudyRuns<'p> {
+    /// The runs table read per design, and the comparisons across designs.
+    fn read(plan: &'p StudyPlan, df: &DataFrame) -> PolarsResult<Self> {
+        let scale = measure_scale(plan);
+        let clock = SettlingClock::of(plan);
+        let by_design = design_runs(df, scale.tau, clock)?;
+        let from_start = match clock {
+            SettlingClock::FromStart => None,
+            SettlingClock::FromOperatingSpeed(_) => {
+                Some(design_runs(df, scale.tau, SettlingClock::FromStart)?)
+            }
+        };
+        let criterion = plan.file.summary.rank_by;
+        let verdicts = best_versus_rest(
+            &by_design,
+            criterion,
+            &scale,
+            plan.file.statistics.alpha,
+            plan.file.sampling.common_random_numbers,
+            plan.file.seed,
+        );
+        let pareto = pareto_set(&by_design, &plan.file.summary.pareto, &scale);
+        let most_runs = by_design
+            .iter()
+            .map(|d| d.settling.len())
+            .max()
+            .unwrap_or(0);
+        Ok(StudyRuns {
+            plan,
+            scale,
+            clock,
+            from_start,
+            criterion,
+            estimated: plan.file.solver.fidelity.is_estimate(),
+            balancer_planes: plan.file.scene.rotor.as_rotor().planes() as u32,
+            verdicts,
+            pareto,
+            most_runs,
+            by_design,
+        })
+    }
+
+    /// A design's runs as the statistics count them, if it has any.
+    fn runs(&self, id: u32) -> Option<&DesignRuns> {
+        self.by_design.iter().find(|d| d.design_id == id)
+    }
+
+    /// A raced design with fewer runs than the most any design has left the
+    /// race after those samples.
+    fn left_race_after(&self, id: u32) -> Option<u32> {
+        let runs = self.runs(id)?.settling.len();
+        (crate::study::run::racing::races(self.plan) && runs < self.most_runs)
+            .then_some(runs as u32)
+    }
+
+    /// The design's place in the ranking (1 for every design with runs
+    /// when there is no ranking).
+    fn rank_of(&self, id: u32) -> Option<u32> {
+        match &self.verdicts {
+            Some(v) => v.order.iter().position(|&d| d == id).map(|r| r as u32 + 1),
+            None => self.runs(id).is_some().then_some(1),
+        }
+    }
+}
+
+/// One design's runs as the row reads them: the outcomes, the settled
+/// runs and those with a residual.
+struct DesignTable<'d> {
+    mine: &'d DataFrame,
+    outcomes: Vec<Option<Outcome>>,
+    residual: Float64Chunked,
+    simulated: DataFrame,
+    runs_n: u64,
+    settled_n: u64,
+}
+
+impl<'d> DesignTable<'d> {
+    fn read(mine: &'d DataFrame) -> PolarsResult<Self> {
         let outcome = mine.column("outcome")?.str()?.clone();
         let outcomes: Vec<Option<Outcome>> =
             outcome.iter().map(|o| o.and_then(Outcome::parse)).collect();
-        let count = |which: Outcome| outcomes.iter().filter(|&&o| o == Some(which)).count() as u64;
         let settled_mask = mine.column("settled")?.bool()?.clone();
         let settled = mine.filter(&settled_mask)?;
         let simulated = mine.filter(&BooleanChunked::from_iter_values(
@@ -105,14 +177,54 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
                 .map(|o| o.is_some_and(Outcome::has_residual)),
         ))?;
         let residual = simulated.column("residual_rel")?.f64()?.clone();
-        let runs_n = mine.height() as u64;
-        let settled_n = settled.height() as u64;
-        let (lo, hi) = wilson_interval(settled_n, runs_n);
-        let runs = by_design.iter().find(|d| d.design_id == design.id);
+        Ok(DesignTable {
+            mine,
+            runs_n: mine.height() as u64,
+            settled_n: settled.height() as u64,
+            outcomes,
+            residual,
+            simulated,
+        })
+    }
+
+    /// Runs that ended with this outcome.
+    fn count(&self, which: Outcome) -> u64 {
+        self.outcomes.iter().filter(|&&o| o == Some(which)).count() as u64
+    }
+}
+
+impl SummaryColumns {
+    /// One design's row, column group by column group in the table's order.
+    fn push_design(
+        &mut self,
+        study: &StudyRuns,
+        design: &Design,
+        mine: &DataFrame,
+    ) -> PolarsResult<()> {
+        let table = DesignTable::read(mine)?;
+        self.push_identity(study, design);
+        self.push_settling(study, design, &table);
+        self.push_diagnosis(study, design, &table)?;
+        self.failed_counted.push(FAILED_RUNS_COUNTED.to_string());
+        self.vs_best_alpha.push(study.plan.file.statistics.alpha);
+        self.push_residuals(study, &table)?;
+        self.estimated.push(study.estimated);
+        // The revolution every `*_revs` column counts in: one turn at the
+        // operating speed, whatever the speed law.
+        self.seconds_per_rev.push(Some(
+            std::f64::consts::TAU / study.plan.file.scene.speed.nominal_speed(),
+        ));
+        self.push_outcomes_and_contact(study, design, &table)?;
+        self.push_speed(design, mine)
+    }
+
+    /// What the design is: its grid values and geometry.
+    fn push_identity(&mut self, study: &StudyRuns, design: &Design) {
+        let rows = self;
         rows.design_id.push(design.id);
-        rows.rank.push(rank_of(design.id));
-        rows.rank_by.push(criterion.to_string());
-        rows.settling_from.push(clock.describe().to_string());
+        rows.rank.push(study.rank_of(design.id));
+        rows.rank_by.push(study.criterion.to_string());
+        rows.settling_from.push(study.clock.describe().to_string());
         rows.kind.push(design.spec.kind.name().to_string());
         rows.n.push(design.spec.n);
         rows.rho.push(design.rho);
@@ -125,7 +237,22 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.race_radius.push(design.spec.race_radius);
         rows.weight_mass.push(design.weight_mass);
         rows.roller_height.push(design.roller_length());
-        rows.balancer_planes.push(balancer_planes);
+        rows.balancer_planes.push(study.balancer_planes);
+    }
+
+    /// How many runs settled and when: shares, Kaplan–Meier, restricted
+    /// mean, the ranking's value, the verdict and the Pareto set.
+    fn push_settling(&mut self, study: &StudyRuns, design: &Design, table: &DesignTable) {
+        let rows = self;
+        let (runs_n, settled_n) = (table.runs_n, table.settled_n);
+        let (lo, hi) = wilson_interval(settled_n, runs_n);
+        let runs = study.runs(design.id);
+        let scale = &study.scale;
+        let criterion = study.criterion;
+        let verdicts = &study.verdicts;
+        let pareto = &study.pareto;
+        let from_start = &study.from_start;
+        let left_race_after = |id| study.left_race_after(id);
         rows.runs.push(runs_n);
         rows.left_race_after.push(left_race_after(design.id));
         rows.settled.push(settled_n);
@@ -137,7 +264,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.settled_lo.push(lo);
         rows.settled_hi.push(hi);
         rows.ts_p90_all
-            .push(runs.and_then(|r| Criterion::P90.value(r, &scale)));
+            .push(runs.and_then(|r| Criterion::P90.value(r, scale)));
         let km = runs.and_then(DesignRuns::kaplan_meier);
         let median = km.as_ref().and_then(|k| k.median());
         let (median_lo, median_hi) = km.as_ref().map_or((None, None), |k| {
@@ -164,16 +291,31 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         rows.ts_rmst_hi.push(rmst_interval.map(|i| i.upper));
         rows.horizon.push(scale.tau);
         rows.rank_value
-            .push(runs.and_then(|r| criterion.value(r, &scale)));
+            .push(runs.and_then(|r| criterion.value(r, scale)));
         rows.push_verdict(verdicts.as_ref(), design.id);
         rows.pareto.push(pareto.contains(&design.id));
         rows.balances
             .push(runs.is_some_and(crate::decide::verdict::balances));
+    }
+
+    /// What the no-crown checks measure, and their verdict on the first.
+    fn push_diagnosis(
+        &mut self,
+        study: &StudyRuns,
+        design: &Design,
+        table: &DesignTable,
+    ) -> PolarsResult<()> {
+        let rows = self;
+        let plan = study.plan;
+        let mine = table.mine;
+        let outcomes = &table.outcomes;
+        let runs = study.runs(design.id);
+        let verdicts = &study.verdicts;
         // What the no-crown checks measure, and their verdict on the first.
         let a_ref = sorted_values(mine.column("a_ref")?.f64()?);
         let fraction = sorted_values(mine.column("unbalance_fraction")?.f64()?);
         let median_of = |v: &[f64]| quantile_sorted(v, 0.5, Interpolation::Linear);
-        let plane_a_refs = crate::study::results::record::nullable_lists(&mine, "plane_a_ref")?;
+        let plane_a_refs = crate::study::results::record::nullable_lists(mine, "plane_a_ref")?;
         let facts = DesignFacts {
             plane_a_ref_medians: plane_medians(plane_a_refs.as_deref()),
             a_ref_median: median_of(&a_ref).unwrap_or(f64::NAN),
@@ -197,21 +339,29 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
             _ => None,
         };
         rows.unsettled_floor.push(
-            unsettled_a_refs(&mine, &outcomes, plane_a_refs.as_deref())?
+            unsettled_a_refs(mine, outcomes, plane_a_refs.as_deref())?
                 .and_then(|a| floor_reach(plan, design, &a))
                 .map(|r| r.to_string()),
         );
         rows.diagnosis_cause
             .push(diagnosis.as_ref().map(|d| d.cause.key().to_string()));
         rows.diagnosis.push(diagnosis.map(|d| d.to_string()));
-        rows.failed_counted.push(FAILED_RUNS_COUNTED.to_string());
-        rows.vs_best_alpha.push(plan.file.statistics.alpha);
+        Ok(())
+    }
+
+    /// The residual statistics (none for an estimate rung).
+    fn push_residuals(&mut self, study: &StudyRuns, table: &DesignTable) -> PolarsResult<()> {
+        let rows = self;
+        let estimated = study.estimated;
+        let residual = &table.residual;
+        let runs_n = table.runs_n;
+        let simulated = &table.simulated;
         // An estimate rung measures no residual: its zeros are not data, so
         // no residual statistic is written (before 2026-11-27 the analytic
         // rung printed "residual p95 0.00 µm" as if measured).
         let measured = |v: Option<f64>| v.filter(|_| !estimated);
         rows.res_mean.push(measured(residual.mean()));
-        let res_sorted = sorted_values(&residual);
+        let res_sorted = sorted_values(residual);
         let res_q = |q| measured(quantile_sorted(&res_sorted, q, Interpolation::Linear));
         rows.res_median.push(res_q(0.5));
         rows.res_p95.push(res_q(0.95));
@@ -225,12 +375,20 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
             0.95,
             Interpolation::Linear,
         )));
-        rows.estimated.push(estimated);
-        // The revolution every `*_revs` column counts in: one turn at the
-        // operating speed, whatever the speed law.
-        rows.seconds_per_rev.push(Some(
-            std::f64::consts::TAU / plan.file.scene.speed.nominal_speed(),
-        ));
+        Ok(())
+    }
+
+    /// How runs ended, and whether and how the weights were solid.
+    fn push_outcomes_and_contact(
+        &mut self,
+        study: &StudyRuns,
+        design: &Design,
+        table: &DesignTable,
+    ) -> PolarsResult<()> {
+        let rows = self;
+        let plan = study.plan;
+        let mine = table.mine;
+        let count = |which| table.count(which);
         rows.censored.push(count(Outcome::Censored));
         rows.not_settled.push(count(Outcome::NotSettled));
         rows.diverged.push(count(Outcome::Diverged));
@@ -266,8 +424,13 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
                 .zip(touching)
                 .map(|(gap, angle)| (-gap).max(0.0) / angle),
         );
-        // Variable speed: how many runs passed through to the operating
-        // speed, and where the others were held (the Sommerfeld effect).
+        Ok(())
+    }
+
+    /// Variable speed: how many runs passed through to the operating speed,
+    /// and where the others were held (the Sommerfeld effect).
+    fn push_speed(&mut self, design: &Design, mine: &DataFrame) -> PolarsResult<()> {
+        let rows = self;
         rows.stall_torque.push(design.stall_torque);
         let t_op = mine.column("operating_time_s")?.f64()?;
         rows.reached_operating
@@ -280,11 +443,8 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         let spin = sorted_values(mine.column("final_spin_rate")?.f64()?);
         rows.spin_median
             .push(quantile_sorted(&spin, 0.5, Interpolation::Linear));
+        Ok(())
     }
-    let mut summary = rows.into_dataframe()?;
-    crate::study::plan::plane_designs::append_columns(&mut summary, &plan.designs)?;
-    crate::decide::plane_summary::append_columns(&mut summary, df, plan, scale.tau, clock)?;
-    Ok(summary)
 }
 
 /// Column buffers of the summary table.
