@@ -19,7 +19,7 @@ mod output;
 #[path = "../study/user_error.rs"]
 mod user_error;
 
-use clap::{CommandFactory, FromArgMatches, Parser};
+use clap::Parser;
 use std::process::ExitCode;
 pub use user_error::UserError;
 
@@ -39,12 +39,6 @@ struct Cli {
 
 fn main() -> ExitCode {
     user_error::end_quietly_on_closed_pipe();
-    let matches = Cli::command()
-        .term_width(output::terminal_columns())
-        .get_matches();
-    let cli = match Cli::from_arg_matches(&matches) {
-        Ok(cli) => cli,
-        Err(e) => e.exit(),
-    };
+    let cli: Cli = user_error::parse_args();
     user_error::exit_code(bench_cmd::run(&cli.args))
 }

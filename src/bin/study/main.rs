@@ -29,7 +29,7 @@ mod sweep_cmd;
 mod tradeoff_cmd;
 mod user_error;
 
-use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 pub use user_error::UserError;
 
@@ -122,14 +122,7 @@ enum Command {
 
 fn main() -> ExitCode {
     user_error::end_quietly_on_closed_pipe();
-    // Help text wraps at words to the terminal (80 columns off a terminal).
-    let matches = Cli::command()
-        .term_width(output::terminal_columns())
-        .get_matches();
-    let cli = match Cli::from_arg_matches(&matches) {
-        Ok(cli) => cli,
-        Err(e) => e.exit(),
-    };
+    let cli: Cli = user_error::parse_args();
     output::set_wide(cli.wide);
     let result = match cli.command {
         Command::Design(args) => design_cmd::run(&args),

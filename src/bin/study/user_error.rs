@@ -1,6 +1,7 @@
-//! How a verb ends: an error printed on stderr with its exit code (2 for bad
-//! input, 1 for internal failures), and a closed pipe ending the verb
-//! quietly. Shared with the benchmark binary, so both end alike.
+//! How a verb starts and ends: its arguments parsed with help wrapped to the
+//! terminal, an error printed on stderr with its exit code (2 for bad input,
+//! 1 for internal failures), and a closed pipe ending the verb quietly.
+//! Shared with the benchmark binary, so both start and end alike.
 
 use std::process::ExitCode;
 
@@ -17,6 +18,18 @@ impl UserError {
 impl<E: std::fmt::Display> From<E> for UserError {
     fn from(e: E) -> Self {
         UserError(e.to_string(), 2)
+    }
+}
+
+/// The command line parsed, help text wrapped at words to the terminal (80
+/// columns off a terminal); a usage error exits as clap decides.
+pub fn parse_args<C: clap::CommandFactory + clap::FromArgMatches>() -> C {
+    let matches = C::command()
+        .term_width(crate::output::terminal_columns())
+        .get_matches();
+    match C::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
     }
 }
 
