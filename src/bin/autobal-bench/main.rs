@@ -28,7 +28,7 @@ pub use user_error::UserError;
 #[command(
     name = "autobal-bench",
     version = autobal::build_info::VERSION_LINE,
-    about,
+    about = "Time autobal's ODE core and runner: RHS cost per weight count, solves per method and tolerance, rotating against full, the SciPy peer's cases, thread scaling, the lean reference's runs.",
     long_about = None,
     after_help = bench_cmd::EXAMPLES
 )]
