@@ -106,6 +106,41 @@ fn bench_lean_inputs_writes_one_row_per_run() {
 }
 
 #[test]
+fn racing_looks_replay_the_race_the_study_makes() {
+    // The main job at 200 samples per design (4 000 runs, 20 looks of 10):
+    // the replay makes the race the raced study makes, looks until it ends,
+    // and never more runs than every sample.
+    let out = bench(&[
+        "--racing-looks",
+        "--samples",
+        "200",
+        "--repeats",
+        "1",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["runs_every_sample"], 4000);
+    let looks = v["looks"].as_array().unwrap();
+    assert!(
+        !looks.is_empty() && looks.len() <= 19,
+        "{} looks",
+        looks.len()
+    );
+    let left: u64 = looks.iter().map(|l| l["left"].as_u64().unwrap()).sum();
+    let raced = v["runs_raced"].as_u64().unwrap();
+    assert!(
+        raced <= 4000 && (left == 0) == (raced == 4000),
+        "{left} left, {raced} runs"
+    );
+    assert!(v["max_ms"].as_f64().unwrap() >= v["median_ms"].as_f64().unwrap());
+}
+
+#[test]
 fn the_designers_binary_lists_no_benchmark() {
     let help = Command::new(env!("CARGO_BIN_EXE_study"))
         .arg("--help")

@@ -19,6 +19,7 @@ pub const EXAMPLES: &str = "Examples:
   cargo run --release --bin autobal-bench -- --peer-cases --json > autobal.json   # bench/scipy/run.sh does this
   cargo run --release --bin autobal-bench -- --thread-scaling --repeats 9
   autobal-bench --lean-inputs runs.csv --samples 20   # bench/lean/run.sh does this
+  autobal-bench --racing-looks --repeats 5
 
 Timings are only comparable within one run (cases are interleaved and the
 median is reported); build with --release, a debug build says so in the output.";
@@ -61,8 +62,13 @@ pub struct BenchArgs {
     /// job's (one plane rotor in the rotating frame; e.g. bench/lean/peer.toml).
     #[arg(long, value_name = "STUDY", requires = "lean_inputs", conflicts_with_all = ["thread_scaling", "peer_cases", "fidelity"])]
     lean_study: Option<std::path::PathBuf>,
-    /// Samples per design with --thread-scaling (default 25; 1 with --quick)
-    /// or --lean-inputs (default 20).
+    /// Run the main job on every sample, then replay the race it makes on
+    /// those runs and time each look (the paired tests and bounds that
+    /// decide which designs leave).
+    #[arg(long, conflicts_with_all = ["thread_scaling", "peer_cases", "fidelity", "lean_inputs"])]
+    racing_looks: bool,
+    /// Samples per design with --thread-scaling (default 25; 1 with --quick),
+    /// --lean-inputs (default 20) or --racing-looks (default the main job's 500).
     #[arg(long, value_parser = crate::limits::bench_runs)]
     samples: Option<usize>,
     /// Replace the --lean-inputs file if it exists.
@@ -72,9 +78,11 @@ pub struct BenchArgs {
 
 /// Run the benchmark the arguments name.
 pub fn run(args: &BenchArgs) -> Result<(), UserError> {
-    if args.samples.is_some() && !(args.thread_scaling || args.lean_inputs.is_some()) {
+    if args.samples.is_some()
+        && !(args.thread_scaling || args.racing_looks || args.lean_inputs.is_some())
+    {
         return Err(UserError(
-            "--samples needs --thread-scaling or --lean-inputs".into(),
+            "--samples needs --thread-scaling, --racing-looks or --lean-inputs".into(),
             2,
         ));
     }
@@ -96,6 +104,9 @@ pub fn run(args: &BenchArgs) -> Result<(), UserError> {
     }
     if args.thread_scaling {
         return run_thread_scaling(args);
+    }
+    if args.racing_looks {
+        return run_racing_looks(args);
     }
     let mut config = if args.quick {
         BenchConfig::quick()
@@ -283,6 +294,48 @@ fn run_thread_scaling(args: &BenchArgs) -> Result<(), UserError> {
     } else {
         print!("{}", describe_threads(&report));
     }
+    Ok(())
+}
+
+/// `autobal-bench --racing-looks`: the main job's race replayed, each look timed.
+fn run_racing_looks(args: &BenchArgs) -> Result<(), UserError> {
+    let samples = args.samples.map_or(500, |s| s as u32);
+    let repeats = args.repeats.unwrap_or(if args.quick { 1 } else { 5 });
+    let dir = std::env::temp_dir().join(format!("autobal-bench-looks-{}", std::process::id()));
+    let result = bench::looks::measure_looks(samples, repeats, &dir);
+    // The study's files are scratch: remove them whatever happened.
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = result.map_err(|e| UserError::internal(e.to_string()))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    if report.debug_build {
+        println!(
+            "warning: debug build; use `cargo run --release --bin autobal-bench` for timings\n"
+        );
+    }
+    let rows: Vec<Vec<String>> = report
+        .looks
+        .iter()
+        .map(|l| {
+            vec![
+                l.look.to_string(),
+                l.samples.to_string(),
+                l.running.to_string(),
+                l.left.to_string(),
+                format!("{:.2}", l.ms),
+            ]
+        })
+        .collect();
+    print!(
+        "{}",
+        text_table(&["look", "samples", "running", "left", "ms"], &rows)
+    );
+    println!(
+        "looks: median {:.2} ms, largest {:.2} ms (median of {repeats} replays); runs {} raced of {} on every sample",
+        report.median_ms, report.max_ms, report.runs_raced, report.runs_every_sample
+    );
     Ok(())
 }
 

@@ -13,10 +13,12 @@
 //! - [`fidelity`]: the rotating frame against the full model;
 //! - [`peer`]: the cases the SciPy peer (`bench/scipy`) repeats;
 //! - [`threads`]: a small study at several thread counts;
-//! - [`lean_inputs`]: the main job's runs for the lean reference (`bench/lean`).
+//! - [`lean_inputs`]: the main job's runs for the lean reference (`bench/lean`);
+//! - [`looks`]: what racing's looks cost on the main job.
 
 pub mod fidelity;
 pub mod lean_inputs;
+pub mod looks;
 pub mod peer;
 pub mod problem;
 pub mod rhs;
