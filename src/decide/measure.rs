@@ -3,10 +3,12 @@
 //! The criterion itself, as the study file states it, is the plan's
 //! (`crate::study::plan::criterion`).
 
-use crate::stats::paired::{Settling, SettlingComparison, compare_settling};
+use crate::stats::paired::{
+    Settling, SettlingComparison, compare_settling, compare_settling_by_ranks,
+};
 use crate::stats::paired_measures::{
-    Difference, honest_p, mean_difference_bootstrap, paired_mean_difference, quantile_difference,
-    share_difference,
+    Difference, honest_p, mean_difference_bootstrap, mean_point_difference, paired_mean_difference,
+    quantile_difference, quantile_point_difference, quantile_se_difference, share_difference,
 };
 use crate::study::plan::criterion::{Criterion, Within};
 use crate::study::results::measured_runs::{DesignRuns, Scale};
@@ -57,7 +59,8 @@ impl Criterion {
     }
 
     /// Design A against design B on this measure (A − B), paired when
-    /// `paired` (the caller checked that they share samples).
+    /// `paired` (the caller checked that they share samples), with the
+    /// verdicts' full interval ([`Spread::Interval`]).
     pub fn compare(
         self,
         a: &DesignRuns,
@@ -67,6 +70,27 @@ impl Criterion {
         level: f64,
         rng: &mut impl Rng,
     ) -> Option<Difference> {
+        self.compare_with(a, b, paired, scale, level, Spread::Interval, rng)
+    }
+
+    /// [`Criterion::compare`] with the interval `spread` asks for.
+    #[allow(clippy::too_many_arguments)]
+    pub fn compare_with<R: Rng>(
+        self,
+        a: &DesignRuns,
+        b: &DesignRuns,
+        paired: bool,
+        scale: &Scale,
+        level: f64,
+        spread: Spread,
+        rng: &mut R,
+    ) -> Option<Difference> {
+        let look = spread != Spread::Interval;
+        let quantile = |x: &[f64], y: &[f64], q: f64, paired: bool, rng: &mut R| match spread {
+            Spread::Interval => quantile_difference(x, y, q, paired, level, rng),
+            Spread::Look => quantile_se_difference(x, y, q, paired, level, rng),
+            Spread::Point => quantile_point_difference(x, y, q, paired, level),
+        };
         match self {
             Criterion::Median if paired => {
                 let to = |d: &DesignRuns| -> Vec<Settling> {
@@ -75,36 +99,32 @@ impl Criterion {
                         .map(|o| Settling::new(o.time, o.settled))
                         .collect()
                 };
-                let c = compare_settling(&to(a), &to(b), level, rng)?;
+                let c = if look {
+                    compare_settling_by_ranks(&to(a), &to(b), level)?
+                } else {
+                    compare_settling(&to(a), &to(b), level, rng)?
+                };
                 let value = |d| self.value(d, scale).unwrap_or(f64::INFINITY);
                 Some(sign_difference(&c, value(a), value(b)))
             }
-            Criterion::Median => quantile_difference(
-                &uncapped_times(a),
-                &uncapped_times(b),
-                0.5,
-                false,
-                level,
-                rng,
-            ),
+            Criterion::Median => quantile(&uncapped_times(a), &uncapped_times(b), 0.5, false, rng),
             Criterion::Mean => {
                 let (x, y) = (capped_times(a, scale.tau), capped_times(b, scale.tau));
-                let d = if paired {
-                    paired_mean_difference(&x, &y, level)
-                } else {
-                    mean_difference_bootstrap(&x, &y, level, rng)
+                let d = match (paired, spread) {
+                    (true, _) => paired_mean_difference(&x, &y, level),
+                    (false, Spread::Point) => mean_point_difference(&x, &y, level),
+                    (false, _) => mean_difference_bootstrap(&x, &y, level, rng),
                 };
                 d.map(|d| Difference {
                     scale: settled_scale(a, b).unwrap_or(d.scale),
                     ..d
                 })
             }
-            Criterion::P90 => quantile_difference(
+            Criterion::P90 => quantile(
                 &capped_times(a, scale.tau),
                 &capped_times(b, scale.tau),
                 0.9,
                 paired,
-                level,
                 rng,
             ),
             Criterion::ResidualP95 => {
@@ -120,7 +140,7 @@ impl Criterion {
                         b.residual.iter().flatten().copied().collect(),
                     )
                 };
-                quantile_difference(&x, &y, 0.95, paired, level, rng)
+                quantile(&x, &y, 0.95, paired, rng)
             }
             _ => share_difference(
                 &self.outcomes(a, scale),
@@ -130,6 +150,24 @@ impl Criterion {
             ),
         }
     }
+}
+
+/// How a comparison measures the spread of its difference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spread {
+    /// The verdicts' interval: percentile bootstraps of 2 000 resamples
+    /// where a measure needs one, and their p-values.
+    Interval,
+    /// A race's look, which needs a difference's standard error and not
+    /// its tails: the sign test's rank interval for the paired median, and
+    /// a normal interval from a 200-resample standard error (normal
+    /// p-value) for the other quantiles. Means and shares, and the paired
+    /// median's p-value, are the same as with `Interval`.
+    Look,
+    /// The point estimates alone where a spread would need resampling (an
+    /// unbounded interval, p = 1; `Look` elsewhere), drawing no
+    /// randomness: what a look checks before paying for a spread.
+    Point,
 }
 
 /// The paired median comparison as a [`Difference`]: the Kaplan–Meier

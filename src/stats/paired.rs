@@ -30,6 +30,7 @@ use super::bootstrap::CI_RESAMPLES;
 use super::interval::wilson_interval_at;
 use super::quantile::{Interpolation, quantile_sorted};
 use rand::{Rng, RngExt};
+use statrs::distribution::{ContinuousCDF, Normal};
 use statrs::function::factorial::ln_binomial;
 use statrs::function::gamma::gamma_ur;
 use std::f64::consts::LN_2;
@@ -109,6 +110,28 @@ pub fn compare_settling(
     level: f64,
     rng: &mut impl Rng,
 ) -> Option<SettlingComparison> {
+    compare_settling_with(a, b, level, |d| bootstrap_median(d, level, rng))
+}
+
+/// [`compare_settling`] with the median difference's interval read off the
+/// sorted differences by the sign test's own order statistics (the
+/// distribution-free interval of a median, normal approximation to the
+/// binomial) instead of a bootstrap: no resampling, for a race's looks.
+pub fn compare_settling_by_ranks(
+    a: &[Settling],
+    b: &[Settling],
+    level: f64,
+) -> Option<SettlingComparison> {
+    compare_settling_with(a, b, level, |d| median_rank_interval(d, level))
+}
+
+/// [`compare_settling`] with the median difference's interval from `interval`.
+fn compare_settling_with(
+    a: &[Settling],
+    b: &[Settling],
+    level: f64,
+    interval: impl FnOnce(&[f64]) -> (f64, f64),
+) -> Option<SettlingComparison> {
     check_level(level);
     let finite = |s: &Settling| !matches!(s, Settling::Settled(t) if !t.is_finite());
     if a.len() != b.len() || a.is_empty() || !a.iter().chain(b).all(finite) {
@@ -119,7 +142,7 @@ pub fn compare_settling(
     let a_sooner = differences.iter().filter(|&&d| d > 0.0).count() as u64;
     let b_sooner = differences.iter().filter(|&&d| d < 0.0).count() as u64;
     let n = a.len() as u64;
-    let median_difference_interval = bootstrap_median(&differences, level, rng);
+    let median_difference_interval = interval(&differences);
     Some(SettlingComparison {
         n,
         a_sooner,
@@ -314,6 +337,23 @@ fn median_in_place(values: &mut [f64]) -> f64 {
 }
 
 /// Percentile bootstrap interval at `level` of the median of `values`.
+/// The distribution-free `level` interval of the median of `values`: the
+/// k-th smallest and k-th largest value, k from the normal approximation to
+/// Binomial(n, ½) (Conover 1999, §3.2); unbounded when n is too small for
+/// any k ≥ 1.
+fn median_rank_interval(values: &[f64], level: f64) -> (f64, f64) {
+    let n = values.len();
+    let z = Normal::standard().inverse_cdf(0.5 + level / 2.0);
+    let k = (0.5 * (n as f64 - z * (n as f64).sqrt())).floor();
+    if k < 1.0 {
+        return (f64::NEG_INFINITY, f64::INFINITY);
+    }
+    let k = k as usize;
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    (sorted[k - 1], sorted[n - k])
+}
+
 fn bootstrap_median(values: &[f64], level: f64, rng: &mut impl Rng) -> (f64, f64) {
     let n = values.len();
     let mut buf = vec![0.0; n];
@@ -373,6 +413,19 @@ mod tests {
         (0, 100_000, 0.0),
         (499_000, 1_000_000, 0.0456082998653896),
     ];
+
+    #[test]
+    fn the_rank_interval_of_a_median_is_the_tables() {
+        // n = 100 at 95 %: the 40th and 61st smallest (Conover 1999, Table
+        // A3's normal approximation); too few values for any rank: unbounded.
+        let values: Vec<f64> = (1..=100).rev().map(f64::from).collect();
+        assert_eq!(median_rank_interval(&values, 0.95), (40.0, 61.0));
+        let few = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(
+            median_rank_interval(&few, 0.95),
+            (f64::NEG_INFINITY, f64::INFINITY)
+        );
+    }
 
     #[test]
     fn sign_test_matches_scipy_binomtest() {

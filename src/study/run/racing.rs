@@ -17,7 +17,12 @@
 //! A look reads only the runs of the batches so far, and draws its
 //! bootstrap streams from (seed, look, designs): the same seed gives the
 //! same race for any thread count, and an interrupted race resumes exactly.
+//! A look needs p-values and standard errors, not an interval's tails, so
+//! it compares with [`Spread::Look`]: no resampling for the paired median
+//! (the sign test and its rank interval), a tenth of the verdicts'
+//! resamples for the other quantiles.
 
+use crate::decide::measure::Spread;
 use crate::decide::verdict::{
     Favours, LEVEL, balances, favoured, material_difference, pareto_set, ranking,
 };
@@ -251,7 +256,7 @@ pub fn leaves(
             Purpose::Racing,
         );
         criterion
-            .compare(c, d, paired, &scale, LEVEL, &mut rng)
+            .compare_with(c, d, paired, &scale, LEVEL, Spread::Look, &mut rng)
             .is_some_and(|x| {
                 favoured(criterion, &x, (x.p_value * factor).min(1.0), alpha) == Some(Favours::A)
             })
@@ -273,37 +278,52 @@ pub fn leaves(
     // ([`material_difference`]): a design that might still turn out better
     // on one by a difference worth reporting keeps running, so that the
     // finding "better than #1 on m" cannot be lost with it.
-    let at_least_as_good = |d: &DesignRuns| {
-        measures.iter().enumerate().all(|(j, m)| {
-            let (a, b) = (m.value(leader, &scale), m.value(d, &scale));
-            if m.order(a, b) == std::cmp::Ordering::Equal {
-                return true;
-            }
-            let mut rng = stream(
-                plan.file.seed,
-                Some(leader.design_id),
-                ((look as u64) << 32) | ((j as u64 + 1) << 24) | u64::from(d.design_id),
-                Purpose::Racing,
-            );
-            match m.compare(leader, d, paired, &scale, LEVEL, &mut rng) {
-                Some(x) if x.interval.0.is_finite() && x.interval.1.is_finite() => {
-                    let se = (x.interval.1 - x.interval.0) / (2.0 * Z_95);
-                    let lead = if m.a_better(x.difference) {
-                        x.difference.abs()
-                    } else {
-                        -x.difference.abs()
-                    };
-                    let ahead = lead >= MARGIN_Z * se;
-                    // The design's largest plausible lead, still immaterial.
-                    let immaterial = !material_difference(&Difference {
-                        difference: (MARGIN_Z * se - lead).max(0.0),
-                        ..x
-                    });
-                    ahead || immaterial
-                }
-                _ => m.order(a, b) == std::cmp::Ordering::Less,
-            }
+    // A design ahead of the leader on some measure's point estimate by the
+    // minimum effect stays whatever the spread: checked first, with no
+    // resampling, so that the spreads below are paid only for designs that
+    // may leave.
+    let leads_on_a_point = |d: &DesignRuns| {
+        measures.iter().any(|m| {
+            // Point draws nothing: any stream serves.
+            let mut unused = stream(plan.file.seed, None, 0, Purpose::Racing);
+            m.compare_with(leader, d, paired, &scale, LEVEL, Spread::Point, &mut unused)
+                .is_some_and(|x| {
+                    x.difference != 0.0 && !m.a_better(x.difference) && material_difference(&x)
+                })
         })
+    };
+    let at_least_as_good = |d: &DesignRuns| {
+        !leads_on_a_point(d)
+            && measures.iter().enumerate().all(|(j, m)| {
+                let (a, b) = (m.value(leader, &scale), m.value(d, &scale));
+                if m.order(a, b) == std::cmp::Ordering::Equal {
+                    return true;
+                }
+                let mut rng = stream(
+                    plan.file.seed,
+                    Some(leader.design_id),
+                    ((look as u64) << 32) | ((j as u64 + 1) << 24) | u64::from(d.design_id),
+                    Purpose::Racing,
+                );
+                match m.compare_with(leader, d, paired, &scale, LEVEL, Spread::Look, &mut rng) {
+                    Some(x) if x.interval.0.is_finite() && x.interval.1.is_finite() => {
+                        let se = (x.interval.1 - x.interval.0) / (2.0 * Z_95);
+                        let lead = if m.a_better(x.difference) {
+                            x.difference.abs()
+                        } else {
+                            -x.difference.abs()
+                        };
+                        let ahead = lead >= MARGIN_Z * se;
+                        // The design's largest plausible lead, still immaterial.
+                        let immaterial = !material_difference(&Difference {
+                            difference: (MARGIN_Z * se - lead).max(0.0),
+                            ..x
+                        });
+                        ahead || immaterial
+                    }
+                    _ => m.order(a, b) == std::cmp::Ordering::Less,
+                }
+            })
     };
     worse
         .into_iter()
@@ -341,7 +361,7 @@ pub fn significantly_worse(
                 ((look as u64) << 32) | u64::from(d.design_id),
                 Purpose::Racing,
             );
-            criterion.compare(leader, d, paired, &scale, LEVEL, &mut rng)
+            criterion.compare_with(leader, d, paired, &scale, LEVEL, Spread::Look, &mut rng)
         })
         .collect();
     let p: Vec<f64> = differences
