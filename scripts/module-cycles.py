@@ -35,7 +35,7 @@ CRATE_LAYERS = [
     {"decide"},
     {"study::run"},
     {"study"},
-    {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report", "calibrate"},
+    {"optimize", "claims", "tradeoff", "check", "plot", "schema", "report", "calibrate", "text"},
 ]
 MODEL_LAYERS = [
     {"validate", "cargo", "speed", "rotor", "effect", "balancer", "trig", "race_ring", "coupling",

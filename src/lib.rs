@@ -55,5 +55,6 @@ pub mod schema;
 pub mod simulation;
 pub mod stats;
 pub mod study;
+pub mod text;
 pub mod tradeoff;
 pub mod uncertain;

@@ -12,7 +12,7 @@ mod bench_limits;
 #[allow(dead_code)]
 #[path = "../study/limits.rs"]
 mod limits;
-#[allow(dead_code)]
+#[allow(dead_code, unused_imports)]
 #[path = "../study/output.rs"]
 mod output;
 #[allow(dead_code)]

@@ -4,12 +4,13 @@
 
 use crate::UserError;
 use crate::plot_cmd::plot_error;
-use crate::ranking::{ranking, robustness_findings};
+use crate::robustness_notes::robustness_findings;
 use autobal::decide::decision::StudyDecision;
 use autobal::output_file::{WhenExists, prepare};
 use autobal::report::{Report, question, study_figures};
 use autobal::study::results::io::{read_metadata, write_text};
 use autobal::study::results::results_table::{TableKind, read_table};
+use autobal::text::ranking::ranking;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -106,7 +107,8 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
     // A column the ranking needs beyond those checked above: still the file's fault.
     let in_summary =
         |message: String| UserError(format!("{}: {message}", summary_path.display()), 2);
-    let parts = ranking(&summary).map_err(|UserError(m, _)| in_summary(m))?;
+    let parts =
+        ranking(&summary, crate::output::layout()).map_err(|e| in_summary(e.to_string()))?;
     let study_text = autobal::input_file::read_text(&args.dir.join("study.toml"))
         .map_err(|e| UserError(format!("{}/study.toml: {e}", args.dir.display()), 2))?;
     // The leading designs' ids, in rank order, from the typed decision.

@@ -3,12 +3,13 @@
 use crate::UserError;
 use crate::output::{text_width, wrap};
 use crate::progress::RunProgress;
-use crate::ranking::{ranked_table, robustness_lines};
+use crate::robustness_notes::robustness_lines;
 use autobal::decide::failures::failure_advice;
 use autobal::study::plan::config::load;
 use autobal::study::plan::criterion::Criterion;
 use autobal::study::run::merge::merge;
 use autobal::study::run::{AdaptiveOutcome, RunError, RunOptions, Shard, run_study};
+use autobal::text::ranking::ranked_table;
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -109,7 +110,7 @@ pub fn run(args: &RunArgs) -> Result<(), UserError> {
     })?;
     match &output.summary {
         Some(summary) => {
-            print!("{}", ranked_table(summary)?);
+            print!("{}", ranked_table(summary, crate::output::layout())?);
             if let Some(adaptive) = &output.adaptive {
                 println!("{}", adaptive_line(adaptive));
             }
@@ -156,7 +157,7 @@ pub fn merge_shards(args: &MergeArgs) -> Result<(), UserError> {
     }
     let output = merge(&args.dirs, args.out.as_deref(), args.overwrite)?;
     if let Some(summary) = &output.summary {
-        print!("{}", ranked_table(summary)?);
+        print!("{}", ranked_table(summary, crate::output::layout())?);
     }
     if let Some(line) = race_line(&output) {
         print!("{}", wrap(&(line + "\n"), text_width()));

@@ -183,7 +183,7 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
             "; it sits at the {} {} swept ({}): the best may lie beyond, so extend {} {} it",
             if e.high { "largest" } else { "smallest" },
             e.axis.key(),
-            autobal::number_text::significant(e.value, 4),
+            crate::number_text::significant(e.value, 4),
             e.axis.key(),
             if e.high { "above" } else { "below" },
         );

@@ -1,33 +1,27 @@
-//! The ranking `study run` and `study merge` print from `summary.parquet`:
-//! the designs in the order of the declared criterion, the verdict on it,
-//! where the other measures disagree, and the recommendation (or why no
-//! design is recommended).
+//! The ranking `study run`, `study merge` and `study report` print from
+//! `summary.parquet`: the designs in the order of the declared criterion,
+//! the verdict on it, where the other measures disagree, and the
+//! recommendation (or why no design is recommended).
 
-use crate::UserError;
-use crate::output::{dropped_note, fitted_table, p_value_text, text_table, text_width, wrap};
-use autobal::decide::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
-use autobal::decide::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE};
-use autobal::study::plan::criterion::Criterion;
-use polars::prelude::DataFrame;
+use crate::decide::decision::{Crown, Recommendation, StoredVerdict, StudyDecision};
+use crate::decide::verdict::{Shortfall, WORKS_SETTLED_SHARE, WORKS_WORSE_SHARE};
+use crate::study::plan::criterion::Criterion;
+use crate::text::{Layout, dropped_note, fitted_table, p_value_text, text_table, wrap};
+use polars::prelude::{DataFrame, PolarsResult};
 
 mod findings;
 mod notes;
-mod robustness;
-
-pub use robustness::{robustness_findings, robustness_lines};
 
 use findings::{disagreement_line, recommendation_line, verdict_line};
 use notes::{contact_line, dead_band_line, merged_line, passage_table};
 
 /// The summary's columns by name (the library's reader).
-use autobal::study::results::summary_columns::SummaryColumns as Summary;
+use crate::study::results::summary_columns::SummaryColumns as Summary;
 
 /// A parameter to four significant digits (`10`, `0.5`, not
 /// `0.05000000000000001`), or "–".
 fn plain(v: Option<f64>) -> String {
-    v.map_or("–".to_string(), |x| {
-        autobal::number_text::significant(x, 4)
-    })
+    v.map_or("–".to_string(), |x| crate::number_text::significant(x, 4))
 }
 
 /// A number with `digits` decimals, or "–".
@@ -65,7 +59,7 @@ struct PlaneCells {
 
 impl PlaneCells {
     /// `None` when the summary has no per-plane columns.
-    fn read(summary: &DataFrame) -> Result<Option<PlaneCells>, UserError> {
+    fn read(summary: &DataFrame) -> PolarsResult<Option<PlaneCells>> {
         let mut planes = Vec::new();
         while summary.column(&format!("n_plane{}", planes.len())).is_ok() {
             let p = planes.len();
@@ -110,10 +104,10 @@ impl PlaneCells {
 }
 
 /// The ranking, verdicts, disagreements and recommendation of a summary.
-pub fn ranked_table(summary: &DataFrame) -> Result<String, UserError> {
-    let parts = ranking(summary)?;
+pub fn ranked_table(summary: &DataFrame, layout: Layout) -> PolarsResult<String> {
+    let parts = ranking(summary, layout)?;
     let header: Vec<&str> = parts.header.iter().map(String::as_str).collect();
-    let width = text_width();
+    let width = layout.width;
     let (table, dropped) = fitted_table(&header, &parts.rows, &parts.priority, width);
     let dropped_note = dropped_note(&dropped);
     Ok(table + &wrap(&(parts.legend + &dropped_note + &parts.findings), width) + &parts.passage)
@@ -136,7 +130,7 @@ pub struct Ranking {
 }
 
 /// The ranking of a summary, in pieces.
-pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
+pub fn ranking(summary: &DataFrame, layout: Layout) -> PolarsResult<Ranking> {
     let sum = Summary(summary);
     let decision = StudyDecision::from_summary(summary)?;
     let criterion = decision.criterion;
@@ -188,7 +182,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
     } else {
         ""
     };
-    let legend = legend_text(&sum, criterion, run_up)?;
+    let legend = legend_text(&sum, criterion, run_up, layout.wide)?;
     let seconds_note = cols.seconds_note(&order, criterion, run_up);
     let rho_note = rho_note(&sum, &cols)?;
     let plane_note = cols.planes.as_ref().map_or(String::new(), |p| {
@@ -208,7 +202,7 @@ pub fn ranking(summary: &DataFrame) -> Result<Ranking, UserError> {
         + &recommendation_line(&decision)
         + &merged_line(&sum, &order)?
         + &dead_band_line(&sum, &order)?
-        + &contact_line(summary)?;
+        + &contact_line(summary, layout.wide)?;
     Ok(Ranking {
         header,
         rows,
@@ -258,7 +252,7 @@ struct RankColumns {
 impl RankColumns {
     /// Reads the columns in the order the ranking always read them, so a
     /// damaged summary reports the same missing column.
-    fn read(summary: &DataFrame, criterion: Criterion) -> Result<Self, UserError> {
+    fn read(summary: &DataFrame, criterion: Criterion) -> PolarsResult<Self> {
         let sum = Summary(summary);
         Ok(Self {
             ids: summary
@@ -413,7 +407,7 @@ fn criterion_differences(
     sum: &Summary,
     criterion: Criterion,
     height: usize,
-) -> Result<[Vec<Option<f64>>; 3], UserError> {
+) -> PolarsResult<[Vec<Option<f64>>; 3]> {
     let crit_name = criterion.to_string();
     Ok(if Criterion::REPORTED.contains(&criterion) {
         [
@@ -469,7 +463,7 @@ fn insert_runs_column(
     order: &[usize],
     header: &mut Vec<String>,
     rows: &mut [Vec<String>],
-) -> Result<bool, UserError> {
+) -> PolarsResult<bool> {
     let runs: Vec<Option<u64>> = summary.column("runs")?.u64()?.iter().collect();
     let raced = runs.iter().flatten().min() != runs.iter().flatten().max();
     if raced {
@@ -484,7 +478,12 @@ fn insert_runs_column(
 
 /// What the columns mean, with the clock the settling times were counted on
 /// and the horizon the restricted mean stops at.
-fn legend_text(sum: &Summary, criterion: Criterion, run_up: bool) -> Result<String, UserError> {
+fn legend_text(
+    sum: &Summary,
+    criterion: Criterion,
+    run_up: bool,
+    wide: bool,
+) -> PolarsResult<String> {
     let from = sum
         .s("settling_from")?
         .into_iter()
@@ -499,16 +498,19 @@ fn legend_text(sum: &Summary, criterion: Criterion, run_up: bool) -> Result<Stri
         } else {
             ""
         },
-        horizon_text(num(
-            sum.f("settling_horizon_revs")?.first().copied().flatten(),
-            0
-        ))
+        horizon_text(
+            num(
+                sum.f("settling_horizon_revs")?.first().copied().flatten(),
+                0
+            ),
+            wide
+        )
     ))
 }
 
 /// Which ρ came from a rule rather than a number: the value alone does
 /// not say that 0.364 is the Table-1 optimum.
-fn rho_note(sum: &Summary, cols: &RankColumns) -> Result<String, UserError> {
+fn rho_note(sum: &Summary, cols: &RankColumns) -> PolarsResult<String> {
     let rules = sum.s_or_none("rho_rule")?;
     let mut rule_notes = Vec::new();
     for rule in ["optimal", "half_race"] {
@@ -542,7 +544,7 @@ fn rho_note(sum: &Summary, cols: &RankColumns) -> Result<String, UserError> {
 /// each counted at the horizon τ (share (1 − settled) τ / mean over a half):
 /// such a mean grows with the horizon, not with the design, and the reader
 /// must know it (in rank order; empty when none).
-fn censoring_note(sum: &Summary, order: &[usize], ids: &[u32]) -> Result<String, UserError> {
+fn censoring_note(sum: &Summary, order: &[usize], ids: &[u32]) -> PolarsResult<String> {
     let (frac, rmst) = (sum.f("settled_fraction")?, sum.f("settling_revs_rmst")?);
     let tau = sum.f("settling_horizon_revs")?;
     let mostly: Vec<String> = order
@@ -585,8 +587,8 @@ fn insert_column(
 
 /// How far the restricted mean counts a run: in words by default (the
 /// verdict's test names τ), with the symbol and its formula under `--wide`.
-fn horizon_text(revs: String) -> String {
-    if crate::output::wide() {
+fn horizon_text(revs: String, wide: bool) -> String {
+    if wide {
         format!("the horizon τ = {revs} rev, t_end − hold")
     } else {
         format!("{revs} rev, the run's length less its hold window (τ)")
@@ -622,7 +624,7 @@ fn p_text(p: Option<f64>) -> String {
 }
 
 /// Each summary row's design id.
-fn design_ids(sum: &Summary) -> Result<Vec<u32>, UserError> {
+fn design_ids(sum: &Summary) -> PolarsResult<Vec<u32>> {
     Ok(sum
         .0
         .column("design_id")?
@@ -635,7 +637,7 @@ fn design_ids(sum: &Summary) -> Result<Vec<u32>, UserError> {
 /// Said first when the runs are estimates (the analytic or linear rung):
 /// their settling times are predicted, not simulated, and they measure no
 /// residual, so the ranking is a ranking of predictions.
-fn estimate_note(sum: &Summary) -> Result<String, UserError> {
+fn estimate_note(sum: &Summary) -> PolarsResult<String> {
     // Absent from summaries written before the column existed.
     let estimated = sum
         .b("estimated")

@@ -5,7 +5,7 @@
 use super::*;
 
 /// Runs that ended `merged`: how many, of which designs, and the way out.
-pub(super) fn merged_line(sum: &Summary, order: &[usize]) -> Result<String, UserError> {
+pub(super) fn merged_line(sum: &Summary, order: &[usize]) -> PolarsResult<String> {
     let Ok(column) = sum.0.column("merged") else {
         return Ok(String::new());
     };
@@ -31,7 +31,7 @@ pub(super) fn merged_line(sum: &Summary, order: &[usize]) -> Result<String, User
 }
 
 /// With rolling resistance: the dead band μ_s·l beside the band δ·A_ref.
-pub(super) fn dead_band_line(sum: &Summary, order: &[usize]) -> Result<String, UserError> {
+pub(super) fn dead_band_line(sum: &Summary, order: &[usize]) -> PolarsResult<String> {
     let dead = sum.f("dead_band_m")?;
     if dead.iter().all(Option::is_none) {
         return Ok(String::new());
@@ -86,10 +86,10 @@ type PlaneBands = Vec<(Vec<Option<f64>>, Vec<Option<f64>>)>;
 /// Per balancer plane with weights (a dead band), its dead band and own
 /// settling band per design; empty on a rotor with one plane or a summary
 /// written before the columns.
-fn plane_bands(sum: &Summary) -> Result<PlaneBands, UserError> {
+fn plane_bands(sum: &Summary) -> PolarsResult<PlaneBands> {
     let mut out = Vec::new();
     for p in 0.. {
-        let [.., band, dead] = autobal::decide::plane_summary::column_names(p);
+        let [.., band, dead] = crate::decide::plane_summary::column_names(p);
         if sum.0.column(&dead).is_err() {
             break;
         }
@@ -104,7 +104,7 @@ fn plane_bands(sum: &Summary) -> Result<PlaneBands, UserError> {
 
 /// Whether the weights were solid, said under every ranking: a study that
 /// switched contact off prints numbers for weights that pass through each other.
-pub(super) fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
+pub(super) fn contact_line(summary: &DataFrame, wide: bool) -> PolarsResult<String> {
     let contact = summary.column("contact")?.bool()?;
     let deepest = summary
         .column("max_overlap_fraction")?
@@ -116,7 +116,7 @@ pub(super) fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
         format!(
             "; deepest overlap {:.2} % of the angle at which two weights touch{}",
             100.0 * f,
-            if crate::output::wide() { " (2α)" } else { "" }
+            if wide { " (2α)" } else { "" }
         )
     });
     let off = contact.iter().filter(|c| *c == Some(false)).count();
@@ -147,7 +147,7 @@ pub(super) fn contact_line(summary: &DataFrame) -> Result<String, UserError> {
 /// For a study that sweeps the motor's stall torque: per design, how many
 /// runs reached the operating speed and where the rest were held (the
 /// Sommerfeld effect, docs/realism.md); empty otherwise.
-pub(super) fn passage_table(summary: &DataFrame) -> Result<String, UserError> {
+pub(super) fn passage_table(summary: &DataFrame) -> PolarsResult<String> {
     let Ok(torque) = summary.column("stall_torque") else {
         return Ok(String::new());
     };
