@@ -38,6 +38,15 @@ pub fn toml_message(text: &str, error: &toml::de::Error) -> String {
     }
 }
 
+/// The dotted key a TOML parse error of `text` read as `T` points at
+/// (`balancer.dragg` for an unknown key on that line); `None` when `text`
+/// parses or the error has no place. For callers that report the key apart
+/// from the message (the Python package's `InputError.key`).
+pub fn toml_error_key<T: serde::de::DeserializeOwned>(text: &str) -> Option<String> {
+    let error = toml::from_str::<T>(text).err()?;
+    dotted_key_at(text, error.span()?.start)
+}
+
 /// `T` read from a TOML table by way of its text: serde reads an internally
 /// tagged or flattened table from a buffer that has lost each value's
 /// place, so its errors name no key ("invalid type: sequence, expected a
@@ -154,6 +163,24 @@ pub fn in_user_words(message: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_parse_errors_key_is_the_dotted_key_of_its_line() {
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        #[allow(dead_code)]
+        struct Balancer {
+            drag: f64,
+        }
+        #[derive(serde::Deserialize)]
+        #[allow(dead_code)]
+        struct File {
+            balancer: Balancer,
+        }
+        let key = toml_error_key::<File>("[balancer]\ndrag = 1.0\ndragg = 2.0\n");
+        assert_eq!(key.as_deref(), Some("balancer.dragg"));
+        assert_eq!(toml_error_key::<File>("[balancer]\ndrag = 1.0\n"), None);
+    }
 
     #[test]
     fn rust_type_names_never_reach_the_user() {

@@ -113,6 +113,13 @@ pub fn ranked_table(summary: &DataFrame, layout: Layout) -> PolarsResult<String>
     Ok(table + &wrap(&(parts.legend + &dropped_note + &parts.findings), width) + &parts.passage)
 }
 
+/// The decision's sentences as `study run` prints them, unwrapped: the
+/// verdict on #1, where the other measures disagree, and the
+/// recommendation.
+pub fn decision_text(decision: &StudyDecision) -> String {
+    verdict_line(decision) + &disagreement_line(decision) + &recommendation_line(decision)
+}
+
 /// The ranking's pieces, for the terminal ([`ranked_table`]) and the report.
 pub struct Ranking {
     /// Column headers ("\n" stacks a header on two lines).
