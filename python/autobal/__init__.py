@@ -5,7 +5,7 @@ command), not a subprocess::
 
     import autobal
     run = autobal.simulate("scenes/three_balls.toml")
-    run.t, run.r, run.angles          # NumPy arrays
+    run.t, run.r, run.angles, run.bearing_x  # NumPy arrays
     run.metrics["settling_revs"]  # the same numbers as `study simulate --json`
     study = autobal.run_study("studies/three_balls.toml", threads=2, overwrite=True)
     study.summary, study.decision.text
@@ -129,6 +129,11 @@ class Run:
     """Balancing error ε."""
     angles: np.ndarray
     """Each weight's angle relative to the rotor (rad), one row per weight."""
+    bearing_x: np.ndarray
+    """Each bearing's displacement x (m), one row per bearing in support
+    order: rotors with bearings of their own (two supports); no rows otherwise."""
+    bearing_y: np.ndarray
+    """Each bearing's displacement y (m)."""
     metrics: dict
     """The run's metrics (settling time, residual, bearing orbits where the rotor has bearings…)."""
     metrics_json: str
@@ -140,8 +145,15 @@ def simulate(scene: Source, series: bool = True) -> Run:
     text, name = _text_of(scene, "scene")
     out = _native_call(_native.simulate, text, name, series)
     arrays = {k: np.asarray(out.get(k, []), dtype=np.float64) for k in ("t", "x", "y", "r", "eps")}
-    angles = np.asarray(out.get("psi", []), dtype=np.float64)
-    return Run(angles=angles, metrics=json.loads(out["metrics_json"]), metrics_json=out["metrics_json"], **arrays)
+    rows = {k: np.asarray(out.get(k, []), dtype=np.float64) for k in ("psi", "bearing_x", "bearing_y")}
+    return Run(
+        angles=rows["psi"],
+        bearing_x=rows["bearing_x"],
+        bearing_y=rows["bearing_y"],
+        metrics=json.loads(out["metrics_json"]),
+        metrics_json=out["metrics_json"],
+        **arrays,
+    )
 
 
 @dataclass(frozen=True)

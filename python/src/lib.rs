@@ -57,7 +57,8 @@ fn study_key(error: &StudyError, text: &str) -> Option<String> {
 
 /// Simulate the scene in `text` (`name` in messages): the run's metrics as
 /// the JSON `study simulate --json` prints, and (with `series`) the sampled
-/// time history as lists (t, x, y, r, eps, and one list of angles per weight).
+/// time history as lists (t, x, y, r, eps, one list of angles per weight,
+/// and each bearing's x and y on rotors with bearings of their own).
 #[pyfunction]
 #[pyo3(signature = (text, name, series = true))]
 fn simulate(py: Python<'_>, text: &str, name: &str, series: bool) -> PyResult<Py<PyAny>> {
@@ -83,6 +84,8 @@ fn simulate(py: Python<'_>, text: &str, name: &str, series: bool) -> PyResult<Py
         out.set_item("r", s.r)?;
         out.set_item("eps", s.eps)?;
         out.set_item("psi", s.psi)?;
+        out.set_item("bearing_x", s.bearing_x)?;
+        out.set_item("bearing_y", s.bearing_y)?;
     }
     Ok(out.into_any().unbind())
 }

@@ -52,6 +52,21 @@ def test_a_scene_simulates_bit_for_bit_as_the_command_line(tmp_path):
         assert np.array_equal(getattr(run, name), frame[name].to_numpy()), name
     assert run.angles.shape == (3, len(run.t))
     assert np.array_equal(run.angles[0], frame["psi_0"].to_numpy())
+    assert run.bearing_x.size == 0  # a plane rotor has no bearings of its own
+
+
+def test_a_two_support_rotors_bearing_orbits_are_the_command_lines(tmp_path):
+    scene = ROOT / "scenes" / "two_support_single.toml"
+    run = autobal.simulate(scene)
+    series = tmp_path / "series.parquet"
+    cli = study("simulate", scene, "--series", series, "--json")
+    assert cli.returncode == 0, cli.stderr
+    assert run.metrics_json == cli.stdout.rstrip("\n")
+    frame = pl.read_parquet(series)
+    assert run.bearing_x.shape == (2, len(run.t))
+    for b in range(2):
+        assert np.array_equal(run.bearing_x[b], frame[f"bearing_{b}_x"].to_numpy())
+        assert np.array_equal(run.bearing_y[b], frame[f"bearing_{b}_y"].to_numpy())
 
 
 def test_a_dict_and_a_toml_string_are_the_file(tmp_path):

@@ -426,3 +426,34 @@ fn the_flexible_shaft_is_its_equivalent_two_support_rotor_under_every_effect() {
         assert_same_trajectory(&a, &b, 1e-5, name);
     }
 }
+
+#[test]
+fn a_recorded_series_holds_each_bearings_orbit_as_a_rigid_rotor_moves() {
+    // Supports at z = −l1 and +l2 of a rigid rotor: its centre of mass
+    // (z = 0) lies on the line between them, x = (l2 x₀ + l1 x₁)/(l1 + l2),
+    // at every sample; the plane rotor has no bearings of its own.
+    // The balancer 0.3 from the centre of mass, so that the rotor tilts.
+    let text =
+        decoupled_two_support(1.0, 1.0, 0.1, 0.1).replace("planes = [0.0]", "planes = [0.3]");
+    let series = run(&text).series.expect("recorded");
+    assert_eq!(series.bearing_x.len(), 2);
+    let (l1, l2) = (0.5, 0.75);
+    let mut largest_tilt: f64 = 0.0;
+    for k in 0..series.t.len() {
+        let (x0, x1) = (series.bearing_x[0][k], series.bearing_x[1][k]);
+        let (y0, y1) = (series.bearing_y[0][k], series.bearing_y[1][k]);
+        assert!(
+            (series.x[k] - (l2 * x0 + l1 * x1) / (l1 + l2)).abs() < 1e-15,
+            "sample {k}"
+        );
+        assert!(
+            (series.y[k] - (l2 * y0 + l1 * y1) / (l1 + l2)).abs() < 1e-15,
+            "sample {k}"
+        );
+        largest_tilt = largest_tilt.max((x1 - x0).abs());
+    }
+    // The bearings are not the centre of mass: the rotor tilts.
+    assert!(largest_tilt > 1e-6, "largest tilt {largest_tilt}");
+    let plane = run(&plane(1.0, 1.0, 0.1, 0.1)).series.expect("recorded");
+    assert!(plane.bearing_x.is_empty() && plane.bearing_y.is_empty());
+}

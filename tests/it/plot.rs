@@ -174,6 +174,7 @@ fn unsettled_run_with_circulating_cargo() {
             t.iter().map(|t| 2.0 - 0.11 * t).collect(),
         ],
         t,
+        ..Default::default()
     };
     let metrics: RunMetrics = study_runs(&study_plan(), 1)[3].metrics.clone();
     assert!(!metrics.settled);

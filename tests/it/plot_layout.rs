@@ -333,6 +333,7 @@ fn every_figure_keeps_its_text_inside_and_apart() {
             .map(|j| t.iter().map(|t| f64::from(j) * 0.6 + 0.01 * t).collect())
             .collect(),
         t,
+        ..Default::default()
     };
     let settled = metrics(true, 40.0);
     let run = RunFigure {

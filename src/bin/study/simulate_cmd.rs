@@ -25,7 +25,7 @@ pub struct SimulateArgs {
     /// Print the metrics as one JSON object.
     #[arg(long)]
     json: bool,
-    /// Write the sampled time history (t, x, y, r, ε, ψ_j) to this file:
+    /// Write the sampled time history (t, x, y, r, ε, ψ_j, each bearing's x and y) to this file:
     /// Parquet when it ends in .parquet, CSV otherwise.
     #[arg(long)]
     series: Option<PathBuf>,

@@ -77,6 +77,8 @@ pub struct SettlingObserver<'a> {
     /// The first pair that coincided, and when.
     merged: Option<(usize, usize, f64)>,
     series: Option<Series>,
+    /// Each bearing's maps from rotor coordinates, when a series is recorded.
+    bearing_maps: Vec<[crate::model::rotor::DofVec; 2]>,
     frame: Option<f64>,
     certifier: Option<HoldCertifier<'a>>,
     /// The integrated system's events (rigid contact), which decide whether
@@ -230,8 +232,15 @@ impl<'a> SettlingObserver<'a> {
             merged: None,
             series: record.then(|| Series {
                 psi: vec![Vec::new(); system.cargo().len()],
+                bearing_x: vec![Vec::new(); system.rotor().bearing_maps().len()],
+                bearing_y: vec![Vec::new(); system.rotor().bearing_maps().len()],
                 ..Series::default()
             }),
+            bearing_maps: if record {
+                system.rotor().bearing_maps()
+            } else {
+                Vec::new()
+            },
             frame: None,
             certifier: None,
             events: None,

@@ -1,10 +1,12 @@
 //! The series a run records: the sampled time history of the whirl, the
-//! balancing error and the weights, and the part that records it.
+//! balancing error, the weights and the bearings, and the part that
+//! records it.
 
 use super::{Sample, SettlingObserver};
 use crate::integrate::Flow;
+use crate::model::rotor::DofVec;
 
-/// A sampled time history: t, x, y, r, ε and every ψ_j.
+/// A sampled time history: t, x, y, r, ε, every ψ_j and every bearing's x and y.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Series {
     /// Sample times (s).
@@ -19,6 +21,11 @@ pub struct Series {
     pub eps: Vec<f64>,
     /// Cargo angles relative to the rotor, one vector per cargo (rad).
     pub psi: Vec<Vec<f64>>,
+    /// Each bearing's displacement x (m), one vector per bearing in support
+    /// order: rotors with bearings of their own (two supports), else none.
+    pub bearing_x: Vec<Vec<f64>>,
+    /// Each bearing's displacement y (m).
+    pub bearing_y: Vec<Vec<f64>>,
 }
 
 impl SettlingObserver<'_> {
@@ -30,13 +37,12 @@ impl SettlingObserver<'_> {
         let (t, y) = (s.t, &self.scratch);
         series.t.push(t);
         // The rotating frame integrates (u, v): report inertial (x, y).
-        let (x, yy) = match self.frame {
-            Some(w) => {
-                let (sin, cos) = (w * t).sin_cos();
-                (y[0] * cos - y[1] * sin, y[0] * sin + y[1] * cos)
-            }
-            None => (y[0], y[1]),
+        let turn = self.frame.map(|w| (w * t).sin_cos());
+        let inertial = |u: f64, v: f64| match turn {
+            Some((sin, cos)) => (u * cos - v * sin, u * sin + v * cos),
+            None => (u, v),
         };
+        let (x, yy) = inertial(y[0], y[1]);
         series.x.push(x);
         series.y.push(yy);
         series.r.push(s.r);
@@ -44,6 +50,19 @@ impl SettlingObserver<'_> {
         let lay = self.system.layout();
         for (j, p) in y[lay.head()..lay.nq()].iter().enumerate() {
             series.psi[j].push(*p);
+        }
+        let dof = self.system.rotor().dof();
+        let dot = |g: &DofVec| {
+            g[..dof]
+                .iter()
+                .zip(y.iter())
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+        };
+        for (b, [gu, gv]) in self.bearing_maps.iter().enumerate() {
+            let (bx, by) = inertial(dot(gu), dot(gv));
+            series.bearing_x[b].push(bx);
+            series.bearing_y[b].push(by);
         }
         Flow::Continue
     }

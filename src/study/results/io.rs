@@ -301,6 +301,10 @@ pub fn series_dataframe(series: &crate::metrics::observer::Series) -> PolarsResu
     for (j, psi) in series.psi.iter().enumerate() {
         columns.push(Column::new(format!("psi_{j}").into(), psi.clone()));
     }
+    for (b, (x, y)) in series.bearing_x.iter().zip(&series.bearing_y).enumerate() {
+        columns.push(Column::new(format!("bearing_{b}_x").into(), x.clone()));
+        columns.push(Column::new(format!("bearing_{b}_y").into(), y.clone()));
+    }
     DataFrame::new(series.t.len(), columns)
 }
 
