@@ -34,20 +34,27 @@ def study(*args):
     return subprocess.run([STUDY, *map(str, args)], capture_output=True, text=True)
 
 
+def recorded_both_ways(scene, tmp_path):
+    """The scene run with its time history by the package and by
+    `study simulate --series --json` (a recorded run goes to its horizon, so
+    both print those metrics): the package's run and the command's series,
+    after checking that the metrics are the same text."""
+    run = autobal.simulate(scene)
+    series = tmp_path / "series.parquet"
+    cli = study("simulate", scene, "--series", series, "--json")
+    assert cli.returncode == 0, cli.stderr
+    assert run.metrics_json == cli.stdout.rstrip("\n")
+    return run, pl.read_parquet(series)
+
+
 def test_a_scene_simulates_bit_for_bit_as_the_command_line(tmp_path):
     plain = autobal.simulate(SCENE, series=False)
     cli = study("simulate", SCENE, "--json")
     assert cli.returncode == 0, cli.stderr
     assert plain.metrics_json == cli.stdout.rstrip("\n")
     assert plain.metrics == json.loads(cli.stdout)
-    # With the time history, as `--series` writes it (a recorded run goes
-    # to its horizon, so its metrics are those of `--series --json`).
-    run = autobal.simulate(SCENE)
-    series = tmp_path / "series.parquet"
-    cli = study("simulate", SCENE, "--series", series, "--json")
-    assert cli.returncode == 0, cli.stderr
-    assert run.metrics_json == cli.stdout.rstrip("\n")
-    frame = pl.read_parquet(series)
+    # With the time history, as `--series` writes it.
+    run, frame = recorded_both_ways(SCENE, tmp_path)
     for name in ("t", "x", "y", "r"):
         assert np.array_equal(getattr(run, name), frame[name].to_numpy()), name
     assert run.angles.shape == (3, len(run.t))
@@ -56,13 +63,7 @@ def test_a_scene_simulates_bit_for_bit_as_the_command_line(tmp_path):
 
 
 def test_a_two_support_rotors_bearing_orbits_are_the_command_lines(tmp_path):
-    scene = ROOT / "scenes" / "two_support_single.toml"
-    run = autobal.simulate(scene)
-    series = tmp_path / "series.parquet"
-    cli = study("simulate", scene, "--series", series, "--json")
-    assert cli.returncode == 0, cli.stderr
-    assert run.metrics_json == cli.stdout.rstrip("\n")
-    frame = pl.read_parquet(series)
+    run, frame = recorded_both_ways(ROOT / "scenes" / "two_support_single.toml", tmp_path)
     assert run.bearing_x.shape == (2, len(run.t))
     for b in range(2):
         assert np.array_equal(run.bearing_x[b], frame[f"bearing_{b}_x"].to_numpy())

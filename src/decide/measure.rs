@@ -7,8 +7,8 @@ use crate::stats::paired::{
     Settling, SettlingComparison, compare_settling, compare_settling_by_ranks,
 };
 use crate::stats::paired_measures::{
-    Difference, honest_p, mean_difference_bootstrap, mean_point_difference, paired_mean_difference,
-    quantile_difference, quantile_point_difference, quantile_se_difference, share_difference,
+    Difference, Resampling, honest_p, mean_difference_bootstrap, mean_point_difference,
+    paired_mean_difference, quantile_difference_by, share_difference,
 };
 use crate::study::plan::criterion::{Criterion, Within};
 use crate::study::results::measured_runs::{DesignRuns, Scale};
@@ -86,10 +86,13 @@ impl Criterion {
         rng: &mut R,
     ) -> Option<Difference> {
         let look = spread != Spread::Interval;
-        let quantile = |x: &[f64], y: &[f64], q: f64, paired: bool, rng: &mut R| match spread {
-            Spread::Interval => quantile_difference(x, y, q, paired, level, rng),
-            Spread::Look => quantile_se_difference(x, y, q, paired, level, rng),
-            Spread::Point => quantile_point_difference(x, y, q, paired, level),
+        let resampling = match spread {
+            Spread::Interval => Resampling::Interval,
+            Spread::Look => Resampling::StandardError,
+            Spread::Point => Resampling::PointOnly,
+        };
+        let quantile = |x: &[f64], y: &[f64], q: f64, paired: bool, rng: &mut R| {
+            quantile_difference_by(x, y, q, (paired, level), resampling, rng)
         };
         match self {
             Criterion::Median if paired => {

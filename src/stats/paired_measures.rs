@@ -140,34 +140,63 @@ pub fn quantile_difference(
     level: f64,
     rng: &mut impl Rng,
 ) -> Option<Difference> {
-    let at = |v: &mut [f64]| quantile_in_place(v, q);
-    let (qa, qb) = statistics_of(a, b, &at, paired, level)?;
-    let diffs = QuantileResampler::new(a, b, q, paired).differences(CI_RESAMPLES, rng);
-    Some(percentile_difference(
-        (qa, qb),
-        diffs,
-        level,
-        (a.len(), b.len()),
-        paired,
-    ))
+    quantile_difference_by(a, b, q, (paired, level), Resampling::Interval, rng)
 }
 
-/// The q-quantile of a and of b and their difference, with a normal
-/// interval and p-value from the bootstrap standard error of the difference
-/// over [`STD_ERROR_RESAMPLES`] resamples: a tenth of an interval's
-/// resampling, for callers that need a spread and not the tails (a race's
-/// look). The p-value keeps [`exact_floor`]. None as [`quantile_difference`].
-pub fn quantile_se_difference(
+/// How a quantile difference measures its spread.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Resampling {
+    /// A percentile bootstrap of [`CI_RESAMPLES`] resamples: its interval
+    /// and its p-value ([`quantile_difference`]).
+    Interval,
+    /// A normal interval and p-value from the bootstrap standard error over
+    /// [`STD_ERROR_RESAMPLES`] resamples: a tenth of an interval's
+    /// resampling, for callers that need a spread and not the tails (a
+    /// race's look). The p-value keeps [`exact_floor`].
+    StandardError,
+    /// None: the point estimates alone (an unbounded interval, p = 1),
+    /// drawing no randomness, for a caller that checks them before paying
+    /// for a spread.
+    PointOnly,
+}
+
+/// The q-quantile of a and of b and their difference, its spread measured
+/// as `resampling` says, `paired` and at `level` as [`quantile_difference`].
+pub fn quantile_difference_by(
     a: &[f64],
     b: &[f64],
     q: f64,
-    paired: bool,
-    level: f64,
+    (paired, level): (bool, f64),
+    resampling: Resampling,
     rng: &mut impl Rng,
 ) -> Option<Difference> {
     let at = |v: &mut [f64]| quantile_in_place(v, q);
     let (qa, qb) = statistics_of(a, b, &at, paired, level)?;
-    let diffs = QuantileResampler::new(a, b, q, paired).differences(STD_ERROR_RESAMPLES, rng);
+    let sizes = (a.len(), b.len());
+    let resampler = || QuantileResampler::new(a, b, q, paired);
+    Some(match resampling {
+        Resampling::Interval => {
+            let diffs = resampler().differences(CI_RESAMPLES, rng);
+            percentile_difference((qa, qb), diffs, level, sizes, paired)
+        }
+        Resampling::StandardError => {
+            let diffs = resampler().differences(STD_ERROR_RESAMPLES, rng);
+            normal_difference((qa, qb), &diffs, level, sizes, paired)
+        }
+        Resampling::PointOnly => point_difference((qa, qb)),
+    })
+}
+
+/// The difference qa − qb with a normal interval and p-value from the
+/// standard deviation of the resampled `diffs`, never below
+/// [`exact_floor`] for samples of `sizes`.
+fn normal_difference(
+    (qa, qb): (f64, f64),
+    diffs: &[f64],
+    level: f64,
+    sizes: (usize, usize),
+    paired: bool,
+) -> Difference {
     let n = diffs.len() as f64;
     let mean = diffs.iter().sum::<f64>() / n;
     // A resample whose quantile is infinite leaves the spread unbounded.
@@ -183,37 +212,23 @@ pub fn quantile_se_difference(
     } else {
         0.0
     };
-    Some(Difference {
+    Difference {
         a: qa,
         b: qb,
         scale: qa.abs().max(qb.abs()),
         difference: d,
         interval: (d - z * se, d + z * se),
-        p_value: honest_p(p.max(exact_floor(a.len(), b.len(), paired))),
+        p_value: honest_p(p.max(exact_floor(sizes.0, sizes.1, paired))),
         test: if paired {
             "bootstrap_se_paired"
         } else {
             "bootstrap_se"
         },
-    })
-}
-
-/// The q-quantile of a and of b and their difference, with no spread
-/// measured (an unbounded interval, p = 1) and no randomness drawn: the
-/// point estimate a caller checks before paying for a spread.
-pub fn quantile_point_difference(
-    a: &[f64],
-    b: &[f64],
-    q: f64,
-    paired: bool,
-    level: f64,
-) -> Option<Difference> {
-    let at = |v: &mut [f64]| quantile_in_place(v, q);
-    statistics_of(a, b, &at, paired, level).map(point_difference)
+    }
 }
 
 /// The mean of a and of b and their difference, with no spread measured
-/// (as [`quantile_point_difference`]).
+/// ([`Resampling::PointOnly`]).
 pub fn mean_point_difference(a: &[f64], b: &[f64], level: f64) -> Option<Difference> {
     let mean = |v: &mut [f64]| v.iter().sum::<f64>() / v.len() as f64;
     statistics_of(a, b, &mean, false, level).map(point_difference)
@@ -561,7 +576,15 @@ mod tests {
             .map(|(i, x)| x - 3.0 + ((i * 31) % 13) as f64 / 4.0)
             .collect();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
-        let se = quantile_se_difference(&a, &b, 0.9, true, 0.95, &mut rng).unwrap();
+        let se = quantile_difference_by(
+            &a,
+            &b,
+            0.9,
+            (true, 0.95),
+            Resampling::StandardError,
+            &mut rng,
+        )
+        .unwrap();
         let full = quantile_difference(&a, &b, 0.9, true, 0.95, &mut rng).unwrap();
         assert_eq!(se.difference, full.difference);
         let (w_se, w_full) = (
@@ -583,7 +606,15 @@ mod tests {
             .collect();
         let b: Vec<f64> = (0..30).map(|i| i as f64 + 1.0).collect();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
-        let d = quantile_se_difference(&a, &b, 0.5, true, 0.95, &mut rng).unwrap();
+        let d = quantile_difference_by(
+            &a,
+            &b,
+            0.5,
+            (true, 0.95),
+            Resampling::StandardError,
+            &mut rng,
+        )
+        .unwrap();
         assert!(d.interval.0 == f64::NEG_INFINITY && d.interval.1 == f64::INFINITY);
         assert_eq!(d.p_value, 1.0);
     }
