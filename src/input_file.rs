@@ -44,7 +44,26 @@ pub fn toml_message(text: &str, error: &toml::de::Error) -> String {
 /// from the message (the Python package's `InputError.key`).
 pub fn toml_error_key<T: serde::de::DeserializeOwned>(text: &str) -> Option<String> {
     let error = toml::from_str::<T>(text).err()?;
-    dotted_key_at(text, error.span()?.start)
+    let at = error.span()?.start;
+    dotted_key_at(text, at).or_else(|| missing_key_at(text, at, error.message()))
+}
+
+/// The dotted key a "missing field `x`" error means when it points at its
+/// table's header line (`[rotor]` and `kx` → `rotor.kx`).
+fn missing_key_at(text: &str, offset: usize, message: &str) -> Option<String> {
+    let field = message.split_once("missing field `")?.1.split('`').next()?;
+    let start = text
+        .get(..offset.min(text.len()))?
+        .rfind('\n')
+        .map_or(0, |i| i + 1);
+    let header = text[start..].lines().next()?.trim();
+    let table = header
+        .strip_prefix('[')?
+        .trim_start_matches('[')
+        .split(']')
+        .next()?
+        .trim();
+    Some(format!("{}.{field}", table.trim_matches('"')))
 }
 
 /// `T` read from a TOML table by way of its text: serde reads an internally
@@ -179,6 +198,9 @@ mod tests {
         }
         let key = toml_error_key::<File>("[balancer]\ndrag = 1.0\ndragg = 2.0\n");
         assert_eq!(key.as_deref(), Some("balancer.dragg"));
+        // A missing key is pointed at by its table's header.
+        let key = toml_error_key::<File>("[balancer]\n");
+        assert_eq!(key.as_deref(), Some("balancer.drag"));
         assert_eq!(toml_error_key::<File>("[balancer]\ndrag = 1.0\n"), None);
     }
 

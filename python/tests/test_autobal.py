@@ -96,6 +96,11 @@ def test_a_bad_key_raises_naming_the_key(tmp_path):
     cli = study("simulate", path)
     assert cli.returncode == 2
     assert cli.stderr.strip() == f"error: {caught.value}"
+    # A key left out: named by its table and its name.
+    rotor = {k: v for k, v in MAIN_JOB_DESIGN["rotor"].items() if k != "kx"}
+    with pytest.raises(autobal.InputError) as caught:
+        autobal.simulate(dict(MAIN_JOB_DESIGN, rotor=rotor))
+    assert caught.value.key == "rotor.kx", str(caught.value)
     with pytest.raises(autobal.InputError):
         autobal.simulate(tmp_path / "missing.toml")
 
