@@ -203,6 +203,12 @@ impl<'a> SettlingObserver<'a> {
         let u = reference_unbalance(system);
         let weights: f64 = system.cargo().iter().map(|c| c.unbalance()).sum();
         let start_scale = if u > 0.0 { a * (u + weights) / u } else { a };
+        // Only a recorded series reads the bearings.
+        let bearing_maps = if record {
+            system.rotor().bearing_maps()
+        } else {
+            Vec::new()
+        };
         let balancing = BalancingGauge::new(system, reference_unbalance(system));
         SettlingObserver {
             system,
@@ -232,15 +238,11 @@ impl<'a> SettlingObserver<'a> {
             merged: None,
             series: record.then(|| Series {
                 psi: vec![Vec::new(); system.cargo().len()],
-                bearing_x: vec![Vec::new(); system.rotor().bearing_maps().len()],
-                bearing_y: vec![Vec::new(); system.rotor().bearing_maps().len()],
+                bearing_x: vec![Vec::new(); bearing_maps.len()],
+                bearing_y: vec![Vec::new(); bearing_maps.len()],
                 ..Series::default()
             }),
-            bearing_maps: if record {
-                system.rotor().bearing_maps()
-            } else {
-                Vec::new()
-            },
+            bearing_maps,
             frame: None,
             certifier: None,
             events: None,
