@@ -4,7 +4,9 @@
 //! implicit method. A [`Stepper`] supplies only the method itself.
 
 use super::cost::{CostTrial, StallWindow, TRIAL_STEPS, TrialWindow};
-use super::events::{EventFlow, crossed, first_root, lowest, may_dip};
+use super::events::{
+    EventFlow, crossed, first_root, lowest, may_dip, may_dip_unevenly, scan_for_dip,
+};
 use super::norm::check_step;
 use super::stepper::{Stepper, Trial};
 use super::stiffness::{StiffnessWatch, Verdict};
@@ -153,6 +155,12 @@ where
                 } else if has_rates
                     && may_dip((g_now[k], g_end[k]), (r_now[k], r_end[k]), h)
                     && let (bottom, low) = lowest(&mut g_at, t_prev, t)
+                    && low <= 0.0
+                {
+                    (bottom, low)
+                } else if has_rates
+                    && may_dip_unevenly((g_now[k], g_end[k]), (r_now[k], r_end[k]), h)
+                    && let (bottom, low) = scan_for_dip(&mut g_at, t_prev, t)
                     && low <= 0.0
                 {
                     (bottom, low)

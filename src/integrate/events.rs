@@ -93,6 +93,41 @@ pub(crate) fn may_dip(g: (f64, f64), r: (f64, f64), h: f64) -> bool {
         && g.0.min(g.1) <= 2.0 * h * r.0.abs().max(r.1)
 }
 
+/// Whether g, falling at both of the step's ends (rates `r0` < 0 and
+/// `r1` ≤ 0) yet higher at its end than at its start, may have dipped below
+/// zero in between: it rose somewhere, so it is not monotone, and from
+/// within reach of zero (its start within `h`·|r0| of it) it may have gone
+/// under first. The step's ends disagree with a smooth fall there (an
+/// explicit method's error in a gap, far below the tolerance on the angles
+/// it is the difference of, after an impact left a pair closing at a
+/// picoradian), so the dense output is scanned rather than searched as one
+/// valley.
+pub(crate) fn may_dip_unevenly(g: (f64, f64), r: (f64, f64), h: f64) -> bool {
+    r.0 < 0.0 && r.1 <= 0.0 && g.0 > 0.0 && g.1 > g.0 && g.0 <= h * r.0.abs()
+}
+
+/// Interior points at which a step's dense output is scanned for an uneven
+/// dip: a dip seen so far spanned a third of its step.
+const DIP_SCAN_POINTS: usize = 16;
+
+/// The first point (t, g) of an even scan of g over (a, b) at or below
+/// zero; else the bottom of the valley around the scan's lowest point
+/// ([`lowest`] between its neighbours).
+pub(crate) fn scan_for_dip(mut g: impl FnMut(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
+    let at = |i: usize| a + (b - a) * i as f64 / (DIP_SCAN_POINTS + 1) as f64;
+    let mut low = (0, f64::INFINITY);
+    for i in 1..=DIP_SCAN_POINTS {
+        let value = g(at(i));
+        if value <= 0.0 {
+            return (at(i), value);
+        }
+        if value < low.1 {
+            low = (i, value);
+        }
+    }
+    lowest(g, at(low.0 - 1), at(low.0 + 1))
+}
+
 /// Golden-section steps of the search for a dip: the bracket shrinks to
 /// 0.618⁴⁰ ≈ 4·10⁻⁹ of the step.
 const DIP_ITERATIONS: usize = 40;
@@ -191,6 +226,28 @@ mod tests {
         let root = first_root(g, (0.0, -0.5), (2.0, g(2.0)));
         assert!(within(root, 0.5f64.powf(0.2)), "{root}");
         assert!(g(root) >= 0.0, "the far side of the crossing");
+    }
+
+    #[test]
+    fn an_uneven_dip_is_scanned_for() {
+        // Falls at both ends, ends higher than it starts: a dip below zero
+        // near the start, g = 1e-12 − t + 3t² − 1.9t³ on [0, 1] (rates −1 and
+        // −0.7; below zero from about 1e-12 to 0.478).
+        let g = |t: f64| 1e-12 - t + 3.0 * t * t - 1.9 * t * t * t;
+        let dg = |t: f64| -1.0 + 6.0 * t - 5.7 * t * t;
+        assert!(g(1.0) > g(0.0) && dg(1.0) < 0.0);
+        assert!(may_dip_unevenly((g(0.0), g(1.0)), (dg(0.0), dg(1.0)), 1.0));
+        assert!(!may_dip((g(0.0), g(1.0)), (dg(0.0), dg(1.0)), 1.0));
+        let (t, low) = scan_for_dip(g, 0.0, 1.0);
+        assert!(low <= 0.0 && t > 0.0 && t < 0.478, "{t} {low}");
+        // A monotone fall that stays above zero: no uneven dip to seek.
+        assert!(!may_dip_unevenly((1.0, 0.5), (-1.0, -0.1), 1.0));
+        // Rising at the end: the unimodal search's case, not this one.
+        assert!(!may_dip_unevenly((1e-12, 0.5), (-1.0, 0.1), 1.0));
+        // A shallow valley between scan points is found by the refinement.
+        let narrow = |t: f64| (t - 0.5).abs() - 1e-3;
+        let (t, low) = scan_for_dip(narrow, 0.0, 1.0);
+        assert!(low <= 0.0 && (t - 0.5).abs() < 1e-3, "{t} {low}");
     }
 
     #[test]

@@ -70,7 +70,9 @@ fn the_peer_design_settles_run_by_run_as_the_rigid_limit_does() {
 /// sides and the certified hold's included): a count, not a time, so a
 /// change that makes rigid runs costlier shows here on any machine.
 /// Measured when written: 2 940 per run on these 60 runs (3 248 on 1 000;
-/// the penalty model takes 3 800 there, contact off 2 740).
+/// the penalty model takes 3 800 there, contact off 2 740); 2 819 since a
+/// clustered start settles its links once instead of relinking them for 64
+/// rounds.
 #[test]
 fn the_rigid_peer_design_costs_no_more_rhs_calls_per_run_than_measured() {
     let metrics = runs(&peer(1e-6));
@@ -83,4 +85,4 @@ fn the_rigid_peer_design_costs_no_more_rhs_calls_per_run_than_measured() {
 }
 
 /// See [`the_rigid_peer_design_costs_no_more_rhs_calls_per_run_than_measured`].
-const MEASURED_RHS_PER_RUN: f64 = 2940.0;
+const MEASURED_RHS_PER_RUN: f64 = 2819.0;

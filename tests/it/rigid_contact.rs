@@ -15,7 +15,9 @@
 //! of two close weights read as overlapping; a touching pair at rest was
 //! left open at the start).
 
-use autobal::integrate::{Flow, Method, SolverOptions, Status, Step, StepObserver, solve};
+use autobal::integrate::{
+    Flow, Method, OdeSystem, SolverOptions, Status, Step, StepObserver, solve,
+};
 use autobal::model::cargo::Cargo;
 use autobal::model::effect::contact::{ContactModel, ContactSpec};
 use autobal::model::effect::{Effect, EffectContext, Effects, Forces};
@@ -537,6 +539,22 @@ fn a_dead_impact_on_a_light_rotor_keeps_momentum_and_loses_the_closed_form_energ
     }
 }
 
+/// A constant torque on each weight.
+#[derive(Debug)]
+struct Torques(Vec<f64>);
+
+impl Effect for Torques {
+    fn name(&self) -> &'static str {
+        "torques"
+    }
+
+    fn apply(&self, _ctx: &EffectContext<'_>, forces: &mut Forces<'_>) {
+        for (q, torque) in forces.cargo.iter_mut().zip(&self.0) {
+            *q += torque;
+        }
+    }
+}
+
 /// A torque −T sin(Ωt) on the weight ahead only.
 #[derive(Debug)]
 struct PushBack {
@@ -860,5 +878,167 @@ fn a_clustered_settling_run_never_overlaps_with_rigid_contact() {
         penalty < -1e-6,
         "the penalty contact overlapped by only {} rad",
         -penalty
+    );
+}
+
+/// The linked pairs of the system's current mode, by the weight behind
+/// each (pairs (j, j + 1) of a chain in weight order).
+fn linked_pairs(system: &RotatingSystem) -> Vec<usize> {
+    let mode = system.rigid().mode();
+    let clusters = mode.clusters();
+    let mut linked: Vec<usize> = (0..clusters.len())
+        .flat_map(|c| {
+            let members = clusters.members(c).to_vec();
+            members.windows(2).map(|w| w[0]).collect::<Vec<_>>()
+        })
+        .collect();
+    linked.sort_unstable();
+    linked
+}
+
+/// The contact problem of a chain at rest, solved independently: with the
+/// pairs of `linked` held (relative acceleration zero) and the dense mass
+/// matrix, M q̈ = f + Σ λ_k d_k, d_k = +1 on weight k + 1 and −1 on weight
+/// k. Returns each held pair's λ (positive pressing) and each pair's
+/// relative acceleration ψ̈_{k+1} − ψ̈_k.
+fn held_chain(m: &[Vec<f64>], f: &[f64], chain: usize, linked: &[usize]) -> (Vec<f64>, Vec<f64>) {
+    let (nq, nl) = (m.len(), linked.len());
+    // The saddle-point system [M −Dᵀ; D 0] [q̈; λ] = [f; 0].
+    let mut kkt = vec![vec![0.0; nq + nl]; nq + nl];
+    let mut rhs = vec![0.0; nq + nl];
+    for i in 0..nq {
+        kkt[i][..nq].copy_from_slice(&m[i]);
+        rhs[i] = f[i];
+    }
+    for (l, &k) in linked.iter().enumerate() {
+        let (behind, ahead) = (2 + k, 2 + k + 1);
+        kkt[ahead][nq + l] = -1.0;
+        kkt[behind][nq + l] = 1.0;
+        kkt[nq + l][ahead] = 1.0;
+        kkt[nq + l][behind] = -1.0;
+    }
+    let x = dense_solve(&kkt, &rhs);
+    let relative = (0..chain - 1).map(|k| x[2 + k + 1] - x[2 + k]).collect();
+    (x[nq..].to_vec(), relative)
+}
+
+/// A chain of five touching weights at rest relative to each other, on a
+/// light rotor that is displaced and moving, draw after draw: the mode
+/// rigid contact settles on (links made at touching, then the pulling ones
+/// opened one at a time and pressed ones relinked) is the one solution of
+/// the chain's contact problem — every held pair pressing, every open pair
+/// parting — found here by trying all 16 subsets of the chain's links with
+/// a dense mass matrix. The problem's matrix D M⁻¹ Dᵀ is positive definite,
+/// so exactly one subset qualifies; opening links one at a time must reach
+/// it, not a mode in which a pair it opened closes again. The same state
+/// met at an event (every pair open, the chain touching at rest) reaches
+/// the same mode from the other side. Fails before least-index pivoting:
+/// the start relinked every opened pair round after round and ended on the
+/// greedy mode of its last round ([3] for [1, 2, 3] at draw 1).
+#[test]
+fn a_chain_parting_at_once_takes_the_one_mode_the_contact_problem_allows() {
+    use rand::{RngExt, SeedableRng};
+    let chain = 5;
+    let rotor_mass = 0.05;
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(20261129);
+    let (mut mixed, mut split, mut unlinked, mut undecided) = (0, 0, 0, 0);
+    let draws = 300;
+    for draw in 0..draws {
+        let masses: Vec<f64> = (0..chain).map(|_| rng.random_range(0.005..0.03)).collect();
+        let rigid = scene(rotor_mass, 1e3, &masses, contact(ContactModel::Rigid, 0.0));
+        let free_scene = Scene {
+            effects: Effects {
+                contact: Some(ContactSpec {
+                    enabled: false,
+                    ..Default::default()
+                }),
+                ..Default::default()
+            },
+            ..rigid.clone()
+        };
+        let cargo = rigid.cargoes().unwrap();
+        // A torque of its own on each weight (a stand-in for uneven drag
+        // or rolling resistance), so that the chain may split anywhere.
+        let torques: Vec<f64> = (0..chain).map(|_| rng.random_range(-0.05..0.05)).collect();
+        let push = || Box::new(Torques(torques.clone()));
+        let system = RotatingSystem::new(&rigid).unwrap().with_effect(push());
+        let free = RotatingSystem::new(&free_scene)
+            .unwrap()
+            .with_effect(push());
+        let nq = system.coordinates();
+        let mut y = vec![0.0; 2 * nq];
+        y[0] = rng.random_range(-1e-2..1e-2);
+        y[1] = rng.random_range(-1e-2..1e-2);
+        let first = rng.random_range(0.0..2.0 * PI);
+        for j in 0..chain {
+            y[psi(j)] = first + j as f64 * touching();
+        }
+        y[nq] = rng.random_range(-0.1..0.1);
+        y[nq + 1] = rng.random_range(-0.1..0.1);
+        let common = rng.random_range(-1.0..1.0);
+        for j in 0..chain {
+            y[rate(chain, j)] = common;
+        }
+        let state = y.clone();
+        rigid_contact::start(&system, 0.0, &mut y);
+        let chosen = linked_pairs(&system);
+        // The same state met at an event: the weights start apart, and the
+        // chain then touches at rest (what a parting chain leaves).
+        let met = RotatingSystem::new(&rigid).unwrap().with_effect(push());
+        let mut apart = state.clone();
+        for j in 0..chain {
+            apart[psi(j)] += 0.05 * j as f64;
+        }
+        rigid_contact::start(&met, 0.0, &mut apart);
+        assert!(!met.rigid().mode().any_linked());
+        let mut at_event = state.clone();
+        rigid_contact::handle(&met, 0.0, &mut at_event, 0, true);
+        assert_eq!(linked_pairs(&met), chosen, "draw {draw}: start and event");
+        // f = M q̈ of the same state without contact.
+        let mut dydt = vec![0.0; 2 * nq];
+        free.rhs(0.0, &state, &mut dydt);
+        let m = mass_matrix(rotor_mass, &cargo, &state);
+        let f = times(&m, &dydt[nq..]);
+        // λ_tol of the system (1e-9 · max I ω²) and a matching slack on
+        // the relative accelerations (λ_tol over the lightest inertia).
+        let inertias: Vec<f64> = cargo.iter().map(Cargo::inertia).collect();
+        let largest = inertias.iter().copied().fold(0.0, f64::max);
+        let lightest = inertias.iter().copied().fold(f64::INFINITY, f64::min);
+        let pull_tol = PULL_TOLERANCE * largest * OMEGA * OMEGA;
+        let slack = pull_tol / lightest;
+        let solutions: Vec<Vec<usize>> = (0u32..1 << (chain - 1))
+            .map(|bits| (0..chain - 1).filter(|k| bits >> k & 1 == 1).collect())
+            .filter(|held: &Vec<usize>| {
+                let (lambda, relative) = held_chain(&m, &f, chain, held);
+                lambda.iter().all(|&l| l > -pull_tol)
+                    && (0..chain - 1)
+                        .filter(|k| !held.contains(k))
+                        .all(|k| relative[k] >= -slack)
+            })
+            .collect();
+        if solutions.len() != 1 {
+            // A λ or an acceleration within the tolerance of zero: two
+            // subsets qualify to rounding; the draw decides nothing.
+            undecided += 1;
+            continue;
+        }
+        assert_eq!(
+            chosen, solutions[0],
+            "draw {draw}: masses {masses:?}, state {state:?}"
+        );
+        mixed += usize::from(!chosen.is_empty() && chosen.len() < chain - 1);
+        let (lowest, highest) = (chosen.first(), chosen.last());
+        split += usize::from(
+            lowest.is_some_and(|&lo| highest.is_some_and(|&hi| hi - lo + 1 > chosen.len())),
+        );
+        unlinked += usize::from(chosen.is_empty());
+    }
+    eprintln!(
+        "{draws} draws: {mixed} partly linked ({split} split into several clusters), {unlinked} all open, {undecided} undecided"
+    );
+    assert!(undecided <= draws / 100, "{undecided} undecided draws");
+    assert!(
+        mixed >= draws / 10 && split >= draws / 20,
+        "{mixed} partly linked, {split} split"
     );
 }

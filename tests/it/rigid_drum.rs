@@ -126,10 +126,11 @@ fn the_drum_answers_in_distribution_with_rigid_contact_as_with_penalty() {
             lr.p_value
         );
         assert!(ks.p_value > 0.01, "design {design}: KS p {}", ks.p_value);
-        // Within 1e-6 rad (1.2e-5 of 2α): chains of touching balls that
-        // part at once can dip that far within a step (docs/model.md).
+        // Within 1e-11 rad (1.2e-10 of 2α), the rounding of a gap between
+        // angles of hundreds of radians: a graze pressed by the chain
+        // behind, or a dip that a step's ends hid, once left 1e-7 rad.
         assert!(
-            overlap(r) >= -1e-6,
+            overlap(r) >= -1e-11,
             "design {design}: rigid overlap {}",
             overlap(r)
         );
@@ -142,7 +143,8 @@ fn the_drum_answers_in_distribution_with_rigid_contact_as_with_penalty() {
 
 /// RHS calls per run of the drum with rigid contact at 3 samples per
 /// design (the golden files' runs): a count, not a time. Measured when
-/// written: 57 495 per run.
+/// written: 57 495 per run; 58 440 since a graze pressed by the chain
+/// behind links and a dip hidden by a step's ends is found (each an event).
 #[test]
 fn the_rigid_drum_costs_no_more_rhs_calls_per_run_than_measured() {
     let rigid: Vec<RunMetrics> = runs(&drum(3, ContactModel::Rigid)).concat();
@@ -151,7 +153,7 @@ fn the_rigid_drum_costs_no_more_rhs_calls_per_run_than_measured() {
     assert!(
         rigid
             .iter()
-            .all(|m| m.min_gap_rad.unwrap() >= -1e-6 && m.method == "dp5")
+            .all(|m| m.min_gap_rad.unwrap() >= -1e-11 && m.method == "dp5")
     );
     assert!(
         per_run <= 1.02 * MEASURED_RHS_PER_RUN,
@@ -160,4 +162,4 @@ fn the_rigid_drum_costs_no_more_rhs_calls_per_run_than_measured() {
 }
 
 /// See [`the_rigid_drum_costs_no_more_rhs_calls_per_run_than_measured`].
-const MEASURED_RHS_PER_RUN: f64 = 57495.0;
+const MEASURED_RHS_PER_RUN: f64 = 58440.0;

@@ -254,6 +254,15 @@ impl Mode {
             .is_some_and(|(at, state)| *at == t && state[..] == *y)
     }
 
+    /// Whether pair `k`'s ring has an open pair other than `k` (so that
+    /// linking `k` leaves the ring a place to start its clusters).
+    fn open_elsewhere_in_ring(&self, k: usize) -> bool {
+        let ring = self.ring_pairs.partition_point(|&p| p <= k) - 1;
+        let ring_first = self.ring_pairs[ring];
+        let ring_len = self.rings[ring].len();
+        (ring_first..ring_first + ring_len).any(|p| p != k && !self.linked[p])
+    }
+
     /// Rebuild the clusters from the links (after an event).
     fn rebuild(&mut self, weights: usize) {
         self.torques_at = None;
