@@ -191,10 +191,21 @@ fn decision_json(d: &StudyDecision) -> serde_json::Value {
     let recommendation = match &d.recommendation {
         Recommendation::Build {
             design,
+            first,
+            indistinguishable,
+            tie_break,
             part,
             pareto,
             ..
-        } => json!({"kind": "build", "design_id": design, "part": part, "pareto": pareto}),
+        } => json!({
+            "kind": "build",
+            "design_id": design,
+            "first": first,
+            "indistinguishable": indistinguishable,
+            "tie_break": tie_break.name(),
+            "part": part,
+            "pareto": pareto,
+        }),
         Recommendation::NoneBalances => json!({"kind": "none_balances"}),
         Recommendation::NoDesigns => json!({"kind": "no_designs"}),
     };

@@ -13,6 +13,7 @@
 use crate::decide::verdict::{Edge, Favours, Shortfall, edges, favoured, shortfalls};
 use crate::stats::paired_measures::Difference;
 use crate::study::plan::criterion::Criterion;
+use crate::study::plan::tie_break::{Candidate, TieBreak, choose};
 use crate::study::results::summary_columns::SummaryColumns;
 use polars::prelude::{DataFrame, PolarsResult};
 
@@ -119,8 +120,20 @@ pub struct Disagreement {
 pub enum Recommendation {
     /// Build this design.
     Build {
-        /// Its id.
+        /// Its id: #1, or the tie-break's choice among the designs the
+        /// data cannot tell from #1.
         design: u32,
+        /// #1 by the point estimate of the criterion.
+        first: u32,
+        /// The designs the part was chosen from, in rank order: #1 and every
+        /// design that balances and is not shown worse than #1 at α (and did
+        /// not leave the race). One design: no tie to break.
+        indistinguishable: Vec<u32>,
+        /// The rule that chose among them.
+        tie_break: TieBreak,
+        /// The part's risk of not settling: runs that did not settle, its
+        /// runs, and the 95 % Wilson upper bound on the share.
+        unsettled_risk: Option<(u64, u64, f64)>,
         /// The part in an engineer's terms (count, diameter, mass, race, drag),
         /// where the summary carries the dimensions.
         part: Option<String>,
@@ -155,6 +168,8 @@ pub struct StudyDecision {
     pub runs_per_design: u64,
     /// The designs in rank order.
     pub ranked: Vec<RankedDesign>,
+    /// How the part is chosen among indistinguishable designs (`tie_break`).
+    pub tie_break: TieBreak,
     /// The verdict on #1.
     pub crown: Crown,
     /// Designs better than #1 on another measure.
@@ -233,7 +248,18 @@ impl StudyDecision {
             .unwrap_or(0);
         let crown = crown(&c, &ranked)?;
         let disagreements = disagreements(&c, &ranked, criterion, alpha)?;
-        let recommendation = recommendation(&c, &ranked)?;
+        // Summaries written before the tie-break kept #1 as the part.
+        let tie_break = match summary.column("tie_break") {
+            Ok(_) => c
+                .s("tie_break")?
+                .into_iter()
+                .flatten()
+                .next()
+                .and_then(|t| TieBreak::parse(&t))
+                .unwrap_or_default(),
+            Err(_) => TieBreak::First,
+        };
+        let recommendation = recommendation(&c, &ranked, tie_break)?;
         Ok(StudyDecision {
             criterion,
             alpha,
@@ -241,6 +267,7 @@ impl StudyDecision {
             paired,
             runs_per_design,
             ranked,
+            tie_break,
             crown,
             disagreements,
             recommendation,
@@ -396,42 +423,125 @@ fn plane_parts(c: &SummaryColumns, i: usize) -> PolarsResult<Option<String>> {
     })
 }
 
-/// The recommendation: #1 with its part, cautions and edges, or none.
-fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Recommendation> {
+/// The part of summary row `i` in an engineer's terms (count, diameter,
+/// mass, race, drag), per plane where the planes differ; `None` where the
+/// summary lacks the dimensions (written before those columns).
+fn part_of(c: &SummaryColumns, i: usize) -> PolarsResult<Option<String>> {
+    if let Some(parts) = plane_parts(c, i)? {
+        return Ok(Some(parts));
+    }
+    let kind = c.s("kind")?;
+    let n = c.u32s("n")?;
+    let (rho, drag) = (c.f("rho")?, c.f("drag")?);
+    let (race, mass) = (c.f_or_none("race_radius")?, c.f_or_none("weight_mass")?);
+    let (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) =
+        (&kind[i], n[i], rho[i], race[i], mass[i], drag[i])
+    else {
+        return Ok(None);
+    };
+    let length = c.f_or_none("roller_height")?[i];
+    let part = crate::study::plan::design::part_text(k, n, (r, race), m, b, length);
+    let planes = balancer_planes(c, i)?;
+    Ok(Some(if planes > 1 {
+        format!("{part}, in each of {planes} planes")
+    } else {
+        part
+    }))
+}
+
+/// Balancer planes of row `i` holding the one design (1 without the column).
+fn balancer_planes(c: &SummaryColumns, i: usize) -> PolarsResult<u32> {
+    Ok(match c.0.column("balancer_planes") {
+        Ok(_) => c.u32s("balancer_planes")?[i].unwrap_or(1),
+        Err(_) => 1,
+    })
+}
+
+/// What the tie-break compares of summary row `i`: the total balancer mass
+/// and weight count over every plane (per-plane designs summed).
+fn candidate(c: &SummaryColumns, d: &RankedDesign, rank: usize) -> PolarsResult<Candidate> {
+    let i = d.row;
+    let mut mass = Some(0.0);
+    let mut weights = 0;
+    let mut p = 0;
+    while c.0.column(&format!("n_plane{p}")).is_ok() {
+        let n = c.u32s(&format!("n_plane{p}"))?[i].unwrap_or(0);
+        let m = c.f_or_none(&format!("weight_mass_plane{p}"))?[i];
+        mass = mass.zip(m).map(|(sum, m)| sum + f64::from(n) * m);
+        weights += n;
+        p += 1;
+    }
+    if p == 0 {
+        let n = c.u32s("n")?[i].unwrap_or(0);
+        let planes = balancer_planes(c, i)?;
+        weights = n * planes;
+        mass = c.f_or_none("weight_mass")?[i].map(|m| f64::from(weights) * m);
+    }
+    Ok(Candidate {
+        id: d.id,
+        rank,
+        mass,
+        weights,
+        rho: c.f("rho")?[i],
+    })
+}
+
+/// The indices (into `ranked`) of the designs the part is chosen from: #1
+/// and every design that balances, was not shown worse than #1 at α and ran
+/// the whole race (a design that left was shown worse at a look); of those,
+/// only the ones that work (no shortfall) when any does.
+fn tied(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Vec<usize>> {
+    let settled = c.f("settled_fraction")?;
+    let worse = c.f_or_none("worse_than_none_fraction")?;
+    let works = |d: &RankedDesign| {
+        shortfalls(settled[d.row].unwrap_or(0.0), worse[d.row].unwrap_or(0.0)).is_empty()
+    };
+    let crowned = ranked
+        .first()
+        .is_some_and(|d| d.verdict == Some(StoredVerdict::Best));
+    let set: Vec<usize> = (0..ranked.len())
+        .filter(|&r| {
+            let d = &ranked[r];
+            r == 0
+                || (crowned
+                    && d.balances
+                    && !d.left_race
+                    && matches!(
+                        d.verdict,
+                        Some(StoredVerdict::NotDistinguishable | StoredVerdict::OtherBetter)
+                    ))
+        })
+        .collect();
+    let working: Vec<usize> = set.iter().copied().filter(|&r| works(&ranked[r])).collect();
+    Ok(if working.is_empty() { set } else { working })
+}
+
+/// The recommendation: the part chosen by `tie_break` among the designs
+/// the data cannot tell from #1, with its cautions, #1's edges, or none.
+fn recommendation(
+    c: &SummaryColumns,
+    ranked: &[RankedDesign],
+    tie_break: TieBreak,
+) -> PolarsResult<Recommendation> {
     let Some(best) = ranked.first() else {
         return Ok(Recommendation::NoDesigns);
     };
     if best.verdict == Some(StoredVerdict::NoDesignBalances) || !best.balances {
         return Ok(Recommendation::NoneBalances);
     }
-    let i = best.row;
+    let set = tied(c, ranked)?;
+    let candidates = set
+        .iter()
+        .map(|&r| candidate(c, &ranked[r], r))
+        .collect::<PolarsResult<Vec<_>>>()?;
+    let chosen = choose(tie_break, &candidates).map_or(best.id, |c| c.id);
+    let pick = ranked.iter().find(|d| d.id == chosen).unwrap_or(best);
+    let i = pick.row;
+    let worse = c.f_or_none("worse_than_none_fraction")?[i].unwrap_or(0.0);
+    let settled = c.f("settled_fraction")?[i].unwrap_or(0.0);
     let kind = c.s("kind")?;
     let n = c.u32s("n")?;
     let (rho, drag) = (c.f("rho")?, c.f("drag")?);
-    // Summaries written before these columns lack the part's dimensions.
-    let (race, mass) = (c.f_or_none("race_radius")?, c.f_or_none("weight_mass")?);
-    let part = match plane_parts(c, i)? {
-        Some(parts) => Some(parts),
-        None => match (&kind[i], n[i], rho[i], race[i], mass[i], drag[i]) {
-            (Some(k), Some(n), Some(r), Some(race), Some(m), Some(b)) => {
-                let length = c.f_or_none("roller_height")?[i];
-                let part = crate::study::plan::design::part_text(k, n, (r, race), m, b, length);
-                // One design in every plane of a rotor with several.
-                let planes = match c.0.column("balancer_planes") {
-                    Ok(_) => c.u32s("balancer_planes")?[i].unwrap_or(1),
-                    Err(_) => 1,
-                };
-                Some(if planes > 1 {
-                    format!("{part}, in each of {planes} planes")
-                } else {
-                    part
-                })
-            }
-            _ => None,
-        },
-    };
-    let worse = c.f_or_none("worse_than_none_fraction")?[i].unwrap_or(0.0);
-    let settled = c.f("settled_fraction")?[i].unwrap_or(0.0);
     let grid: Vec<(String, f64, f64, f64)> = (0..kind.len())
         .map(|j| {
             (
@@ -443,13 +553,37 @@ fn recommendation(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<R
         })
         .collect();
     Ok(Recommendation::Build {
-        design: best.id,
-        part,
+        design: pick.id,
+        first: best.id,
+        indistinguishable: set.iter().map(|&r| ranked[r].id).collect(),
+        tie_break,
+        part: part_of(c, i)?,
+        unsettled_risk: unsettled_risk(c, i)?,
         shortfalls: shortfalls(settled, worse),
         unsettled_floor: c.s_or_none("unsettled_floor")?[i].clone(),
-        edges: edges(&grid, i, &beaten(c)?),
+        // Where the best may lie beyond the grid is a question about #1.
+        edges: edges(&grid, best.row, &beaten(c)?),
         pareto: ranked.iter().filter(|d| d.pareto).map(|d| d.id).collect(),
     })
+}
+
+/// Row `i`'s runs that did not settle, its runs, and the Wilson upper
+/// bound on that share (1 − the settled share's lower bound); `None` for a
+/// summary without the columns or a design without runs.
+fn unsettled_risk(c: &SummaryColumns, i: usize) -> PolarsResult<Option<(u64, u64, f64)>> {
+    let column = |name: &str| -> PolarsResult<Option<u64>> {
+        Ok(match c.0.column(name) {
+            Ok(col) => col.cast(&polars::prelude::DataType::UInt64)?.u64()?.get(i),
+            Err(_) => None,
+        })
+    };
+    let (Some(runs), Some(settled)) = (column("runs")?, column("settled")?) else {
+        return Ok(None);
+    };
+    let lo = c.f_or_none("settled_fraction_lo")?[i];
+    Ok(lo
+        .filter(|_| runs > 0)
+        .map(|lo| (runs - settled.min(runs), runs, 1.0 - lo)))
 }
 
 /// Per summary row: whether #1 is significantly better than it on the

@@ -96,7 +96,8 @@ fn the_raced_main_job_decides_as_the_full_study_with_fewer_runs() {
                 .sum::<u64>()
     );
     let (raced, full) = (decision(&a.dir), decision(&b.dir));
-    assert_eq!(raced.0, Some(2));
+    // #1 is design 2; designs 7 and 16 tie with it and 16 is the lightest.
+    assert_eq!(raced.0, Some(16));
     assert_eq!(raced, full);
     // Every design that left is one the full study calls worse than #1.
     for d in departures {

@@ -13,6 +13,7 @@
 //! - [`truncated`]: truncated normal draws.
 //! - [`stream`]: the per-run random streams, one per (seed, design, sample, purpose).
 //! - [`sample`]: the draws of one run (unbalance, direction, start angles).
+//! - [`tie_break`]: how the part is chosen among designs the data cannot tell apart.
 
 pub mod config;
 pub mod couple;
@@ -23,5 +24,6 @@ pub mod optimize_spec;
 pub mod plane_designs;
 pub mod sample;
 pub mod stream;
+pub mod tie_break;
 pub mod tolerance;
 pub mod truncated;

@@ -224,6 +224,8 @@ impl SummaryColumns {
         rows.design_id.push(design.id);
         rows.rank.push(study.rank_of(design.id));
         rows.rank_by.push(study.criterion.to_string());
+        rows.tie_break
+            .push(study.plan.file.summary.tie_break.name().to_string());
         rows.settling_from.push(study.clock.describe().to_string());
         rows.kind.push(design.spec.kind.name().to_string());
         rows.n.push(design.spec.n);
@@ -453,6 +455,7 @@ struct SummaryColumns {
     design_id: Vec<u32>,
     rank: Vec<Option<u32>>,
     rank_by: Vec<String>,
+    tie_break: Vec<String>,
     rank_value: Vec<Option<f64>>,
     settling_from: Vec<String>,
     pareto: Vec<bool>,
@@ -611,6 +614,7 @@ impl SummaryColumns {
             Column::new("design_id".into(), self.design_id),
             Column::new("rank".into(), self.rank),
             Column::new("rank_by".into(), self.rank_by),
+            Column::new("tie_break".into(), self.tie_break),
             Column::new("rank_value".into(), self.rank_value),
             Column::new("settling_from".into(), self.settling_from),
             Column::new("pareto".into(), self.pareto),

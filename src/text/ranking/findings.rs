@@ -133,6 +133,10 @@ pub(super) fn disagreement_line(decision: &StudyDecision) -> String {
 pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
     let Recommendation::Build {
         design,
+        first,
+        indistinguishable,
+        tie_break,
+        unsettled_risk,
         part,
         shortfalls,
         unsettled_floor,
@@ -147,10 +151,31 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
             _ => String::new(),
         };
     };
-    let mut line = format!(
-        "recommendation: design {design} (#1 by the {})",
-        decision.criterion.label()
-    );
+    let mut line = if indistinguishable.len() > 1 {
+        // The point estimates' order among designs that tie is noise: the
+        // part is chosen from the set by the declared rule.
+        format!(
+            "recommendation: indistinguishable from #1 by the {} at α = {}: designs {}; part by {}: design {design}{}",
+            decision.criterion.label(),
+            decision.alpha,
+            indistinguishable
+                .iter()
+                .map(u32::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            tie_break.label(),
+            if design == first {
+                " (also #1)".to_string()
+            } else {
+                format!(" ({})", who_id(decision, *design))
+            },
+        )
+    } else {
+        format!(
+            "recommendation: design {design} (#1 by the {})",
+            decision.criterion.label()
+        )
+    };
     if let Some(part) = part {
         line += &format!(": {part}");
     }
@@ -178,9 +203,17 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
         }
     }
     // A winner at the end of a swept axis: the best may lie beyond it.
+    // The part's risk of not settling, with the bound a buyer can quote.
+    if let Some((unsettled, runs, upper)) = unsettled_risk {
+        line += &format!(
+            "; it did not settle in {unsettled} of {runs} runs: risk of not settling at most {:.1} % (95 % Wilson upper bound)",
+            100.0 * upper
+        );
+    }
+    let sits = if design == first { "it" } else { "#1" };
     for e in edges {
         line += &format!(
-            "; it sits at the {} {} swept ({}): the best may lie beyond, so extend {} {} it",
+            "; {sits} sits at the {} {} swept ({}): the best may lie beyond, so extend {} {} it",
             if e.high { "largest" } else { "smallest" },
             e.axis.key(),
             crate::number_text::significant(e.value, 4),

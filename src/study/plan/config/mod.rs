@@ -82,6 +82,11 @@ pub struct SummarySpec {
     /// set (`pareto` column of summary.parquet).
     #[serde(default = "default_pareto")]
     pub pareto: Vec<super::criterion::Criterion>,
+    /// How the part is chosen among the designs not distinguishable from
+    /// #1 at α: `"mass"` (least balancer mass, then fewest weights, then
+    /// smallest ρ) or `"first"` (#1 by the point estimate).
+    #[serde(default)]
+    pub tie_break: super::tie_break::TieBreak,
 }
 
 impl Default for SummarySpec {
@@ -89,6 +94,7 @@ impl Default for SummarySpec {
         SummarySpec {
             rank_by: super::criterion::Criterion::default(),
             pareto: default_pareto(),
+            tie_break: super::tie_break::TieBreak::default(),
         }
     }
 }
