@@ -543,8 +543,10 @@ impl RunContext<'_> {
             }
             executed += pending.len() as u64;
             let last = k + 1 == batches.len();
-            // Nothing to judge: a shard of a raced study runs every batch.
-            if stop_when.is_none() && (race.is_none() || last) {
+            // Nothing to judge: a shard of a raced study runs every batch,
+            // and a race with one design left only runs it to the end.
+            let raced_out = race.as_ref().is_none_or(Race::decided);
+            if stop_when.is_none() && (raced_out || last) {
                 continue;
             }
             // Judge the batches so far on their own runs only.
@@ -553,17 +555,12 @@ impl RunContext<'_> {
             let so_far = read_pieces_summary_columns(&pieces)?;
             let mask = so_far.column("sample_id")?.u32()?.lt(range.end);
             let judged = so_far.filter(&mask)?;
-            if let Some(race) = race.as_mut().filter(|_| !last) {
+            if let Some(race) = race.as_mut().filter(|r| !last && !r.decided()) {
                 let left = self.install(|| race.look(plan, k, range.end, &judged))?;
-                // Runs that will not come: the later samples of the designs that
-                // left, and of the one left when that ends the study.
-                let stopped = left.len() + usize::from(race.decided());
-                if stopped > 0 {
+                // Runs that will not come: the later samples of the designs that left.
+                if !left.is_empty() {
                     let remaining = u64::from(plan.file.sampling.samples - range.end);
-                    self.progress.skip(remaining * stopped as u64);
-                }
-                if race.decided() {
-                    break;
+                    self.progress.skip(remaining * left.len() as u64);
                 }
             }
             if let Some(stop) = stop_when {

@@ -88,11 +88,6 @@ pub struct Departure {
 pub struct Race {
     levels: Vec<f64>,
     left: Vec<Option<Departure>>,
-    /// Whether the study ends when one design is left (not when it runs on
-    /// to a precision, `sampling.stop_when`).
-    ends_when_decided: bool,
-    /// The samples after which one design was left: the race, and the study, ended.
-    ended: Option<u32>,
 }
 
 impl Race {
@@ -104,8 +99,6 @@ impl Race {
         Race {
             levels: SPENDING.look_levels(plan.file.statistics.alpha, &fractions),
             left: vec![None; plan.designs.len()],
-            ends_when_decided: plan.file.sampling.stop_when.is_none(),
-            ended: None,
         }
     }
 
@@ -158,23 +151,20 @@ impl Race {
                 *slot = Some(d.clone());
             }
         }
-        // One design left: the decision is made, and more of its runs would
-        // change no verdict (unless the study runs on to a precision).
-        if self.ends_when_decided && self.running_count() < 2 {
-            self.ended = Some(samples);
-        }
         Ok(out)
     }
 
-    /// True once a single design is left in a race that ends then.
+    /// True once a single design is left: no later look can change the
+    /// race. The one left still runs every sample: it is the part, and
+    /// trimming its runs would only widen its intervals (issue 70).
     pub fn decided(&self) -> bool {
-        self.ended.is_some()
+        self.running_count() < 2
     }
 
     /// Whether the raced study runs sample `sample` of design `index`.
     pub fn runs(&self, index: usize, sample: u32) -> bool {
         let left = self.left.get(index).and_then(Option::as_ref);
-        left.is_none_or(|d| sample < d.samples) && self.ended.is_none_or(|e| sample < e)
+        left.is_none_or(|d| sample < d.samples)
     }
 
     /// The race an unsharded study makes, replayed on a table of every
