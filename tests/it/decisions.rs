@@ -355,6 +355,72 @@ fn a_run_up_is_timed_from_the_operating_speed() {
     assert!(stdout.contains("s after the rotor reached it)"), "{stdout}");
 }
 
+/// One clock on a run-up: the horizon τ counts only the revolutions
+/// observable after the ramp (t_end − hold − ramp), every run that did not
+/// settle is censored there, and the restricted mean stays inside it
+/// (before 2026-12-07 τ counted the ramp too, and a design's restricted
+/// mean read 171 rev where 113 were observable).
+#[test]
+fn a_run_up_is_censored_at_the_revolutions_observable_after_the_ramp() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = crate::bad_input::study(&tmp.path().join("results"))
+        .replace(
+            "mode = \"constant\"\nomega = 300.0",
+            "mode = \"ramp\"\nomega_start = 150.0\nomega_end = 300.0\nduration = 0.5",
+        )
+        .replace("drag = 10.0", "drag = [10.0, 400.0]")
+        .replace("samples = 2", "samples = 8");
+    let out = run(tmp.path(), &text, &[]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = read_parquet(&tmp.path().join("results/corpus/summary.parquet")).unwrap();
+    let column = |name: &str| -> Vec<f64> {
+        let c = summary.column(name).unwrap().f64().unwrap().clone();
+        c.iter().map(|v| v.unwrap()).collect()
+    };
+    // 0.5 s of ramp is 0.5 · 300 / 2π = 23.87 rev of the operating speed.
+    let ramp = 0.5 * 300.0 / std::f64::consts::TAU;
+    let tau = column("settling_horizon_revs")[0];
+    assert!((tau - (100.0 - 50.0 - ramp)).abs() < 1e-9, "τ = {tau}");
+    let settled = column("settled_fraction");
+    assert!(
+        settled.iter().any(|&f| f < 1.0),
+        "no run was censored: {settled:?}"
+    );
+    for rmst in column("settling_revs_rmst") {
+        assert!(
+            (0.0..=tau + 1e-9).contains(&rmst),
+            "RMST {rmst} beyond τ = {tau}"
+        );
+    }
+    // The figures count on the same clock, and say so on their axes.
+    let figures = tmp.path().join("figures");
+    let plotted = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["plot", "study"])
+        .arg(tmp.path().join("results/corpus"))
+        .arg("--out")
+        .arg(&figures)
+        .output()
+        .unwrap();
+    assert_eq!(
+        plotted.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&plotted.stderr)
+    );
+    for figure in ["settling_time.svg", "settling_vs_unbalance.svg"] {
+        let svg = std::fs::read_to_string(figures.join(figure)).unwrap();
+        assert!(
+            svg.contains("revolutions after reaching the operating speed"),
+            "{figure}"
+        );
+    }
+}
+
 /// The diagnosis' typed cause, as `summary.parquet` stores it, of the one
 /// design that has one.
 fn diagnosis_cause(summary: &Path) -> Option<String> {

@@ -364,7 +364,7 @@ fn study_figures_from_parquet() {
         &[
             "settling time vs unbalance",
             "unbalance U / capacity S  (–)",
-            "settling time t_s  (rev)",
+            "settling time t_s  (revolutions)",
             "not settled",
         ],
     );

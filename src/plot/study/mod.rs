@@ -242,9 +242,37 @@ impl StudyData {
         self.runs
             .iter()
             .filter(|r| r.design_id == design_id && r.metrics.settled)
-            .filter_map(|r| r.metrics.settling_revs)
+            .filter_map(|r| self.settled_revs(r))
             .filter(|v| v.is_finite())
             .collect()
+    }
+
+    /// Revolutions of run `r` before the rotor reached its operating speed:
+    /// the figures count settling from there, as the ranking does on a
+    /// run-up (0 at a constant speed, or without the operating speed).
+    fn run_up_revs(&self, r: &RunRecord) -> f64 {
+        match (self.operating_speed, r.metrics.operating_time) {
+            (Some(omega), Some(t)) if omega > 0.0 => t * omega / std::f64::consts::TAU,
+            _ => 0.0,
+        }
+    }
+
+    /// Run `r`'s settling time on the ranking's clock (revolutions after
+    /// the operating speed was reached); `None` when it did not settle.
+    fn settled_revs(&self, r: &RunRecord) -> Option<f64> {
+        let t = r.metrics.settling_revs.filter(|_| r.metrics.settled)?;
+        Some((t - self.run_up_revs(r)).max(0.0))
+    }
+
+    /// What a settling-time axis counts: revolutions, and on a run-up from
+    /// when (every figure counts from the operating speed, as the ranking).
+    fn settling_axis(&self) -> &'static str {
+        let run_up = self.runs.iter().any(|r| self.run_up_revs(r) > 0.0);
+        if run_up {
+            "revolutions after reaching the operating speed"
+        } else {
+            "revolutions"
+        }
     }
 
     /// Every run of one design as a settling observation (revolutions):
@@ -264,13 +292,14 @@ impl StudyData {
         self.runs
             .iter()
             .filter(|r| r.design_id == design_id)
-            .map(|r| match r.metrics.settling_revs {
-                Some(t) if r.metrics.settled && t.is_finite() => Observation {
+            .map(|r| match self.settled_revs(r) {
+                Some(t) if t.is_finite() => Observation {
                     time: t,
                     settled: true,
                 },
                 _ => Observation {
-                    time: r.metrics.censoring_revs.unwrap_or(latest),
+                    time: (r.metrics.censoring_revs.unwrap_or(latest) - self.run_up_revs(r))
+                        .max(0.0),
                     settled: false,
                 },
             })

@@ -153,7 +153,10 @@ impl Figure for SettlingBoxes<'_> {
             )?;
         chart
             .configure_mesh()
-            .x_desc("settling time t_s  (revolutions, log scale)")
+            .x_desc(format!(
+                "settling time t_s  ({}, log scale)",
+                self.data.settling_axis()
+            ))
             .y_desc("design")
             .axis_desc_style(text(style::AXIS))
             .label_style(text(TICK))

@@ -62,8 +62,7 @@ impl Figure for SettlingScatter<'_> {
         };
         let settled = runs
             .iter()
-            .filter(|r| r.metrics.settled)
-            .filter_map(|r| r.metrics.settling_revs)
+            .filter_map(|r| self.data.settled_revs(r))
             .filter(|v| *v > 0.0);
         let (lo, data_hi) = style::extent(settled)
             .ok_or_else(|| PlotError::NoData("no positive settling time".into()))?;
@@ -126,7 +125,10 @@ impl Figure for SettlingScatter<'_> {
             chart
                 .configure_mesh()
                 .x_desc("unbalance U / capacity S  (–)")
-                .y_desc("settling time t_s  (rev)")
+                .y_desc(format!(
+                    "settling time t_s  ({})",
+                    self.data.settling_axis()
+                ))
                 .axis_desc_style(text(style::AXIS))
                 .label_style(text(TICK))
                 .x_label_formatter(&linear_label)
@@ -140,7 +142,7 @@ impl Figure for SettlingScatter<'_> {
                 chart.draw_series(
                     mine.iter()
                         .filter(|r| drive_of(r) == Some(k) && r.metrics.settled)
-                        .filter_map(|r| Some((r.unbalance_fraction, r.metrics.settling_revs?)))
+                        .filter_map(|r| Some((r.unbalance_fraction, self.data.settled_revs(r)?)))
                         .map(|p| {
                             EmptyElement::at(p)
                                 + style::marker(look.marker, 3, look.colour.filled())

@@ -9,13 +9,29 @@ pub use crate::study::results::measured_runs::DesignRuns;
 use crate::study::results::measured_runs::Scale;
 use polars::prelude::*;
 
-/// The latest settling time a run of the plan can show (revolutions): the
-/// end of the run less the hold window. Runs that never settled are
-/// censored here, and the restricted mean, the capped times of the paired
-/// mean test and the p90 all run up to it: one τ for `summary.parquet`,
-/// `study compare`, `study claims` and `study optimize`.
+/// The latest settling time a run of the plan can show (revolutions) on
+/// the plan's clock ([`SettlingClock::of`]): the end of the run less the
+/// hold window, and on a ramp less the ramp too, since a run-up's times
+/// count from the moment the speed is reached. Runs that never settled
+/// are censored here, and the restricted mean, the capped times of the
+/// paired mean test and the p90 all run up to it: one τ for
+/// `summary.parquet`, `study compare`, `study claims` and `study optimize`.
+///
+/// A motor's run-up has no time known before the run (its speed only
+/// approaches the synchronous one): each run is censored at what it
+/// showed after reaching speed, and τ stays t_end − hold.
 pub fn settling_horizon(plan: &StudyPlan) -> f64 {
-    plan.file.metrics.t_end_revs - plan.file.metrics.hold_revs
+    let metrics = &plan.file.metrics;
+    let whole = metrics.t_end_revs - metrics.hold_revs;
+    match SettlingClock::of(plan) {
+        SettlingClock::FromStart => whole,
+        SettlingClock::FromOperatingSpeed(rev_seconds) => {
+            let ramp = plan.file.scene.speed.operating_time().unwrap_or(0.0) / rev_seconds;
+            // Before 2026-12-07 τ counted the ramp's revolutions too: a run
+            // that never settled counted 550 rev where 317 were observable.
+            (whole - ramp).max(0.0)
+        }
+    }
 }
 
 /// τ and the length of a revolution of `plan`.
@@ -85,8 +101,14 @@ pub fn settling_observation(run: RunTimes, horizon: f64, clock: SettlingClock) -
             time: (t - offset).max(0.0),
             settled: true,
         },
+        // A run without a censoring time (it failed, or stopped early) is
+        // counted as not settled up to the horizon, which is already on
+        // the plan's clock.
         _ => Observation {
-            time: (run.censoring_revs.unwrap_or(horizon) - offset).max(0.0),
+            time: run
+                .censoring_revs
+                .map_or(horizon, |c| (c - offset).min(horizon))
+                .max(0.0),
             settled: false,
         },
     }

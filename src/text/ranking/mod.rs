@@ -596,7 +596,9 @@ fn insert_column(
 /// verdict's test names τ), with the symbol and its formula under `--wide`.
 fn horizon_text(revs: String, wide: bool) -> String {
     if wide {
-        format!("the horizon τ = {revs} rev, t_end − hold")
+        format!(
+            "the horizon τ = {revs} rev, t_end − hold (less a ramp, counted from the operating speed)"
+        )
     } else {
         format!("{revs} rev, the run's length less its hold window (τ)")
     }
