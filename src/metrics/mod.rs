@@ -259,6 +259,11 @@ pub struct RunMetrics {
     pub operating_time: Option<f64>,
     /// Spin rate φ̇ at the end of the run (rad/s); `None` for estimates.
     pub final_spin_rate: Option<f64>,
+    /// The weights' mean angular rate relative to the rotor at the end of
+    /// the run (rad/s, negative: behind it): about 0 for weights that
+    /// settled or stopped in the race, far from 0 for a pack that
+    /// circulates; `None` for estimates.
+    pub pack_slip_rate: Option<f64>,
     /// With rolling resistance: the largest angle (degrees) between a
     /// weight's final position and the balanced position nearest the final
     /// ones (`None` without it, at variable speed, or with no balanced state
@@ -326,6 +331,7 @@ impl std::fmt::Debug for RunMetrics {
         s.field("censoring_revs", &self.censoring_revs);
         s.field("operating_time", &self.operating_time);
         s.field("final_spin_rate", &self.final_spin_rate);
+        s.field("pack_slip_rate", &self.pack_slip_rate);
         s.field("balance_angle_error_deg", &self.balance_angle_error_deg);
         if let Some(a) = &self.plane_a_ref {
             s.field("plane_a_ref", a);
@@ -395,6 +401,7 @@ impl RunMetrics {
             censoring_revs: None,
             operating_time: None,
             final_spin_rate: None,
+            pack_slip_rate: None,
             balance_angle_error_deg: None,
             plane_a_ref: None,
             plane_residual_abs: None,
@@ -547,5 +554,50 @@ mod tests {
             }
         }
         assert_eq!(Budget::of_failure(&failures[1]), Some(Budget::WallTime));
+    }
+}
+
+/// The share of the rotor's speed a pack's slip rate must reach for its
+/// weights to count as circulating ([`circulates`]): 10 %, far above the
+/// creep of weights that settled or stopped (≈ 0) and far below the
+/// trapped washer pack that ran 99 rad/s behind a 147 rad/s drum.
+pub const CIRCULATING_SLIP_SHARE: f64 = 0.1;
+
+/// Whether a run's weights circulate instead of balancing: the run did not
+/// settle and, at its end, the pack moved relative to the rotor at
+/// [`CIRCULATING_SLIP_SHARE`] or more of the rotor's speed.
+pub fn circulates(metrics: &RunMetrics) -> bool {
+    circulating(
+        metrics.settled,
+        metrics.pack_slip_rate,
+        metrics.final_spin_rate,
+    )
+}
+
+/// [`circulates`] on the columns of runs.parquet (`settled`,
+/// `pack_slip_rate`, `final_spin_rate`).
+pub fn circulating(settled: bool, slip: Option<f64>, spin: Option<f64>) -> bool {
+    match (slip, spin) {
+        (Some(slip), Some(spin)) => {
+            !settled && spin.abs() > 0.0 && slip.abs() >= CIRCULATING_SLIP_SHARE * spin.abs()
+        }
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod circulation_tests {
+    use super::circulating;
+
+    /// The washer's trapped pack (99 rad/s behind a 147 rad/s drum)
+    /// circulates; a settled pack, a slow creep and a run that settled
+    /// despite slipping do not; a run without the rates is not judged.
+    #[test]
+    fn a_pack_circulates_only_when_it_slips_and_did_not_settle() {
+        assert!(circulating(false, Some(-99.0), Some(146.6)));
+        assert!(!circulating(false, Some(-0.05), Some(146.6)));
+        assert!(!circulating(true, Some(-99.0), Some(146.6)));
+        assert!(!circulating(false, None, Some(146.6)));
+        assert!(!circulating(false, Some(-99.0), Some(0.0)));
     }
 }

@@ -284,6 +284,7 @@ fn study_runs(plan: &autobal::study::plan::config::StudyPlan, samples: u32) -> V
                     censoring_revs: None,
                     operating_time: Some(0.0),
                     final_spin_rate: None,
+                    pack_slip_rate: None,
                     balance_angle_error_deg: None,
                     plane_a_ref: None,
                     plane_residual_abs: None,

@@ -236,6 +236,7 @@ fn metrics(settled: bool, revs: f64) -> RunMetrics {
         censoring_revs: None,
         operating_time: Some(0.0),
         final_spin_rate: None,
+        pack_slip_rate: None,
         balance_angle_error_deg: None,
         plane_a_ref: None,
         plane_residual_abs: None,

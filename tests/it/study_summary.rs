@@ -79,6 +79,7 @@ pub(crate) fn record(id: u64, outcome: Outcome, revs: Option<f64>, residual_rel:
             censoring_revs: None,
             operating_time: Some(0.0),
             final_spin_rate: None,
+            pack_slip_rate: None,
             balance_angle_error_deg: None,
             plane_a_ref: None,
             plane_residual_abs: None,

@@ -178,7 +178,7 @@ fn describe(m: &RunMetrics) -> String {
         .map(|a| format!("{a:.1}"))
         .collect();
     format!(
-        "outcome            {}\nreason             {}\nsettled            {}\nsettling time      {} s ({} rev, ± {:.4} s)\nsettling time (ε)  {} s\nresidual           {:.4e} ({:.4} A_ref)\nA_ref              {:.4e}\nbalancing error ε  {:.4e}\npeak r             {:.4e}\nfinal angles       [{}] deg\np final            {:.4}\nsteps, RHS calls   {}, {}\nclosest weights    {}\n",
+        "outcome            {}\nreason             {}\nsettled            {}\nsettling time      {} s ({} rev, ± {:.4} s)\nsettling time (ε)  {} s\nresidual           {:.4e} ({:.4} A_ref)\nA_ref              {:.4e}\nbalancing error ε  {:.4e}\npeak r             {:.4e}\nfinal angles       [{}] deg\np final            {:.4}\nsteps, RHS calls   {}, {}\nclosest weights    {}\npack slip rate     {}\n",
         m.outcome.name(),
         m.reason,
         m.settled,
@@ -202,6 +202,18 @@ fn describe(m: &RunMetrics) -> String {
                 end.to_degrees()
             ),
             _ => "– (point masses)".to_string(),
+        },
+        match (m.pack_slip_rate, m.final_spin_rate) {
+            (Some(slip), Some(spin)) => format!(
+                "{slip:.4} rad/s relative to the rotor at the end ({:.1} % of its speed{})",
+                100.0 * slip / spin.abs().max(f64::MIN_POSITIVE),
+                if autobal::metrics::circulates(m) {
+                    ": the weights circulate"
+                } else {
+                    ""
+                }
+            ),
+            _ => "–".to_string(),
         }
     )
 }

@@ -234,6 +234,7 @@ impl SettlingObserver<'_> {
             final_min_gap_rad: self.gap.as_ref().map(|g| g.min_gap(psi)),
             operating_time: self.operating_since,
             final_spin_rate: Some(self.system.spin(t_final, y_final).1),
+            pack_slip_rate: pack_slip_rate(self.system, y_final),
             balance_angle_error_deg: None,
             plane_a_ref: self.planes.as_ref().map(|p| p.a_ref.clone()),
             // A run certified never to settle: each plane's last LAG
@@ -289,4 +290,12 @@ impl SettlingObserver<'_> {
             })
             .collect()
     }
+}
+
+/// The weights' mean rate ψ̇ relative to the rotor in state `y` (rad/s);
+/// `None` without weights.
+fn pack_slip_rate(system: &RotorSystem, y: &[f64]) -> Option<f64> {
+    let lay = system.layout();
+    let rates = y.get(lay.nq() + lay.head()..2 * lay.nq())?;
+    (!rates.is_empty()).then(|| rates.iter().sum::<f64>() / rates.len() as f64)
 }

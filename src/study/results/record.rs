@@ -208,6 +208,7 @@ pub fn to_dataframe(rows: &[RunRecord]) -> PolarsResult<DataFrame> {
         col!("stall_torque", |r: &RunRecord| r.stall_torque),
         col!("operating_time_s", |r: &RunRecord| r.metrics.operating_time),
         col!("final_spin_rate", |r: &RunRecord| r.metrics.final_spin_rate),
+        col!("pack_slip_rate", |r: &RunRecord| r.metrics.pack_slip_rate),
         col!("balance_angle_error_deg", |r: &RunRecord| r
             .metrics
             .balance_angle_error_deg),
@@ -712,6 +713,7 @@ struct OptionalColumns {
     stall: Vec<Option<f64>>,
     t_op: Vec<Option<f64>>,
     spin: Vec<Option<f64>>,
+    slip: Vec<Option<f64>>,
     angle_error: Vec<Option<f64>>,
     plane_a_ref: Option<Vec<Vec<f64>>>,
     plane_residual: Option<Vec<Vec<f64>>>,
@@ -730,6 +732,7 @@ impl OptionalColumns {
             stall: c.optional("stall_torque")?,
             t_op: c.optional("operating_time_s")?,
             spin: c.optional("final_spin_rate")?,
+            slip: c.optional("pack_slip_rate")?,
             angle_error: c.optional("balance_angle_error_deg")?,
             plane_a_ref: c.optional_lists(PLANE_COLUMNS[0])?,
             plane_residual: c.optional_lists(PLANE_COLUMNS[1])?,
@@ -787,6 +790,7 @@ fn metrics_at(
         censoring_revs: core.censoring[i],
         operating_time: optional.t_op[i],
         final_spin_rate: optional.spin[i],
+        pack_slip_rate: optional.slip[i],
         balance_angle_error_deg: optional.angle_error[i],
         plane_a_ref: plane_row(&optional.plane_a_ref, i),
         plane_residual_abs: plane_row(&optional.plane_residual, i),

@@ -230,8 +230,9 @@ pub const PLANE_SUMMARY_COLUMNS: [&str; 3] =
     ["plane_settling_revs", "plane_residual_abs", "plane_a_ref"];
 
 /// Columns the summary reads when a file has them: how contact was
-/// modelled (files written before the column have none).
-pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 1] = ["contact_model"];
+/// modelled, and the pack's slip rate (files written before the columns
+/// have none).
+pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 2] = ["contact_model", "pack_slip_rate"];
 
 /// The summary's projection of the file at `path`: [`SUMMARY_COLUMNS`], and
 /// [`PLANE_SUMMARY_COLUMNS`] and [`OPTIONAL_SUMMARY_COLUMNS`] where the file

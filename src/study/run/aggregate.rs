@@ -351,6 +351,34 @@ impl SummaryColumns {
         Ok(())
     }
 
+    /// Runs whose weights circulate instead of balancing
+    /// ([`crate::metrics::circulates`]) and how much worse than no balancer
+    /// they end (the range of their residual/A_ref).
+    fn push_circulating(&mut self, table: &DesignTable) -> PolarsResult<()> {
+        let mine = table.mine;
+        let slip: Vec<Option<f64>> = match mine.column("pack_slip_rate") {
+            Ok(c) => c.f64()?.iter().collect(),
+            // Runs written before the column: nothing to tell.
+            Err(_) => vec![None; mine.height()],
+        };
+        let spin = mine.column("final_spin_rate")?.f64()?;
+        let settled = mine.column("settled")?.bool()?;
+        let residual = mine.column("residual_rel")?.f64()?;
+        let worse: Vec<f64> = (0..mine.height())
+            .filter(|&i| {
+                crate::metrics::circulating(settled.get(i).unwrap_or(false), slip[i], spin.get(i))
+            })
+            .map(|i| residual.get(i).unwrap_or(f64::NAN))
+            .collect();
+        self.circulating.push(worse.len() as u64);
+        let finite = || worse.iter().copied().filter(|r| r.is_finite());
+        self.circulating_residual_min
+            .push(finite().reduce(f64::min));
+        self.circulating_residual_max
+            .push(finite().reduce(f64::max));
+        Ok(())
+    }
+
     /// The residual statistics (none for an estimate rung).
     fn push_residuals(&mut self, study: &StudyRuns, table: &DesignTable) -> PolarsResult<()> {
         let rows = self;
@@ -371,6 +399,11 @@ impl SummaryColumns {
         let worse = residual.iter().flatten().filter(|&r| r > 1.0).count();
         rows.worse_than_none
             .push(measured((runs_n > 0).then(|| worse as f64 / runs_n as f64)));
+        let (worse_lo, worse_hi) = wilson_interval(worse as u64, runs_n);
+        let bounds = (runs_n > 0 && !estimated).then_some((worse_lo, worse_hi));
+        rows.worse_than_none_lo.push(bounds.map(|b| b.0));
+        rows.worse_than_none_hi.push(bounds.map(|b| b.1));
+        rows.push_circulating(table)?;
         let abs_sorted = sorted_values(simulated.column("residual_abs")?.f64()?);
         rows.res_abs_p95.push(measured(quantile_sorted(
             &abs_sorted,
@@ -512,6 +545,12 @@ struct SummaryColumns {
     res_median: Vec<Option<f64>>,
     res_p95: Vec<Option<f64>>,
     worse_than_none: Vec<Option<f64>>,
+    worse_than_none_lo: Vec<Option<f64>>,
+    worse_than_none_hi: Vec<Option<f64>>,
+    /// Runs whose weights circulate, and their residual/A_ref range.
+    circulating: Vec<u64>,
+    circulating_residual_min: Vec<Option<f64>>,
+    circulating_residual_max: Vec<Option<f64>>,
     estimated: Vec<bool>,
     /// 95th percentile of the residual whirl in metres.
     res_abs_p95: Vec<Option<f64>>,
@@ -662,6 +701,17 @@ impl SummaryColumns {
             Column::new("residual_rel_median".into(), self.res_median),
             Column::new("residual_rel_p95".into(), self.res_p95),
             Column::new("worse_than_none_fraction".into(), self.worse_than_none),
+            Column::new("worse_than_none_lo".into(), self.worse_than_none_lo),
+            Column::new("worse_than_none_hi".into(), self.worse_than_none_hi),
+            Column::new("circulating_runs".into(), self.circulating),
+            Column::new(
+                "circulating_residual_rel_min".into(),
+                self.circulating_residual_min,
+            ),
+            Column::new(
+                "circulating_residual_rel_max".into(),
+                self.circulating_residual_max,
+            ),
             Column::new("estimated".into(), self.estimated),
             Column::new("residual_abs_p95".into(), self.res_abs_p95),
             Column::new("seconds_per_rev".into(), self.seconds_per_rev),

@@ -13,7 +13,7 @@ mod findings;
 mod notes;
 
 use findings::{disagreement_line, recommendation_line, verdict_line};
-use notes::{contact_line, dead_band_line, merged_line, passage_table};
+use notes::{circulating_line, contact_line, dead_band_line, merged_line, passage_table};
 
 /// The summary's columns by name (the library's reader).
 use crate::study::results::summary_columns::SummaryColumns as Summary;
@@ -208,6 +208,7 @@ pub fn ranking(summary: &DataFrame, layout: Layout) -> PolarsResult<Ranking> {
         + &disagreement_line(&decision)
         + &recommendation_line(&decision)
         + &merged_line(&sum, &order)?
+        + &circulating_line(&sum, &order)?
         + &dead_band_line(&sum, &order)?
         + &contact_line(summary, layout.wide)?;
     Ok(Ranking {

@@ -30,6 +30,64 @@ pub(super) fn merged_line(sum: &Summary, order: &[usize]) -> PolarsResult<String
     ))
 }
 
+/// Designs whose weights circulated instead of balancing
+/// ([`crate::metrics::circulates`]): in how many runs, and how much worse
+/// than no balancer those runs ended.
+pub(super) fn circulating_line(sum: &Summary, order: &[usize]) -> PolarsResult<String> {
+    let Ok(column) = sum.0.column("circulating_runs") else {
+        return Ok(String::new());
+    };
+    let count: Vec<u64> = column
+        .u64()?
+        .iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let runs: Vec<u64> = sum
+        .0
+        .column("runs")?
+        .u64()?
+        .iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let (lo, hi) = (
+        sum.f("circulating_residual_rel_min")?,
+        sum.f("circulating_residual_rel_max")?,
+    );
+    let ids = design_ids(sum)?;
+    let parts: Vec<String> = order
+        .iter()
+        .filter(|&&i| count[i] > 0)
+        .map(|&i| {
+            let worse = match (lo[i], hi[i]) {
+                (Some(a), Some(b)) if a > 1.0 => {
+                    format!(
+                        ", {}–{}× worse than no balancer",
+                        num(Some(a), 1),
+                        num(Some(b), 1)
+                    )
+                }
+                (Some(a), Some(b)) => {
+                    format!(", residual/A_ref {}–{}", num(Some(a), 2), num(Some(b), 2))
+                }
+                _ => String::new(),
+            };
+            format!(
+                "design {}: weights circulate in {} of {} runs{worse}",
+                ids[i], count[i], runs[i]
+            )
+        })
+        .collect();
+    if parts.is_empty() {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "circulating weights (the pack slipped against the rotor by at least {:.0} % of its speed at the end of a run that did not settle): {}; such runs count as not settled, and a design that ends worse than no balancer in significantly more than {:.0} % of its runs does not balance\n",
+        100.0 * crate::metrics::CIRCULATING_SLIP_SHARE,
+        parts.join("; "),
+        100.0 * crate::decide::verdict::WORKS_WORSE_SHARE,
+    ))
+}
+
 /// With rolling resistance: the dead band μ_s·l beside the band δ·A_ref.
 pub(super) fn dead_band_line(sum: &Summary, order: &[usize]) -> PolarsResult<String> {
     let dead = sum.f("dead_band_m")?;
