@@ -92,6 +92,15 @@ pub enum Crown {
         cause: Option<String>,
         /// The diagnosis' key (`diagnosis_cause`).
         cause_key: Option<String>,
+        /// #1's share of runs that end worse than with no balancer.
+        worse_than_none: Option<f64>,
+        /// #1's dead band μ_s·l over its median A_ref, when rolling
+        /// resistance is on and the dead band exceeds A_ref: the weights
+        /// never break away, and no band narrower than the dead band helps.
+        dead_band_over_a_ref: Option<f64>,
+        /// #1's dead band over its settling band δ·A_ref (how many times
+        /// lower the friction must be for the dead band to fit the band).
+        dead_band_over_band: Option<f64>,
     },
     /// One design that balances, or none at all: nothing to crown against.
     Alone,
@@ -299,6 +308,9 @@ fn crown(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Crown> {
             residual_median: c.f("residual_rel_median")?[best.row],
             cause: c.s("diagnosis")?[best.row].clone(),
             cause_key: c.s_or_none("diagnosis_cause")?[best.row].clone(),
+            worse_than_none: c.f_or_none("worse_than_none_fraction")?[best.row],
+            dead_band_over_a_ref: ratio(c, "a_ref_median", best.row)?.filter(|r| *r > 1.0),
+            dead_band_over_band: ratio(c, "settling_band_m", best.row)?,
         });
     }
     if best.verdict != Some(StoredVerdict::Best) {
@@ -317,6 +329,14 @@ fn crown(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Crown> {
         not_distinguishable: of(StoredVerdict::NotDistinguishable),
         other_better: of(StoredVerdict::OtherBetter),
     })
+}
+
+/// Row `row`'s dead band (`dead_band_m`) over its `column`; `None` without
+/// rolling resistance or the columns.
+fn ratio(c: &SummaryColumns, column: &str, row: usize) -> PolarsResult<Option<f64>> {
+    let dead = c.f_or_none("dead_band_m")?[row];
+    let of = c.f_or_none(column)?[row];
+    Ok(dead.zip(of).filter(|(_, x)| *x > 0.0).map(|(d, x)| d / x))
 }
 
 /// Every design better than #1 on a reported measure other than the criterion.

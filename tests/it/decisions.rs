@@ -102,6 +102,46 @@ fn a_dead_band_wider_than_the_settling_band_crowns_no_design_and_is_named() {
     );
     assert!(!stdout.contains("recommendation: design"), "{stdout}");
     assert!(!stdout.contains("is better than"), "{stdout}");
+    // When no design balances: the share worse than none, and, with the
+    // dead band beyond A_ref, that the weights never break away and by how
+    // much the friction must fall (dead band over the band δ·A_ref).
+    assert!(
+        stdout.contains("of its runs end worse than with no balancer"),
+        "{stdout}"
+    );
+    // Here the dead band (15.9 µm) is below A_ref (18.7 µm): a wider band
+    // could still be met, so nothing says the weights never break away.
+    assert!(!stdout.contains("never break away"), "{stdout}");
+    let doubled = text.replace("coefficient = 1e-3", "coefficient = 2e-3");
+    let out = run(tmp.path(), &doubled, &["--overwrite"]);
+    let twice = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        twice.contains("at this friction the weights never break away"),
+        "{twice}"
+    );
+    let summary = read_parquet(&tmp.path().join("results/deadband/summary.parquet")).unwrap();
+    let at_best = |name: &str| {
+        let rank = summary.column("rank").unwrap().u32().unwrap().clone();
+        let row = (0..summary.height())
+            .find(|&i| rank.get(i) == Some(1))
+            .unwrap();
+        summary
+            .column(name)
+            .unwrap()
+            .f64()
+            .unwrap()
+            .get(row)
+            .unwrap()
+    };
+    assert!(at_best("dead_band_m") > at_best("a_ref_median"));
+    let lower = at_best("dead_band_m") / at_best("settling_band_m");
+    assert!(
+        twice.contains(&format!(
+            "at least {lower:.0}× lower would bring the dead band inside"
+        )),
+        "{lower}: {twice}"
+    );
+    run(tmp.path(), &text, &["--overwrite"]);
     let summary = read_parquet(&tmp.path().join("results/deadband/summary.parquet")).unwrap();
     // The same decision, typed.
     let decision = StudyDecision::from_summary(&summary).unwrap();

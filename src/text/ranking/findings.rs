@@ -19,16 +19,34 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             settled_fraction,
             residual_median,
             cause,
+            worse_than_none,
+            dead_band_over_a_ref,
+            dead_band_over_band,
             ..
-        } => format!(
-            "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {}\n",
-            who_id(decision, *best),
-            100.0 * settled_fraction,
-            residual_median.map_or("– (no run was simulated to its end)".into(), |r| format!(
-                "{r:.2}"
-            )),
-            cause.as_deref().unwrap_or("no cause found")
-        ),
+        } => {
+            let mut line = format!(
+                "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer){}; cause: {}",
+                who_id(decision, *best),
+                100.0 * settled_fraction,
+                residual_median.map_or("– (no run was simulated to its end)".into(), |r| format!(
+                    "{r:.2}"
+                )),
+                worse_than_none.map_or(String::new(), |w| format!(
+                    "; {:.1} % of its runs end worse than with no balancer",
+                    100.0 * w
+                )),
+                cause.as_deref().unwrap_or("no cause found")
+            );
+            // A dead band beyond A_ref: no band a user would accept helps,
+            // only less friction does, and by how much is a number.
+            if let (Some(over_a_ref), Some(over_band)) = (dead_band_over_a_ref, dead_band_over_band)
+            {
+                line += &format!(
+                    "; at this friction the weights never break away: the dead band of rolling resistance is {over_a_ref:.1}× the whirl with no balancer (A_ref), so no settling band narrower than no balancer at all can be met; a rolling resistance at least {over_band:.0}× lower would bring the dead band inside the band δ·A_ref"
+                );
+            }
+            line + "\n"
+        }
         Crown::Alone => String::new(),
         Crown::Best {
             best,
