@@ -45,7 +45,7 @@ MODEL_LAYERS = [
 ]
 # Inside each room, lowest first.
 PLAN_LAYERS = [
-    {"stream", "truncated", "distribution", "design", "optimize_spec", "criterion"},
+    {"stream", "truncated", "distribution", "design", "optimize_spec", "criterion", "tie_break"},
     {"couple", "tolerance", "plane_designs"},
     {"config"},
     {"sample"},
