@@ -37,6 +37,7 @@ pub mod bearing_orbit;
 pub mod certify;
 pub mod never_settles;
 pub mod observer;
+pub mod peak_whirl;
 pub mod reference;
 
 use crate::model::speed::SpeedLaw;

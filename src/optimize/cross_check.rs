@@ -8,7 +8,9 @@
 //! errors restarts its search from there.
 
 use super::evaluate::{Candidate, Evaluator};
-use super::search::{SearchResult, nelder_mead_from, rho_interval, solver_cost, try_points};
+use super::search::{
+    SearchEnd, SearchResult, nelder_mead_from, rho_interval, solver_cost, try_points,
+};
 use super::spec::Variable;
 
 /// Fewest evaluations left for a restart from a better seed: a simplex of
@@ -77,6 +79,7 @@ pub fn cross_check(
                     .join(", ")
             ),
             stop: first.stop,
+            end: first.end,
         };
     };
     let (label, seed) = tried[k];
@@ -102,6 +105,7 @@ pub fn cross_check(
                 first.termination
             ),
             stop: "unconfirmed",
+            end: SearchEnd::Unconfirmed,
         };
     }
     let restart = nelder_mead_from(evaluator, base, (seed.rho, seed.drag), left);
@@ -110,5 +114,6 @@ pub fn cross_check(
         evaluations,
         termination: format!("restarted: {why}; from there, {}", restart.termination),
         stop: restart.stop,
+        end: restart.end,
     }
 }

@@ -4,6 +4,7 @@
 use super::spec::{Objective, OptimizeSpec};
 use crate::decide::verdict::settling_horizon;
 use crate::design::transient::a_tilde;
+use crate::metrics::{RunMetrics, peak_whirl};
 use crate::model::balancer::Kind;
 use crate::model::scene::{DesignSpec, RhoChoice};
 use crate::stats::bootstrap;
@@ -82,6 +83,9 @@ pub struct Evaluation {
     pub constraint: String,
     /// Which search produced it (scan, brent, nelder_mead, analytic).
     pub phase: &'static str,
+    /// Median over its runs of `peak_r / a_ref`, the start-up whirl
+    /// ([`crate::metrics::peak_whirl`]); `None` when it was not simulated.
+    pub peak_whirl_over_a_ref: Option<f64>,
 }
 
 /// Evaluates candidates of one study plan against one objective.
@@ -170,9 +174,17 @@ impl Evaluator<'_> {
                     feasible: false,
                     constraint: why,
                     phase,
+                    peak_whirl_over_a_ref: None,
                 };
             }
         };
+        // Runs on the search's samples 0..N, for a simulated objective or
+        // for the start-up whirl constraint.
+        let runs = (self.spec.objective.simulated() || self.spec.max_peak_over_a_ref.is_some())
+            .then(|| self.run_metrics(&design, 0..u64::from(self.samples)));
+        let peak = runs.as_ref().and_then(|m| {
+            peak_whirl::median_and_p95(m.iter().filter_map(peak_whirl::of_run)).map(|s| s.0)
+        });
         let (value, std_err) = match self.spec.objective {
             Objective::Capacity => (design.capacity, 0.0),
             Objective::ATilde => {
@@ -184,16 +196,24 @@ impl Evaluator<'_> {
                     .fold(f64::INFINITY, f64::min);
                 (value, 0.0)
             }
-            objective => self.simulate(&design, objective),
+            objective => {
+                let values = self.values_of(runs.as_deref().unwrap_or_default(), objective);
+                estimate(self.plan, objective, &values)
+            }
         };
+        let too_high = self
+            .spec
+            .max_peak_over_a_ref
+            .and_then(|max| peak_too_high(peak, max));
         Evaluation {
             candidate: c,
-            value: Some(value),
+            value: too_high.is_none().then_some(value),
             std_err,
             capacity: Some(design.capacity),
-            feasible: true,
-            constraint: "ok".into(),
+            feasible: too_high.is_none(),
+            constraint: too_high.unwrap_or_else(|| "ok".into()),
             phase,
+            peak_whirl_over_a_ref: peak,
         }
     }
 
@@ -211,12 +231,21 @@ impl Evaluator<'_> {
         samples: std::ops::Range<u64>,
         objective: Objective,
     ) -> Vec<f64> {
+        self.values_of(&self.run_metrics(design, samples), objective)
+    }
+
+    /// The metrics of the design's runs on `samples`, in index order
+    /// whatever the thread count.
+    fn run_metrics(&self, design: &Design, samples: std::ops::Range<u64>) -> Vec<RunMetrics> {
         let ids: Vec<u64> = samples.collect();
-        let metrics: Vec<_> = ids
-            .into_par_iter()
+        ids.into_par_iter()
             .with_max_len(1) // one simulation per job, as runs (study::run)
             .map(|k| run_design_sample(self.plan, design, k, k).metrics)
-            .collect();
+            .collect()
+    }
+
+    /// Each run's contribution to a simulated objective.
+    fn values_of(&self, metrics: &[RunMetrics], objective: Objective) -> Vec<f64> {
         // A run that never settles counts as the horizon, the latest settling
         // time a run can show: right-censored there, so the mean is the
         // restricted mean and the quantiles are the Kaplan–Meier ones.
@@ -240,12 +269,19 @@ impl Evaluator<'_> {
             })
             .collect()
     }
+}
 
-    /// Monte Carlo estimate and standard error of a simulated objective on
-    /// the search's samples 0..N.
-    fn simulate(&self, design: &Design, objective: Objective) -> (f64, f64) {
-        let values = self.run_values(design, 0..u64::from(self.samples), objective);
-        estimate(self.plan, objective, &values)
+/// Why a candidate whose runs' median start-up whirl is `peak` (over
+/// A_ref) breaks `optimize.max_peak_over_a_ref = max`; `None` when it holds.
+fn peak_too_high(peak: Option<f64>, max: f64) -> Option<String> {
+    match peak {
+        Some(p) if p <= max => None,
+        Some(p) => Some(format!(
+            "start-up whirl: median peak_r/A_ref {p:.3} above optimize.max_peak_over_a_ref = {max}"
+        )),
+        None => Some(format!(
+            "start-up whirl: no run recorded a whole peak to check against optimize.max_peak_over_a_ref = {max}"
+        )),
     }
 }
 

@@ -11,6 +11,7 @@ pub mod confirm;
 pub mod cross_check;
 pub mod evaluate;
 pub mod noisy_simplex;
+pub mod pick;
 pub mod search;
 /// The `[optimize]` table is part of the study file, so it lives with the
 /// study schema; named here as well, where it is used.
@@ -48,6 +49,8 @@ pub struct OptimizeOutput {
     pub dir: PathBuf,
     /// The optima confirmed on fresh samples (simulated objectives).
     pub confirmation: Option<confirm::Confirmation>,
+    /// Whether the overall pick is final: its own search converged.
+    pub pick: pick::PickStatus,
 }
 
 /// Why an optimisation cannot run.
@@ -135,6 +138,7 @@ fn validate_bounds(spec: &OptimizeSpec) -> Result<(), OptimizeError> {
     for (key, v) in [
         ("safety_factor", spec.safety_factor),
         ("max_unbalance", spec.max_unbalance),
+        ("max_peak_over_a_ref", spec.max_peak_over_a_ref),
     ] {
         if let Some(v) = v
             && !(v.is_finite() && v > 0.0)
@@ -276,6 +280,7 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
     let results = cross_check_counts(&evaluator, results);
     let mut evaluations = Vec::new();
     let mut terminations = Vec::new();
+    let mut stops = Vec::new();
     let mut best = Vec::new();
     for (c, r) in &results {
         let (scope, label) = match c.plane1 {
@@ -294,18 +299,26 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
                 evaluation: b,
             });
         }
+        stops.push(pick::SearchStop {
+            label: label.clone(),
+            scope: scope.clone(),
+            end: r.end,
+            evaluations: r.evaluations.len(),
+        });
         terminations.push((label, scope, r.termination.clone()));
         evaluations.extend(r.evaluations.iter().cloned());
     }
     let per_scope: Vec<Evaluation> = best.iter().map(|b| b.evaluation.clone()).collect();
     let search_pick = best_of(&per_scope, spec.objective);
+    let search_at = search_pick
+        .as_ref()
+        .and_then(|p| per_scope.iter().position(|e| e == p));
     // A simulated pick is the best on fresh samples, not on the search's own.
-    let confirmation = search_pick.as_ref().and_then(|pick| {
+    let confirmation = search_at.and_then(|at| {
         let optima: Vec<(String, evaluate::Candidate)> = best
             .iter()
             .map(|b| (b.scope.clone(), b.evaluation.candidate))
             .collect();
-        let at = per_scope.iter().position(|e| e == pick)?;
         confirm::confirm(
             &evaluator,
             &optima,
@@ -315,10 +328,13 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
             1.0 - plan.file.statistics.alpha,
         )
     });
-    let overall = match &confirmation {
-        Some(c) => Some(per_scope[c.overall].clone()),
-        None => search_pick,
-    };
+    let pick_at = confirmation.as_ref().map(|c| c.overall).or(search_at);
+    let pick = pick::pick_status(
+        pick_at.map(|i| best[i].scope.as_str()),
+        &stops,
+        spec.max_evaluations,
+    );
+    let overall = pick_at.map(|i| per_scope[i].clone());
     if let Some(b) = overall {
         best.push(Best {
             scope: "overall".into(),
@@ -345,6 +361,7 @@ pub fn optimize(plan: &StudyPlan) -> Result<OptimizeOutput, OptimizeError> {
         best,
         dir,
         confirmation,
+        pick,
     })
 }
 
@@ -534,6 +551,13 @@ pub fn evaluations_frame(
             evals
                 .iter()
                 .map(|e| e.constraint.clone())
+                .collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "peak_whirl_over_a_ref_median".into(),
+            evals
+                .iter()
+                .map(|e| e.peak_whirl_over_a_ref)
                 .collect::<Vec<_>>(),
         ),
         Column::new(

@@ -181,6 +181,35 @@ pub struct SearchResult {
     pub termination: String,
     /// Why, in one word: "converged", "budget", "bound", "unconfirmed" or "infeasible".
     pub stop: &'static str,
+    /// How the search itself ended, whether or not its optimum sits on a
+    /// bound (`stop` says "bound" over any of these).
+    pub end: SearchEnd,
+}
+
+/// How a search ended: converged, or why not.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchEnd {
+    /// It met its tolerance and its optimum held against its neighbours.
+    Converged,
+    /// `optimize.max_evaluations` ran out before it met its tolerance.
+    Budget,
+    /// A point better than its optimum was found (a neighbour, or another
+    /// count's optimum) with no budget left to search from there.
+    Unconfirmed,
+    /// No feasible candidate was found.
+    Infeasible,
+}
+
+impl SearchEnd {
+    /// The end of the search in one word, as `stop` spells it.
+    fn from_stop(stop: &str) -> SearchEnd {
+        match stop {
+            "converged" => SearchEnd::Converged,
+            "unconfirmed" => SearchEnd::Unconfirmed,
+            "infeasible" => SearchEnd::Infeasible,
+            _ => SearchEnd::Budget,
+        }
+    }
 }
 
 /// The ρ interval to search for n weights: the bounds, the fit limit and the housing limit.
@@ -293,6 +322,7 @@ pub fn search_slot(evaluator: &Evaluator<'_>, base: Candidate, slot: Slot) -> Se
             evaluations: cost.take_log(),
             termination: "infeasible: no feasible ρ in the scan".into(),
             stop: "infeasible",
+            end: SearchEnd::Infeasible,
         };
     }
     // … then Brent refines it between the neighbouring scan points, and the
@@ -390,6 +420,7 @@ pub fn search_planes(evaluator: &Evaluator<'_>, base: Candidate) -> SearchResult
     let mut evaluations: Vec<Evaluation> = Vec::new();
     let mut words = Vec::new();
     let mut stops = Vec::new();
+    let mut ends = Vec::new();
     let mut start = base;
     let mut previous: Option<(f64, f64)> = None;
     let stages = std::iter::once((Slot::Tied, "one ρ for both planes")).chain(
@@ -401,6 +432,7 @@ pub fn search_planes(evaluator: &Evaluator<'_>, base: Candidate) -> SearchResult
         evaluations.extend(r.evaluations);
         words.push(format!("{name}: {}", r.termination));
         stops.push(r.stop);
+        ends.push(r.end);
         let Some(best) = evaluations.iter().min_by(|a, b| key(a).total_cmp(&key(b))) else {
             break;
         };
@@ -409,6 +441,7 @@ pub fn search_planes(evaluator: &Evaluator<'_>, base: Candidate) -> SearchResult
                 evaluations,
                 termination: words.join("; "),
                 stop: "infeasible",
+                end: SearchEnd::Infeasible,
             };
         }
         start = best.candidate;
@@ -437,10 +470,22 @@ pub fn search_planes(evaluator: &Evaluator<'_>, base: Candidate) -> SearchResult
         .copied()
         .min_by_key(|s| rank(s))
         .unwrap_or("budget");
+    // Converged only when both of the last stages did.
+    let last = &ends[ends.len().saturating_sub(2)..];
+    let end = last
+        .iter()
+        .copied()
+        .find(|e| *e != SearchEnd::Converged)
+        .unwrap_or(if last.is_empty() {
+            SearchEnd::Budget
+        } else {
+            SearchEnd::Converged
+        });
     SearchResult {
         evaluations,
         termination: words.join("; "),
         stop,
+        end,
     }
 }
 
@@ -476,6 +521,7 @@ fn finish(
             }
         ),
     };
+    let end = SearchEnd::from_stop(stop);
     let mut stop = stop;
     if let Some(note) = best
         .as_ref()
@@ -488,6 +534,7 @@ fn finish(
         evaluations: cost.take_log(),
         termination: text,
         stop,
+        end,
     }
 }
 
@@ -751,6 +798,7 @@ mod tests {
             feasible: true,
             constraint: "ok".into(),
             phase: "test",
+            peak_whirl_over_a_ref: None,
         }
     }
 

@@ -544,3 +544,248 @@ fn the_pick_is_printed_as_a_part() {
         "{pick}"
     );
 }
+
+/// `study optimize` on `text` (written to `dir`/s.toml) with `args`.
+fn optimize_cli(dir: &Path, text: &str, args: &[&str]) -> std::process::Output {
+    let path = dir.join("s.toml");
+    std::fs::write(&path, text).unwrap();
+    std::process::Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["optimize", path.to_str().unwrap(), "--wide"])
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// The corpus study with a simulated objective and `max_evaluations`.
+fn settling_text(results: &Path, max_evaluations: u64) -> String {
+    crate::bad_input::study(results)
+        + &format!(
+            "[optimize]\nobjective = \"settling_mean\"\nmax_evaluations = {max_evaluations}\nconfirm_samples = 0\n"
+        )
+}
+
+/// A search that ends on its budget gives a candidate, not a part: with
+/// `max_evaluations = 4` the ρ scan spends the whole budget, and the last
+/// line says "pick: unconfirmed" with why, then the best candidate (before,
+/// it printed "pick: 3 balls of …" as final).
+#[test]
+fn a_pick_whose_search_ended_on_its_budget_is_printed_unconfirmed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = optimize_cli(
+        tmp.path(),
+        &settling_text(&tmp.path().join("results"), 4),
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let pick = stdout
+        .lines()
+        .find(|l| l.starts_with("pick: "))
+        .unwrap_or_else(|| panic!("no pick line: {stdout}"));
+    assert!(
+        pick.starts_with(
+            "pick: unconfirmed — the search for ball n = 3 ended on its budget of 4 evaluations without converging; 1 of 1 searches did not converge"
+        ),
+        "{pick}"
+    );
+    assert!(
+        pick.contains("Best candidate found, not a final part: 3 balls of "),
+        "{pick}"
+    );
+    // The library says so, typed: the pick's own search ended on its budget.
+    let plan = {
+        let text = settling_text(&tmp.path().join("again"), 4);
+        StudyFile::parse(&text, "s.toml")
+            .unwrap()
+            .plan(&text, "s.toml")
+            .unwrap()
+    };
+    match optimize(&plan).unwrap().pick {
+        autobal::optimize::pick::PickStatus::Unconfirmed { pick, budget, .. } => {
+            assert_eq!(
+                (pick.end, budget),
+                (autobal::optimize::search::SearchEnd::Budget, 4)
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// `--threads 1` and `--threads 2` print the same and write the same
+/// optimize.parquet and optimum.parquet, bit for bit.
+#[test]
+fn optimize_threads_give_identical_outputs() {
+    use autobal::study::results::io::read_parquet;
+    let run = |threads: &str| {
+        let tmp = tempfile::tempdir().unwrap();
+        let text = settling_text(&tmp.path().join("results"), 6)
+            .replace("n = 3\n", "n = [3, 4]\n")
+            .replace("confirm_samples = 0", "confirm_samples = 2");
+        let out = optimize_cli(tmp.path(), &text, &["--threads", threads]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let folder = tmp.path().join("results").join("corpus");
+        let frames =
+            ["optimize.parquet", "optimum.parquet"].map(|f| read_parquet(&folder.join(f)).unwrap());
+        (String::from_utf8_lossy(&out.stdout).to_string(), frames)
+    };
+    let (one, two) = (run("1"), run("2"));
+    assert_eq!(one.0, two.0);
+    for (a, b) in one.1.iter().zip(&two.1) {
+        assert!(a.height() > 0);
+        assert!(a.equals_missing(b), "{a}\n{b}");
+    }
+}
+
+/// `optimize.max_peak_over_a_ref` makes the candidates whose median
+/// start-up whirl exceeds it infeasible: set just below the unconstrained
+/// pick's, that pick is excluded, and every candidate is feasible exactly
+/// when its median is within the limit.
+#[test]
+fn a_start_up_whirl_limit_excludes_the_candidates_above_it() {
+    let constrained = |limit: Option<f64>| {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = plan(
+            tmp.path(),
+            "kind = \"ball\"\nn = [2, 3, 4]\nrho = \"optimal\"\ndrag = 10.0",
+            "samples = 4\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }\ninitial = \"clustered\"",
+            &format!(
+                "objective = \"settling_mean\"\nmax_evaluations = 6\nconfirm_samples = 0\n{}",
+                limit.map_or(String::new(), |l| format!("max_peak_over_a_ref = {l}"))
+            ),
+        );
+        optimize(&p).unwrap()
+    };
+    let free = constrained(None);
+    let pick = |out: &autobal::optimize::OptimizeOutput| {
+        out.best
+            .iter()
+            .find(|b| b.scope == "overall")
+            .map(|b| b.evaluation.clone())
+    };
+    let before = pick(&free).unwrap();
+    let peak = before.peak_whirl_over_a_ref.unwrap();
+    assert!(
+        peak > 1.0,
+        "the clustered start whirls beyond A_ref: {peak}"
+    );
+    // Without the limit the whirl is recorded and nothing is excluded for it.
+    assert!(free.evaluations.iter().all(|e| e.feasible));
+    let limit = 0.999 * peak;
+    let out = constrained(Some(limit));
+    let mut excluded = 0;
+    for e in &out.evaluations {
+        let p = e.peak_whirl_over_a_ref.unwrap();
+        assert_eq!(e.feasible, p <= limit, "{e:?}");
+        if !e.feasible {
+            excluded += 1;
+            assert!(
+                e.constraint.contains("optimize.max_peak_over_a_ref"),
+                "{e:?}"
+            );
+            assert_eq!(e.value, None);
+        }
+    }
+    assert!(excluded > 0);
+    match pick(&out) {
+        Some(after) => {
+            assert_ne!(after.candidate, before.candidate);
+            assert!(after.peak_whirl_over_a_ref.unwrap() <= limit);
+        }
+        None => assert_eq!(out.pick, autobal::optimize::pick::PickStatus::None),
+    }
+}
+
+/// A start-up whirl limit that is not positive is refused, naming the key.
+#[test]
+fn a_bad_start_up_whirl_limit_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = settling_text(&tmp.path().join("results"), 6)
+        .replace("[optimize]\n", "[optimize]\nmax_peak_over_a_ref = -1.0\n");
+    let out = optimize_cli(tmp.path(), &text, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("optimize.max_peak_over_a_ref = -1: must be positive and finite"),
+        "{stderr}"
+    );
+    assert!(!tmp.path().join("results").exists());
+}
+
+/// The summary's start-up whirl columns are the median and 95th
+/// percentile of each design's `peak_r / a_ref`, recomputed here from
+/// runs.parquet.
+#[test]
+fn the_summarys_start_up_whirl_is_the_runs_peak_over_a_ref() {
+    use autobal::study::results::io::read_parquet;
+    use autobal::study::run::{NoProgress, RunOptions, run_study};
+    let tmp = tempfile::tempdir().unwrap();
+    let p = plan(
+        tmp.path(),
+        "kind = \"ball\"\nn = [3, 4]\nrho = \"optimal\"\ndrag = 10.0",
+        "samples = 5\nunbalance = { distribution = \"uniform\", min = 0.2, max = 0.8, relative_to = \"capacity\" }\ninitial = \"clustered\"",
+        "objective = \"settling_mean\"",
+    );
+    let out = run_study(&p, &RunOptions::default(), &NoProgress).unwrap();
+    let summary = out.summary.unwrap();
+    let runs = read_parquet(&out.dir.join("runs.parquet")).unwrap();
+    let col = |name: &str| -> Vec<f64> {
+        runs.column(name)
+            .unwrap()
+            .f64()
+            .unwrap()
+            .into_no_null_iter()
+            .collect()
+    };
+    let (peak, a_ref) = (col("peak_r"), col("a_ref"));
+    let design: Vec<u32> = runs
+        .column("design_id")
+        .unwrap()
+        .u32()
+        .unwrap()
+        .into_no_null_iter()
+        .collect();
+    let outcome: Vec<String> = runs
+        .column("outcome")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .map(|o| o.unwrap().to_string())
+        .collect();
+    assert!(outcome.iter().all(|o| o == "settled" || o == "censored"));
+    let ids = summary.column("design_id").unwrap().u32().unwrap().clone();
+    let median = summary
+        .column("peak_whirl_over_a_ref_median")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .clone();
+    let p95 = summary
+        .column("peak_whirl_over_a_ref_p95")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .clone();
+    for (row, id) in ids.into_no_null_iter().enumerate() {
+        let mut r: Vec<f64> = (0..runs.height())
+            .filter(|&i| design[i] == id)
+            .map(|i| peak[i] / a_ref[i])
+            .collect();
+        r.sort_by(f64::total_cmp);
+        assert_eq!(r.len(), 5);
+        // Five runs: the median is the third, the p95 0.8 of the way from the fourth to the fifth.
+        assert_eq!(median.get(row), Some(r[2]));
+        let want = r[3] + 0.8 * (r[4] - r[3]);
+        let got = p95.get(row).unwrap();
+        assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+        assert!(r[2] > 1.0, "clustered weights whirl beyond A_ref: {r:?}");
+    }
+}

@@ -3,6 +3,8 @@
 use crate::UserError;
 use crate::output::{dropped_note, fitted_table, say_err, text_width, wrap};
 use autobal::optimize::optimize;
+use autobal::optimize::pick::PickStatus;
+use autobal::optimize::search::SearchEnd;
 use autobal::optimize::spec::Objective;
 use autobal::output_file::WhenExists;
 use autobal::study::plan::config::load;
@@ -23,6 +25,9 @@ pub struct OptimizeArgs {
     /// Replace the study folder's optimize.parquet and optimum.parquet if they exist.
     #[arg(long)]
     overwrite: bool,
+    /// Worker threads (default: all cores, or RAYON_NUM_THREADS); the results do not depend on it.
+    #[arg(long, value_parser = crate::limits::threads)]
+    threads: Option<usize>,
 }
 
 /// Run `study optimize`.
@@ -35,15 +40,10 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
         &["optimize.parquet", "optimum.parquet"],
         WhenExists::from_overwrite(args.overwrite),
     )?;
-    let out = optimize(&plan)?;
+    let out = worker_pool(args.threads)?.install(|| optimize(&plan))?;
     let spec = plan.file.optimize.clone();
-    let objective = spec.as_ref().map_or("", |o| o.objective.name());
     let unit = spec.as_ref().map_or("", |o| o.objective.unit());
-    let objective_header = if unit.is_empty() {
-        objective.to_string()
-    } else {
-        format!("{objective}\n{unit}")
-    };
+    let objective_header = objective_header(spec.as_ref());
     // A residual in metres (µm-sized) would print as 0.00000 at the other
     // objectives' five decimals.
     let metres = plan
@@ -147,6 +147,26 @@ pub fn run(args: &OptimizeArgs) -> Result<(), UserError> {
     Ok(())
 }
 
+/// The pool the searches and their runs share, of `--threads` workers
+/// (default: rayon's), as `study run --threads` builds its own.
+fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, UserError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(crate::limits::capped_threads(threads).unwrap_or(0))
+        .build()
+        .map_err(|e| UserError::internal(e.to_string()))
+}
+
+/// The objective column's header: its name, and its unit below.
+fn objective_header(spec: Option<&autobal::optimize::spec::OptimizeSpec>) -> String {
+    let objective = spec.map_or("", |o| o.objective.name());
+    let unit = spec.map_or("", |o| o.objective.unit());
+    if unit.is_empty() {
+        objective.to_string()
+    } else {
+        format!("{objective}\n{unit}")
+    }
+}
+
 /// A candidate's kind, n and ρ cells: "plane 0/plane 1" where a second
 /// plane's weights are its own.
 fn design_cells(c: &autobal::optimize::evaluate::Candidate) -> [String; 3] {
@@ -226,7 +246,9 @@ fn confirmation_lines(
     text
 }
 
-/// The overall pick as a part to build, in mm and g ("pick: 5 balls of …").
+/// The overall pick as a part to build, in mm and g ("pick: 5 balls of …");
+/// "pick: unconfirmed — why" and the best candidate found when the pick's
+/// own search did not converge.
 fn pick_line(
     plan: &autobal::study::plan::config::StudyPlan,
     out: &autobal::optimize::OptimizeOutput,
@@ -242,7 +264,35 @@ fn pick_line(
         spec,
         samples: 0,
     };
-    evaluator
-        .part(&pick.evaluation.candidate)
-        .map_or(String::new(), |part| format!("pick: {part}\n"))
+    let Some(part) = evaluator.part(&pick.evaluation.candidate) else {
+        return String::new();
+    };
+    match &out.pick {
+        PickStatus::Unconfirmed {
+            pick,
+            budget,
+            searches,
+            unconverged,
+        } => format!(
+            "pick: unconfirmed — {}; {unconverged} of {searches} searches did not converge (raise optimize.max_evaluations). Best candidate found, not a final part: {part}\n",
+            unconverged_why(pick, *budget)
+        ),
+        PickStatus::Final | PickStatus::None => format!("pick: {part}\n"),
+    }
+}
+
+/// Why a search's optimum is not final, in a clause.
+fn unconverged_why(s: &autobal::optimize::pick::SearchStop, budget: u64) -> String {
+    match s.end {
+        SearchEnd::Budget => format!(
+            "the search for {} ended on its budget of {budget} evaluations without converging",
+            s.label
+        ),
+        SearchEnd::Unconfirmed => format!(
+            "the search for {} found a point better than its optimum with too little of its budget of {budget} evaluations left to search from there",
+            s.label
+        ),
+        SearchEnd::Infeasible => format!("the search for {} found no feasible candidate", s.label),
+        SearchEnd::Converged => format!("the search for {} converged", s.label),
+    }
 }

@@ -113,6 +113,12 @@ pub struct OptimizeSpec {
     /// Largest unbalance the machine meets (kg·m), for the capacity constraint.
     #[serde(default)]
     pub max_unbalance: Option<f64>,
+    /// Largest start-up whirl allowed: a candidate whose runs' median
+    /// `peak_r / a_ref` (the summary's `peak_whirl_over_a_ref_median`, on
+    /// the search's samples) exceeds it is infeasible. With an analytic
+    /// objective the candidates are simulated for it.
+    #[serde(default)]
+    pub max_peak_over_a_ref: Option<f64>,
     /// Smallest weight count allowed (e.g. 3, as seed 000 recommends).
     #[serde(default)]
     pub min_n: Option<u32>,

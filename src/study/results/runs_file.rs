@@ -230,9 +230,11 @@ pub const PLANE_SUMMARY_COLUMNS: [&str; 3] =
     ["plane_settling_revs", "plane_residual_abs", "plane_a_ref"];
 
 /// Columns the summary reads when a file has them: how contact was
-/// modelled, and the pack's slip rate (files written before the columns
-/// have none).
-pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 2] = ["contact_model", "pack_slip_rate"];
+/// modelled and the pack's slip rate (files written before the columns
+/// have none), and each run's peak whirl (the start-up whirl columns; every
+/// file has it, but a table built without it still summarises, with those
+/// columns empty).
+pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 3] = ["contact_model", "pack_slip_rate", "peak_r"];
 
 /// The summary's projection of the file at `path`: [`SUMMARY_COLUMNS`], and
 /// [`PLANE_SUMMARY_COLUMNS`] and [`OPTIONAL_SUMMARY_COLUMNS`] where the file

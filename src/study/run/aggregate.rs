@@ -64,6 +64,7 @@ pub fn summarize_table(plan: &StudyPlan, df: &DataFrame) -> PolarsResult<DataFra
         study.scale.tau,
         study.clock,
     )?;
+    append_peak_whirl(&mut summary, df)?;
     Ok(summary)
 }
 
@@ -763,6 +764,51 @@ fn plane_medians(lists: Option<&[Vec<Option<f64>>]>) -> Vec<f64> {
             quantile_sorted(&v, 0.5, Interpolation::Linear).unwrap_or(f64::NAN)
         })
         .collect()
+}
+
+/// The start-up whirl columns, in the summary's design order: the median
+/// and 95th percentile of each design's runs' `peak_r / a_ref`
+/// ([`crate::metrics::peak_whirl`]); null where no run has one, or the runs
+/// table has no `peak_r`.
+fn append_peak_whirl(summary: &mut DataFrame, runs: &DataFrame) -> PolarsResult<()> {
+    let ids: Vec<Option<u32>> = summary.column("design_id")?.u32()?.iter().collect();
+    let mut stats = vec![None; ids.len()];
+    if let Ok(peak) = runs.column("peak_r") {
+        let peak = peak.f64()?;
+        let design = runs.column("design_id")?.u32()?;
+        let a_ref = runs.column("a_ref")?.f64()?;
+        let outcome = runs.column("outcome")?.str()?;
+        let mut ratios = vec![Vec::new(); ids.len()];
+        for i in 0..runs.height() {
+            let row = design
+                .get(i)
+                .and_then(|d| ids.iter().position(|&id| id == Some(d)));
+            let ratio = match (
+                outcome.get(i).and_then(Outcome::parse),
+                peak.get(i),
+                a_ref.get(i),
+            ) {
+                (Some(o), Some(p), Some(a)) => crate::metrics::peak_whirl::peak_over_a_ref(o, p, a),
+                _ => None,
+            };
+            if let (Some(row), Some(ratio)) = (row, ratio) {
+                ratios[row].push(ratio);
+            }
+        }
+        stats = ratios
+            .into_iter()
+            .map(crate::metrics::peak_whirl::median_and_p95)
+            .collect();
+    }
+    summary.with_column(Column::new(
+        "peak_whirl_over_a_ref_median".into(),
+        stats.iter().map(|s| s.map(|s| s.0)).collect::<Vec<_>>(),
+    ))?;
+    summary.with_column(Column::new(
+        "peak_whirl_over_a_ref_p95".into(),
+        stats.iter().map(|s| s.map(|s| s.1)).collect::<Vec<_>>(),
+    ))?;
+    Ok(())
 }
 
 /// A_ref per watched plane (or the rotor's alone) of each run of `mine`
