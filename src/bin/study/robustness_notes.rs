@@ -3,11 +3,14 @@
 //! most of #1's settling time.
 
 use crate::UserError;
+use crate::sensitivity_cmd::{Total, sampled_apart, shown};
 use autobal::decide::decision::StudyDecision;
 use autobal::decide::robustness::{PARTS, robustness};
 use autobal::study::plan::config::StudyPlan;
 use autobal::study::results::io::read_parquet;
-use autobal::study::sensitivity::{FILE as SENSITIVITY_FILE, Measure, read_totals};
+use autobal::study::sensitivity::{
+    FILE as SENSITIVITY_FILE, InputKind, InputTotal, Measure, read_totals,
+};
 use polars::prelude::DataFrame;
 use std::path::Path;
 
@@ -82,17 +85,7 @@ pub fn robustness_findings(
     out += ".";
     let mut findings = vec![out];
     match read_totals(plan, dir, crown, Measure::RestrictedSettling) {
-        Some(totals) => {
-            let top = &totals[0];
-            let (input, total, (lo, hi)) = (&top.input, top.total, top.interval);
-            let c = |x: f64| x.clamp(0.0, 1.0);
-            findings.push(format!(
-                "{input} has the largest total index on #1's settling time capped at the horizon: S_T = {:.2} [{:.2}, {:.2}] ({SENSITIVITY_FILE}; the share of its variance the input accounts for, interactions included).",
-                c(total),
-                c(lo),
-                c(hi)
-            ));
-        }
+        Some(totals) => findings.push(totals_sentence(&totals)),
         None => {
             if let Some(top) = r.explained.first() {
                 findings.push(format!(
@@ -111,4 +104,40 @@ pub fn robustness_findings(
 /// A criterion value as printed.
 fn value(v: Option<f64>) -> String {
     v.map_or("–".into(), |x| autobal::number_text::significant(x, 4))
+}
+
+/// The largest total index among the uncertain keys from
+/// sensitivity.parquet, and the sampled inputs apart.
+fn totals_sentence(totals: &[InputTotal]) -> String {
+    let all: Vec<Total> = totals
+        .iter()
+        .map(|t| Total {
+            input: &t.input,
+            kind: t.kind,
+            total: t.total,
+            interval: t.interval,
+        })
+        .collect();
+    let top = totals
+        .iter()
+        .filter(|t| t.kind == InputKind::MachineUnknown)
+        .max_by(|a, b| a.total.total_cmp(&b.total));
+    let mut out = match top {
+        Some(t) => format!(
+            "of the uncertain keys, {} has the largest total index on #1's settling time capped at the horizon: S_T = {} ({SENSITIVITY_FILE}; the share of its variance the key accounts for, interactions included{})",
+            t.input,
+            shown(t.total, t.interval),
+            // As printed: an interval that shows 0.00 reaches 0.
+            if t.interval.0 < 0.005 {
+                "; its interval reaches 0: not distinguishable from no effect"
+            } else {
+                ""
+            }
+        ),
+        None => format!("{SENSITIVITY_FILE} has no index for the uncertain keys"),
+    };
+    if let Some(rest) = sampled_apart(&all) {
+        out += &format!("; {rest}");
+    }
+    out + "."
 }
