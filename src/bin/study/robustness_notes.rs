@@ -78,7 +78,7 @@ fn thirds_sentence(r: &Robustness, keys: usize) -> String {
         if r.parts.iter().flat_map(|p| &p.tests).all(|t| t.paired) {
             "paired by sample"
         } else {
-            "unpaired where the samples differ"
+            "unpaired (the designs did not share their samples)"
         },
         r.alpha
     );
