@@ -57,9 +57,10 @@ RESULTS_LAYERS = [
     {"design_runs"},
 ]
 DECIDE_LAYERS = [
-    {"measure", "diagnosis", "failures", "robustness"},
+    {"measure", "diagnosis", "failures"},
     {"verdict", "plane_summary"},
-    {"decision", "compare_designs"},
+    # Robustness tests #1 within each third by the verdicts' rule.
+    {"decision", "compare_designs", "robustness"},
 ]
 RUN_LAYERS = [
     {"lock", "racing"},

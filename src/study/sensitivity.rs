@@ -39,6 +39,37 @@ pub struct SensitivityInput {
     pub name: String,
     /// The stream it draws from.
     pub input: Input,
+    /// What kind of input it is to the engineer.
+    pub kind: InputKind,
+}
+
+/// What an input is to the engineer who reads its index. Only a machine
+/// unknown is something to measure or specify before building: the
+/// unbalance and the start are what the balancer meets in service, and a
+/// tolerance is the spread of the balancer's own parts, so a headline on
+/// "which input matters" names the largest machine unknown and reports the
+/// others apart (before 2026-12 it named "unbalance (size, direction)").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputKind {
+    /// An `[uncertain]` scene key: the machine's physics, known only to a
+    /// distribution.
+    MachineUnknown,
+    /// A sampled operating condition: the unbalance (size and direction),
+    /// the start angles, the couple part.
+    OperatingCondition,
+    /// A manufacturing tolerance of the balancer's parts.
+    Tolerance,
+}
+
+impl InputKind {
+    /// Its name in sensitivity.parquet's `input_kind` column.
+    pub fn name(self) -> &'static str {
+        match self {
+            InputKind::MachineUnknown => "machine_unknown",
+            InputKind::OperatingCondition => "operating_condition",
+            InputKind::Tolerance => "tolerance",
+        }
+    }
 }
 
 /// The inputs a study samples, in a fixed order: the unbalance, the start
@@ -48,6 +79,12 @@ pub fn inputs(plan: &StudyPlan) -> Vec<SensitivityInput> {
     let stream = |name: &str, purpose| SensitivityInput {
         name: name.to_string(),
         input: Input::Stream(purpose),
+        kind: match purpose {
+            Purpose::MassTolerance | Purpose::RadiusTolerance | Purpose::EccentricityTolerance => {
+                InputKind::Tolerance
+            }
+            _ => InputKind::OperatingCondition,
+        },
     };
     let mut out = Vec::new();
     let fixed_size = matches!(s.unbalance.distribution, Distribution::Fixed { .. });
@@ -86,6 +123,7 @@ pub fn inputs(plan: &StudyPlan) -> Vec<SensitivityInput> {
     out.extend(plan.file.uncertain.keys().map(|key| SensitivityInput {
         name: key.clone(),
         input: Input::Key(key_hash(key)),
+        kind: InputKind::MachineUnknown,
     }));
     out
 }
@@ -168,6 +206,8 @@ pub struct SensitivityRow {
     pub measure: Measure,
     /// The input's name.
     pub input: String,
+    /// What kind of input it is.
+    pub kind: InputKind,
     /// First-order and total indices with their intervals; `None` with a
     /// note when the measure did not vary (or had too few rows).
     pub index: Option<SobolIndex>,
@@ -269,6 +309,7 @@ pub fn estimate(
                     design_id: design.id,
                     measure,
                     input: input.name.clone(),
+                    kind: input.kind,
                     index,
                     rows: kept.len() as u32,
                     note,
@@ -296,6 +337,8 @@ pub fn write(plan: &StudyPlan, rows: &[SensitivityRow]) -> PolarsResult<std::pat
 pub struct InputTotal {
     /// The input's name.
     pub input: String,
+    /// What kind of input it is (from the study's inputs, by name).
+    pub kind: InputKind,
     /// Its total index (raw estimate).
     pub total: f64,
     /// The index's 95 % bootstrap interval.
@@ -327,11 +370,14 @@ pub fn read_totals(
     );
     let (d, m, input) = (d.u32().ok()?, m.str().ok()?, input.str().ok()?);
     let (t, lo, hi) = (t.f64().ok()?, lo.f64().ok()?, hi.f64().ok()?);
+    let kinds = inputs(plan);
     let mut out: Vec<InputTotal> = (0..df.height())
         .filter(|&i| d.get(i) == Some(design) && m.get(i) == Some(measure.name()))
         .filter_map(|i| {
+            let name = input.get(i)?;
             Some(InputTotal {
-                input: input.get(i)?.to_string(),
+                input: name.to_string(),
+                kind: kinds.iter().find(|k| k.name == name)?.kind,
                 total: t.get(i)?,
                 interval: (lo.get(i)?, hi.get(i)?),
             })
@@ -354,6 +400,7 @@ pub fn to_dataframe(rows: &[SensitivityRow]) -> PolarsResult<DataFrame> {
         "design_id" => rows.iter().map(|r| r.design_id).collect::<Vec<_>>(),
         "measure" => rows.iter().map(|r| r.measure.name()).collect::<Vec<_>>(),
         "input" => rows.iter().map(|r| r.input.clone()).collect::<Vec<_>>(),
+        "input_kind" => rows.iter().map(|r| r.kind.name()).collect::<Vec<_>>(),
         "first_order" => pick(|i| i.first),
         "first_order_lo" => pick(|i| i.first_ci.0),
         "first_order_hi" => pick(|i| i.first_ci.1),

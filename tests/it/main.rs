@@ -57,6 +57,7 @@ mod return_when_dearer;
 mod rigid_agreement;
 mod rigid_contact;
 mod rigid_drum;
+mod robustness;
 mod rolling_resistance;
 mod sample_bounds;
 mod schema;

@@ -5,7 +5,7 @@ use autobal::study::plan::config::{StudyFile, StudyPlan};
 use autobal::study::plan::stream::Sequence;
 use autobal::study::run::run_one;
 use autobal::study::sensitivity::{
-    Measure, SensitivityRow, SensitivitySettings, estimate, inputs, run_pick_freeze,
+    InputKind, Measure, SensitivityRow, SensitivitySettings, estimate, inputs, run_pick_freeze,
 };
 
 /// Two- and three-ball designs on the main job's rotor, with the rotor's
@@ -72,17 +72,23 @@ fn index<'a>(
         .unwrap()
 }
 
-/// The study's inputs, in order: its own streams, then its uncertain keys.
+/// The study's inputs, in order: its own streams (sampled operating
+/// conditions), then its uncertain keys (the machine unknowns).
 #[test]
 fn the_inputs_are_the_studys_streams_and_keys() {
-    let names: Vec<String> = inputs(&plan("sobol")).into_iter().map(|i| i.name).collect();
+    let found: Vec<(String, InputKind)> = inputs(&plan("sobol"))
+        .into_iter()
+        .map(|i| (i.name, i.kind))
+        .collect();
+    let condition = InputKind::OperatingCondition;
+    let unknown = InputKind::MachineUnknown;
     assert_eq!(
-        names,
+        found,
         [
-            "unbalance (size, direction)",
-            "start angles",
-            "rotor.bx",
-            "rotor.inertia"
+            ("unbalance (size, direction)".to_string(), condition),
+            ("start angles".to_string(), condition),
+            ("rotor.bx".to_string(), unknown),
+            ("rotor.inertia".to_string(), unknown)
         ]
     );
 }
@@ -166,9 +172,19 @@ fn robustness_names_the_third_where_the_decision_turns() {
     assert!(bx[0].range.1 < 120.0 && bx[1].range.0 >= 120.0, "{bx:?}");
     // A key that did not vary cuts nothing and is not counted.
     assert!(r.parts.iter().all(|p| p.key == "rotor.bx"));
-    assert_eq!(r.kept(), 2);
+    // Design 0's 10 rev against #1's 60 on all 20 paired samples: a finding
+    // at any α, Holm-adjusted over the three thirds' tests.
+    let turns = r.turns();
+    assert_eq!(turns.len(), 1);
+    assert_eq!((turns[0].0.part, turns[0].1.design), (0, 0));
+    assert!(turns[0].1.p_holm < 1e-4 && r.third_tests() == 3, "{r:?}");
     // The damping explains design 1's settling not at all (it is constant).
-    assert!(r.explained.iter().all(|e| e.share == 0.0));
+    assert!(
+        r.explained
+            .iter()
+            .all(|e| e.share == 0.0 && e.p_value == 1.0)
+    );
+    assert!(r.credited().is_none());
 }
 
 /// From the command line: the cost first, sensitivity.parquet written into
@@ -215,8 +231,92 @@ fn the_cli_writes_the_indices_and_refuses_bad_flags() {
     let written = dir.path().join("sens/sensitivity.parquet");
     let df = autobal::study::results::io::read_parquet(&written).unwrap();
     assert_eq!(df.height(), 3 * 4);
+    let (input, kind) = (
+        df.column("input").unwrap().str().unwrap().clone(),
+        df.column("input_kind").unwrap().str().unwrap().clone(),
+    );
+    let kinds: Vec<(String, String)> = (0..df.height())
+        .map(|i| {
+            let text = |c: &polars::prelude::StringChunked| c.get(i).unwrap().to_string();
+            (text(&input), text(&kind))
+        })
+        .collect();
+    for (input, kind) in &kinds {
+        let unknown = input.starts_with("rotor.");
+        assert_eq!(kind == "machine_unknown", unknown, "{input}: {kind}");
+        assert!(unknown || kind == "operating_condition", "{input}: {kind}");
+    }
     assert_eq!(
         study(&["--rows", "8", "--designs", "1"]).status.code(),
         Some(2)
+    );
+}
+
+/// The headline of `study sensitivity` names the largest total index among
+/// the uncertain keys, the machine unknowns, and reports the unbalance and
+/// the start apart as sampled operating conditions, however large their
+/// index; `study report` on the same folder, which then has
+/// sensitivity.parquet, words it the same way.
+#[test]
+fn the_headline_names_a_machine_unknown_and_the_conditions_apart() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let study = text("sobol")
+        .replace(
+            "seed = 5",
+            &format!("seed = 5\noutput = \"{}\"", dir.path().display()),
+        )
+        .replace("samples = 64", "samples = 16");
+    let file = dir.path().join("sens.toml");
+    std::fs::write(&file, study).unwrap();
+    let cli = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_study"))
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {stderr}");
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let file = file.to_str().unwrap();
+    cli(&["run", file, "--quiet"]);
+    let text = cli(&["sensitivity", file, "--rows", "8"]);
+    // Design 1's headline, with its wrapped continuation lines.
+    let from = text
+        .find("largest total index on design 1")
+        .expect("headline");
+    let line = text[from..]
+        .lines()
+        .enumerate()
+        .take_while(|(i, l)| *i == 0 || l.starts_with(' '))
+        .map(|(_, l)| l.trim())
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert!(
+        line.starts_with("largest total index on design 1's settling time among the machine unknowns ([uncertain] keys): rotor."),
+        "{text}"
+    );
+    let apart = "operating conditions (sampled, not machine unknowns): ";
+    let after = &line[line.find(apart).expect(apart) + apart.len()..];
+    assert!(
+        after.contains("unbalance (size, direction) S_T = ")
+            && after.contains("start angles S_T = "),
+        "{line}"
+    );
+    assert!(!after.contains("rotor."), "{line}");
+    let folder = dir.path().join("sens");
+    let page = dir.path().join("report.html");
+    cli(&[
+        "report",
+        folder.to_str().unwrap(),
+        "--out",
+        page.to_str().unwrap(),
+    ]);
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("of the uncertain keys, rotor.")
+            && html.contains("has the largest total index on #1")
+            && html.contains(apart),
+        "the report's robustness findings"
     );
 }

@@ -8,8 +8,8 @@ use autobal::study::plan::config::load;
 use autobal::study::plan::stream::{SOBOL_MAX_SAMPLES, Sequence};
 use autobal::study::run::study_folder::claim;
 use autobal::study::sensitivity::{
-    FILE, Measure, SensitivityRow, SensitivitySettings, estimate, inputs, run_pick_freeze,
-    runs_needed, write,
+    FILE, InputKind, Measure, SensitivityRow, SensitivitySettings, estimate, inputs,
+    run_pick_freeze, runs_needed, write,
 };
 use clap::Args;
 use std::path::PathBuf;
@@ -208,24 +208,97 @@ fn print_design(id: u32, describe: &str, rows: &[SensitivityRow]) {
             say(&format!("{}: no index ({note})", m.name()));
         }
     }
-    if let Some(top) = mine
+    let settling: Vec<Total> = mine
         .iter()
         .filter(|r| r.measure == Measure::RestrictedSettling)
-        .filter_map(|r| Some((r, r.index.as_ref()?)))
-        .max_by(|a, b| a.1.total.total_cmp(&b.1.total))
-    {
-        say(&format!(
-            "largest total index on design {id}'s settling time: {}, S_T = {}",
-            top.0.input,
-            shown(top.1.total, top.1.total_ci)
-        ));
+        .filter_map(|r| {
+            let i = r.index.as_ref()?;
+            Some(Total {
+                input: &r.input,
+                kind: r.kind,
+                total: i.total,
+                interval: i.total_ci,
+            })
+        })
+        .collect();
+    if let Some(line) = headline(&format!("design {id}'s settling time"), &settling) {
+        say(&line);
     }
+}
+
+/// One input's total index as a headline names it.
+pub struct Total<'a> {
+    /// The input's name.
+    pub input: &'a str,
+    /// What kind of input it is.
+    pub kind: InputKind,
+    /// Its total index (raw estimate).
+    pub total: f64,
+    /// Its interval.
+    pub interval: (f64, f64),
+}
+
+/// Which input matters for `what`: the largest total index among the
+/// machine unknowns (the `[uncertain]` keys, what an engineer can measure
+/// or specify), then the sampled inputs apart ([`sampled_apart`]); `None`
+/// without indices.
+fn headline(what: &str, totals: &[Total]) -> Option<String> {
+    if totals.is_empty() {
+        return None;
+    }
+    let unknown = totals
+        .iter()
+        .filter(|t| t.kind == InputKind::MachineUnknown)
+        .max_by(|a, b| a.total.total_cmp(&b.total));
+    let first = match unknown {
+        Some(top) => format!(
+            "largest total index on {what} among the machine unknowns ([uncertain] keys): {}, S_T = {}",
+            top.input,
+            shown(top.total, top.interval)
+        ),
+        None => "no machine unknowns ([uncertain] keys) to name".to_string(),
+    };
+    Some(match sampled_apart(totals) {
+        Some(rest) => format!("{first}; {rest}"),
+        None => first,
+    })
+}
+
+/// The sampled inputs that are not machine unknowns, each kind apart and
+/// largest total index first: "operating conditions (sampled, not machine
+/// unknowns): unbalance (size, direction) S_T = …"; `None` when there are none.
+pub fn sampled_apart(totals: &[Total]) -> Option<String> {
+    let group = |kind: InputKind, label: &str| {
+        let mut mine: Vec<&Total> = totals.iter().filter(|t| t.kind == kind).collect();
+        mine.sort_by(|a, b| b.total.total_cmp(&a.total));
+        (!mine.is_empty()).then(|| {
+            let each: Vec<String> = mine
+                .iter()
+                .map(|t| format!("{} S_T = {}", t.input, shown(t.total, t.interval)))
+                .collect();
+            format!("{label}: {}", each.join(", "))
+        })
+    };
+    let parts: Vec<String> = [
+        group(
+            InputKind::OperatingCondition,
+            "operating conditions (sampled, not machine unknowns)",
+        ),
+        group(
+            InputKind::Tolerance,
+            "manufacturing tolerances (sampled, not machine unknowns)",
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    (!parts.is_empty()).then(|| parts.join("; "))
 }
 
 /// An index and its interval as printed: a share, so clipped to [0, 1]
 /// (beyond is the estimator's noise; sensitivity.parquet keeps the raw
 /// estimates).
-fn shown(value: f64, (lo, hi): (f64, f64)) -> String {
+pub fn shown(value: f64, (lo, hi): (f64, f64)) -> String {
     let c = |x: f64| x.clamp(0.0, 1.0);
     format!("{:.2} [{:.2}, {:.2}]", c(value), c(lo), c(hi))
 }

@@ -55,6 +55,12 @@ pub enum Purpose {
     /// Draws of a rig's unknowns and synthetic measurement noise
     /// (`crate::calibrate`).
     Calibration = 12,
+    /// Bootstrap resampling of #1 against another design within one third
+    /// of an uncertain key's range (`crate::decide::robustness`).
+    RobustnessThirds = 13,
+    /// Permutations of the test of an uncertain key's share of #1's
+    /// variance (`crate::decide::robustness`).
+    RobustnessShares = 14,
 }
 
 /// The stream for (seed, design, sample, purpose); `design = None` for
