@@ -51,13 +51,13 @@ PLAN_LAYERS = [
     {"sample"},
 ]
 RESULTS_LAYERS = [
-    {"io", "measured_runs", "summary_columns"},
+    {"io", "measured_runs", "summary_columns", "causes_file"},
     {"results_table", "record"},
     {"runs_file"},
     {"design_runs"},
 ]
 DECIDE_LAYERS = [
-    {"measure", "diagnosis", "failures"},
+    {"measure", "diagnosis", "failures", "causes"},
     {"verdict", "plane_summary"},
     # Robustness tests #1 within each third by the verdicts' rule.
     {"decision", "compare_designs", "robustness"},
@@ -66,7 +66,7 @@ RUN_LAYERS = [
     {"lock", "racing"},
     {"adaptive", "aggregate"},
     # The executor (run/mod.rs and its private files) and what uses it.
-    {"mod", "assemble", "executor", "folder"},
+    {"mod", "assemble", "executor", "folder", "causes"},
     {"merge", "study_folder"},
 ]
 STUDY_LAYERS = [

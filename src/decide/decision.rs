@@ -185,6 +185,36 @@ pub struct StudyDecision {
     pub disagreements: Vec<Disagreement>,
     /// The recommendation.
     pub recommendation: Recommendation,
+    /// Why the leading design's runs do not settle (#1 when none
+    /// balances, else the part recommended), as its re-runs without each
+    /// effect tell (`cause_tested`; `None` when the experiment did not run).
+    pub tested_cause: Option<TestedCause>,
+}
+
+/// The cause experiment's finding on one design, as `summary.parquet`
+/// records it ([`crate::decide::causes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestedCause {
+    /// The design whose runs were re-run.
+    pub design: u32,
+    /// The finding in words, with the counts.
+    pub text: String,
+    /// The causes' keys joined by "+", or `no_single_effect`.
+    pub key: String,
+}
+
+/// The tested cause, from the `cause_tested` columns: on the one row the
+/// experiment ran on (the columns are absent in summaries written before it).
+fn tested_cause(c: &SummaryColumns, ranked: &[RankedDesign]) -> PolarsResult<Option<TestedCause>> {
+    let text = c.s_or_none("cause_tested")?;
+    let key = c.s_or_none("cause_tested_key")?;
+    Ok(ranked.iter().find_map(|d| {
+        Some(TestedCause {
+            design: d.id,
+            text: text[d.row].clone()?,
+            key: key[d.row].clone().unwrap_or_default(),
+        })
+    }))
 }
 
 /// The summary column holding each reported measure's value.
@@ -269,6 +299,7 @@ impl StudyDecision {
             Err(_) => TieBreak::First,
         };
         let recommendation = recommendation(&c, &ranked, tie_break)?;
+        let tested_cause = tested_cause(&c, &ranked)?;
         Ok(StudyDecision {
             criterion,
             alpha,
@@ -280,6 +311,7 @@ impl StudyDecision {
             crown,
             disagreements,
             recommendation,
+            tested_cause,
         })
     }
 

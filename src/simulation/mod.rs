@@ -3,8 +3,10 @@
 //! single simulation; the study runner fans many of them out over threads.
 //!
 //! - [`settings`]: the solver settings a run asks for;
-//! - [`estimate`]: the closed-form and linear rungs of the fidelity ladder.
+//! - [`estimate`]: the closed-form and linear rungs of the fidelity ladder;
+//! - [`counterfactual`]: a run with one effect taken out.
 
+pub mod counterfactual;
 mod estimate;
 pub mod settings;
 pub mod stepped;

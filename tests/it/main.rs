@@ -6,6 +6,7 @@ mod bad_input;
 mod bad_input_two;
 mod bench;
 mod calibration;
+mod causes;
 mod certified_hold;
 mod check;
 mod claims;

@@ -9,7 +9,9 @@
 //! - [`summary_columns`]: typed access to `summary.parquet`'s columns.
 //! - [`measured_runs`]: a design's runs and their scale (τ, revolution), as criteria see them.
 //! - [`design_runs`]: each design's runs as the statistics count them (clock, τ).
+//! - [`causes_file`]: `causes.parquet`, the counterfactual re-runs.
 
+pub mod causes_file;
 pub mod design_runs;
 pub mod io;
 pub mod measured_runs;

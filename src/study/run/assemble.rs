@@ -99,24 +99,7 @@ pub fn run_design_sample_in(
         .as_ref()
         .is_some_and(|c| c.enabled);
     let clock = Instant::now();
-    let result = match &sample.uncertain_refused {
-        Some(reason) => Ok(Err(reason.clone())),
-        None => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            simulation.run(false).map_err(|e| e.to_string())
-        })),
-    };
-    let metrics = match result {
-        Ok(Ok(r)) => r.metrics,
-        Ok(Err(e)) => failed(format!("invalid scene: {e}")),
-        Err(panic) => {
-            let why = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".into());
-            failed(format!("internal error: {why}"))
-        }
-    };
+    let metrics = guarded_metrics(&simulation, sample.uncertain_refused.as_deref());
     RunRecord {
         run_id,
         design_id: design.id,
@@ -148,6 +131,30 @@ pub fn run_design_sample_in(
         weights: sample.weights,
         couple: sample.couple,
         uncertain: sample.uncertain,
+    }
+}
+
+/// The metrics of `simulation`, never a panic: a scene the draws made
+/// invalid (`refused`, or one the run refuses) or a panic inside the run
+/// is a failed run with its reason.
+pub(super) fn guarded_metrics(simulation: &Simulation, refused: Option<&str>) -> RunMetrics {
+    let result = match refused {
+        Some(reason) => Ok(Err(reason.to_string())),
+        None => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            simulation.run(false).map_err(|e| e.to_string())
+        })),
+    };
+    match result {
+        Ok(Ok(r)) => r.metrics,
+        Ok(Err(e)) => failed(format!("invalid scene: {e}")),
+        Err(panic) => {
+            let why = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            failed(format!("internal error: {why}"))
+        }
     }
 }
 

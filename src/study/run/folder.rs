@@ -21,6 +21,8 @@ pub(super) struct FolderFiles {
     pub runs: PathBuf,
     /// The summary table.
     pub summary: PathBuf,
+    /// The counterfactual re-runs.
+    pub causes: PathBuf,
 }
 
 impl FolderFiles {
@@ -32,6 +34,7 @@ impl FolderFiles {
             chunks: dir.join("chunks"),
             runs: dir.join("runs.parquet"),
             summary: dir.join("summary.parquet"),
+            causes: dir.join(crate::study::results::causes_file::CAUSES_FILE),
         }
     }
 
@@ -112,7 +115,7 @@ pub(super) fn start_afresh(
             path: dir.display().to_string(),
         });
     }
-    for stale in [&files.runs, &files.summary] {
+    for stale in [&files.runs, &files.summary, &files.causes] {
         if stale.exists() {
             std::fs::remove_file(stale)?;
         }
@@ -129,12 +132,17 @@ pub(super) fn start_afresh(
 /// anything in it is touched (before, `--resume` with a file named
 /// `chunks` ended on a bare "os error 17").
 fn check_entry_kinds(dir: &Path) -> Result<(), RunError> {
-    let entries: [(&str, bool, &'static str); 5] = [
+    let entries: [(&str, bool, &'static str); 6] = [
         ("chunks", true, "chunks/ folder of finished runs"),
         ("study.toml", false, "copy of the study file (study.toml)"),
         (PLAN_ID_FILE, false, "plan id (plan.sha256)"),
         ("runs.parquet", false, "runs table (runs.parquet)"),
         ("summary.parquet", false, "summary table (summary.parquet)"),
+        (
+            "causes.parquet",
+            false,
+            "counterfactual re-runs (causes.parquet)",
+        ),
     ];
     for (name, want_dir, want) in entries {
         let path = dir.join(name);

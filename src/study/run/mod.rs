@@ -6,6 +6,7 @@
 //! - [`racing`]: designs dropped early once they cannot be #1.
 //! - [`adaptive`]: sampling in batches until a requested precision.
 //! - [`aggregate`]: per-design statistics (`summary.parquet`) with polars.
+//! - [`causes`]: the leading design's unsettled runs re-run without each effect (`causes.parquet`).
 //! - [`merge`]: combining shard outputs.
 //! - [`lock`]: one writer per results folder.
 //! - [`study_folder`]: the study's folder as another verb's destination (tradeoff, optimize).
@@ -39,6 +40,7 @@ use std::time::{Duration, Instant};
 pub mod adaptive;
 pub mod aggregate;
 mod assemble;
+pub mod causes;
 mod executor;
 mod folder;
 pub mod lock;
@@ -610,11 +612,33 @@ impl RunContext<'_> {
         let summary = if self.options.shard.is_none() {
             let table = read_summary_columns(runs_path)?;
             let mut summary = self.install(|| summarize_table(self.plan, &table))?;
+            let found = self.install(|| causes::experiment(self.plan, &table, &summary))?;
+            causes::append_columns(&mut summary, found.as_ref().map(|c| &c.finding))?;
             write_parquet(&self.files.summary, &mut summary, provenance)?;
+            self.write_causes(found.as_ref(), provenance)?;
             Some(summary)
         } else {
             None
         };
         Ok((written, summary))
+    }
+
+    /// Write causes.parquet from the experiment, or remove an earlier one
+    /// (a resumed study's) that no longer matches the summary.
+    fn write_causes(
+        &self,
+        found: Option<&causes::CauseExperiment>,
+        provenance: &Provenance,
+    ) -> Result<(), RunError> {
+        let path = &self.files.causes;
+        match found {
+            Some(c) => {
+                let mut table = crate::study::results::causes_file::to_dataframe(&c.rows)?;
+                write_parquet(path, &mut table, provenance)?;
+            }
+            None if path.exists() => std::fs::remove_file(path)?,
+            None => {}
+        }
+        Ok(())
     }
 }

@@ -23,6 +23,7 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             dead_band_over_a_ref,
             dead_band_over_band,
             ..
+<<<<<<< HEAD
         } => {
             let mut line = format!(
                 "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer){}; cause: {}",
@@ -47,6 +48,17 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             }
             line + "\n"
         }
+=======
+        } => format!(
+            "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {}\n",
+            who_id(decision, *best),
+            100.0 * settled_fraction,
+            residual_median.map_or("– (no run was simulated to its end)".into(), |r| format!(
+                "{r:.2}"
+            )),
+            cause_text(decision, cause.as_deref())
+        ),
+>>>>>>> 89de857 (Causes by counterfactual re-runs: #1's unsettled samples re-run with each effect removed in turn, the effect whose removal settles them named with counts (causes.parquet, summary.counterfactual_runs); bench grinder names the race eccentricity (13 of 13), not the dead band (rolling resistance 0 of 13))
         Crown::Alone => String::new(),
         Crown::Best {
             best,
@@ -91,6 +103,20 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             }
             line + "\n"
         }
+    }
+}
+
+/// The cause after "cause: ": the tested one (#1's runs re-run without
+/// each effect) with the floor checks' diagnosis as context, else the
+/// diagnosis alone.
+fn cause_text(decision: &StudyDecision, diagnosis: Option<&str>) -> String {
+    match (&decision.tested_cause, diagnosis) {
+        (Some(tested), Some(d)) => format!(
+            "{}; the floor checks, which only bound what could stop a run, say: {d}",
+            tested.text
+        ),
+        (Some(tested), None) => tested.text.clone(),
+        (None, d) => d.unwrap_or("no cause found").to_string(),
     }
 }
 
@@ -215,8 +241,11 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
         .collect();
     if !short.is_empty() {
         line += &format!(", with a caution: {}", short.join("; "));
-        // The cause of the shortfall, when a floor explains it.
-        if let Some(floor) = unsettled_floor {
+        // The cause of the shortfall: the tested one, else a floor that
+        // could explain it.
+        if let Some(tested) = &decision.tested_cause {
+            line += &format!(" ({})", tested.text);
+        } else if let Some(floor) = unsettled_floor {
             line += &format!(" ({floor})");
         }
     }

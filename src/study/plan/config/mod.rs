@@ -87,6 +87,11 @@ pub struct SummarySpec {
     /// smallest ρ) or `"first"` (#1 by the point estimate).
     #[serde(default)]
     pub tie_break: super::tie_break::TieBreak,
+    /// When the leading design settles too rarely, at most this many of its
+    /// samples that did not settle are re-run with each effect removed in
+    /// turn, to name the cause (`causes.parquet`); 0 turns it off.
+    #[serde(default = "default_counterfactual_runs")]
+    pub counterfactual_runs: u32,
 }
 
 impl Default for SummarySpec {
@@ -95,9 +100,19 @@ impl Default for SummarySpec {
             rank_by: super::criterion::Criterion::default(),
             pareto: default_pareto(),
             tie_break: super::tie_break::TieBreak::default(),
+            counterfactual_runs: default_counterfactual_runs(),
         }
     }
 }
+
+/// Samples re-run per effect by default: enough to tell "all" from "none"
+/// (6 of 6 against 0 of 6), few enough to add little to a study's time.
+fn default_counterfactual_runs() -> u32 {
+    32
+}
+
+/// The most samples `summary.counterfactual_runs` may re-run.
+pub const MAX_COUNTERFACTUAL_RUNS: u32 = 1024;
 
 fn default_pareto() -> Vec<super::criterion::Criterion> {
     super::criterion::Criterion::REPORTED.to_vec()

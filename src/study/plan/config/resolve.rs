@@ -140,6 +140,17 @@ impl StudyFile {
                 "name at least one measure (median, mean, p90, residual_p95, …), or leave the key out for all four",
             ));
         }
+        let reruns = self.summary.counterfactual_runs;
+        if reruns > super::MAX_COUNTERFACTUAL_RUNS {
+            return Err(r.invalid(
+                "summary.counterfactual_runs",
+                reruns.to_string(),
+                &format!(
+                    "at most {} samples re-run per effect (each one a whole run per effect); 0 turns the experiment off",
+                    super::MAX_COUNTERFACTUAL_RUNS
+                ),
+            ));
+        }
         Ok(())
     }
 
