@@ -91,9 +91,13 @@ fn a_dead_band_wider_than_the_settling_band_crowns_no_design_and_is_named() {
         stdout.contains("verdict: no design balances this rotor"),
         "{stdout}"
     );
-    // μ_s·l = 1e-3 × 15.9 mm = 15.9 µm, against δ·A_ref below 1 µm.
+    // μ_s·l = 1e-3 × 15.9 mm = 15.9 µm, against δ·A_ref below 1 µm: the
+    // re-runs without rolling resistance settle, and the floor check
+    // stays beside them as context.
     assert!(
-        stdout.contains("cause: the dead band of rolling resistance μ_s·l = 15.906 µm"),
+        stdout.contains("cause: why 4 of 4 runs do not settle")
+            && stdout.contains("rolling resistance — removing it settles 4 of 4")
+            && stdout.contains("say: the dead band of rolling resistance μ_s·l = 15.906 µm"),
         "{stdout}"
     );
     assert!(
@@ -184,8 +188,11 @@ fn a_race_eccentricity_above_the_settling_band_is_named_as_the_cause() {
         stdout.contains("verdict: no design balances this rotor"),
         "{stdout}"
     );
+    // Re-run without the eccentricity, the runs settle; the floor check
+    // stays beside them as context.
     assert!(
-        stdout.contains("cause: the race eccentricity e_r (effects.race_eccentricity.offset)")
+        stdout.contains("race eccentricity — removing it settles")
+            && stdout.contains("say: the race eccentricity e_r (effects.race_eccentricity.offset)")
             && stdout.contains("r = e_r = 10.000 µm"),
         "{stdout}"
     );

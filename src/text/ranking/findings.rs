@@ -106,15 +106,16 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
     }
 }
 
+/// What introduces the floor checks beside a tested cause: they bound
+/// what could stop a run, the re-runs say what does.
+const FLOORS_SAY: &str = "the floor checks, which only bound what could stop a run, say: ";
+
 /// The cause after "cause: ": the tested one (#1's runs re-run without
 /// each effect) with the floor checks' diagnosis as context, else the
 /// diagnosis alone.
 fn cause_text(decision: &StudyDecision, diagnosis: Option<&str>) -> String {
     match (&decision.tested_cause, diagnosis) {
-        (Some(tested), Some(d)) => format!(
-            "{}; the floor checks, which only bound what could stop a run, say: {d}",
-            tested.text
-        ),
+        (Some(tested), Some(d)) => format!("{}; {FLOORS_SAY}{d}", tested.text),
         (Some(tested), None) => tested.text.clone(),
         (None, d) => d.unwrap_or("no cause found").to_string(),
     }
@@ -241,12 +242,18 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
         .collect();
     if !short.is_empty() {
         line += &format!(", with a caution: {}", short.join("; "));
-        // The cause of the shortfall: the tested one, else a floor that
-        // could explain it.
-        if let Some(tested) = &decision.tested_cause {
-            line += &format!(" ({})", tested.text);
-        } else if let Some(floor) = unsettled_floor {
-            line += &format!(" ({floor})");
+        // The cause of the shortfall: the tested one, with a floor that
+        // could explain it as context.
+        match (&decision.tested_cause, unsettled_floor) {
+            (Some(tested), floor) => {
+                line += &format!(" ({}", tested.text);
+                if let Some(floor) = floor {
+                    line += &format!("; {FLOORS_SAY}{floor}");
+                }
+                line += ")";
+            }
+            (None, Some(floor)) => line += &format!(" ({floor})"),
+            (None, None) => {}
         }
     }
     // A winner at the end of a swept axis: the best may lie beyond it.
