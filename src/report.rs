@@ -11,6 +11,82 @@ use crate::plot::km::{KmCurve, SecondsAxis, plot_kaplan_meier};
 use crate::plot::study::{StudyData, StudyFigure, plot_study};
 use std::path::Path;
 
+/// The cause experiment on the page: the finding in words and, per effect
+/// removed, how many re-runs settled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CausesTable {
+    /// The finding, as `study run` prints it.
+    pub finding: String,
+    /// Per effect: its name, re-runs, settled, failed.
+    pub rows: Vec<[String; 4]>,
+}
+
+impl CausesTable {
+    /// The table of a finding.
+    pub fn of(finding: &crate::decide::causes::CauseFinding) -> Self {
+        CausesTable {
+            finding: finding.to_string(),
+            rows: finding
+                .tallies
+                .iter()
+                .map(|t| {
+                    [
+                        t.counterfactual.label().to_string(),
+                        t.reruns.to_string(),
+                        t.settled.to_string(),
+                        t.failed.to_string(),
+                    ]
+                })
+                .collect(),
+        }
+    }
+
+    /// Its HTML: a heading, the sentence and the table.
+    fn html(&self) -> String {
+        let mut out =
+            String::from("<h3 id=\"causes\">Why runs do not settle (causes.parquet)</h3>\n");
+        out.push_str(&format!("<p>{}</p>\n", prose(&self.finding)));
+        out.push_str("<table id=\"causes-table\">\n<thead><tr><th>effect removed</th><th>re-runs</th><th>settled</th><th>failed</th></tr></thead>\n<tbody>\n");
+        for row in &self.rows {
+            out.push_str("<tr>");
+            for cell in row {
+                out.push_str(&format!("<td>{}</td>", escape(cell)));
+            }
+            out.push_str("</tr>\n");
+        }
+        out.push_str("</tbody>\n</table>\n");
+        out
+    }
+}
+
+/// The cause experiment of the study folder `dir` (`causes.parquet`,
+/// with the design's run counts from `summary`); `None` when it did not run.
+pub fn causes_table(
+    dir: &Path,
+    summary: &polars::prelude::DataFrame,
+) -> polars::prelude::PolarsResult<Option<CausesTable>> {
+    use crate::study::results::causes_file::{CAUSES_FILE, from_dataframe};
+    let path = dir.join(CAUSES_FILE);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let rows = from_dataframe(&crate::study::results::io::read_parquet(&path)?)?;
+    let Some(id) = rows.first().map(|r| r.design_id) else {
+        return Ok(None);
+    };
+    let ids = summary.column("design_id")?.u32()?;
+    let Some(i) = (0..summary.height()).find(|&i| ids.get(i) == Some(id)) else {
+        return Ok(None);
+    };
+    let count = |name: &str| -> polars::prelude::PolarsResult<usize> {
+        Ok(summary.column(name)?.u64()?.get(i).unwrap_or(0) as usize)
+    };
+    let unsettled = count("censored")? + count("not_settled")?;
+    let finding =
+        crate::decide::causes::CauseFinding::from_rows(id, count("runs")?, unsettled, &rows);
+    Ok(Some(CausesTable::of(&finding)))
+}
+
 /// A figure of the page.
 #[derive(Debug, Clone)]
 pub struct Figure {
@@ -49,6 +125,8 @@ pub struct Report {
     pub findings: Vec<String>,
     /// Preformatted text shown after the findings (e.g. a passage table).
     pub preformatted: String,
+    /// The cause experiment's counts (`causes.parquet`), when it ran.
+    pub causes: Option<CausesTable>,
     /// The figures.
     pub figures: Vec<Figure>,
     /// (what, value) pairs: commit, study hash, seed, the command.
@@ -101,6 +179,9 @@ impl Report {
         }
         if !self.preformatted.trim().is_empty() {
             out.push_str(&format!("<pre>{}</pre>\n", escape(&self.preformatted)));
+        }
+        if let Some(causes) = &self.causes {
+            out.push_str(&causes.html());
         }
         out.push_str("</section>\n<section id=\"figures\">\n<h2>Figures</h2>\n");
         for (i, figure) in self.figures.iter().enumerate() {

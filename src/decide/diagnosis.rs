@@ -30,6 +30,75 @@ pub struct DesignFacts {
     /// planes (empty otherwise): a run settles only when every plane is
     /// inside its own band δ·A_ref of the plane.
     pub plane_a_ref_medians: Vec<f64>,
+    /// Median over the runs of each run's breakaway coefficient μ_s, when
+    /// rolling resistance's keys are `[uncertain]` (`None`: the nominal one).
+    pub breakaway_median: Option<f64>,
+}
+
+/// Rolling resistance's keys whose drawn values set a run's dead band
+/// (μ_s = coefficient × static_ratio), as `[uncertain]` names them;
+/// runs.parquet holds them under [`crate::uncertain::COLUMN_PREFIX`].
+pub const BREAKAWAY_KEYS: [&str; 2] = [
+    "effects.rolling_resistance.coefficient",
+    "effects.rolling_resistance.static_ratio",
+];
+
+/// A run's breakaway coefficient μ_s from its drawn `coefficient` and
+/// `static_ratio` (`None` where the key is not uncertain: the nominal
+/// value); `None` without rolling resistance.
+pub fn breakaway(plan: &StudyPlan, coefficient: Option<f64>, ratio: Option<f64>) -> Option<f64> {
+    let rr = plan.file.scene.effects.rolling_resistance.as_ref()?;
+    Some(coefficient.unwrap_or(rr.coefficient) * ratio.unwrap_or(rr.static_ratio))
+}
+
+/// The dead band of plane `p` at breakaway coefficient `mu_s` (`None`:
+/// the nominal one), `None` without rolling resistance.
+fn dead_band_at(plan: &StudyPlan, design: &Design, p: usize, mu_s: Option<f64>) -> Option<f64> {
+    match mu_s {
+        Some(mu) => plan
+            .file
+            .scene
+            .effects
+            .rolling_resistance
+            .as_ref()
+            .map(|_| mu * plane_track_radius(design, p)),
+        None => plane_dead_band(plan, design, p),
+    }
+}
+
+/// Each run's breakaway coefficient μ_s (rows of `runs`), from its drawn
+/// rolling-resistance keys; `None` when neither key is `[uncertain]` (or
+/// the table lacks their columns) and every run has the nominal one.
+pub fn run_breakaways(
+    plan: &StudyPlan,
+    runs: &polars::prelude::DataFrame,
+) -> polars::prelude::PolarsResult<Option<Vec<Option<f64>>>> {
+    let column = |key: &str| -> polars::prelude::PolarsResult<Option<Vec<Option<f64>>>> {
+        let name = format!("{}{key}", crate::uncertain::COLUMN_PREFIX);
+        match runs.column(&name) {
+            Ok(c) => Ok(Some(c.f64()?.iter().collect())),
+            Err(_) => Ok(None),
+        }
+    };
+    let (coefficient, ratio) = (column(BREAKAWAY_KEYS[0])?, column(BREAKAWAY_KEYS[1])?);
+    if coefficient.is_none() && ratio.is_none() {
+        return Ok(None);
+    }
+    let at = |v: &Option<Vec<Option<f64>>>, i: usize| v.as_ref().and_then(|v| v[i]);
+    Ok(Some(
+        (0..runs.height())
+            .map(|i| breakaway(plan, at(&coefficient, i), at(&ratio, i)))
+            .collect(),
+    ))
+}
+
+/// One run that did not settle, as the floor checks see it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnsettledRun {
+    /// Its A_ref per watched plane (or the rotor's alone).
+    pub a_refs: Vec<f64>,
+    /// Its own breakaway coefficient μ_s, drawn (`None`: the nominal one).
+    pub breakaway: Option<f64>,
 }
 
 /// The dead band μ_s·l of a design (m), with rolling resistance on.
@@ -308,8 +377,11 @@ impl std::fmt::Display for Cause {
 pub struct FloorReach {
     /// What makes the floor.
     pub what: String,
-    /// Its size (m).
+    /// Its size (m): the largest over the runs it reaches.
     pub floor: f64,
+    /// The smallest and largest over the runs it reaches (m): a dead band
+    /// differs from run to run when μ is uncertain.
+    pub floors: (f64, f64),
     /// The balancer plane whose own band it reaches (rotors with several).
     pub plane: Option<usize>,
     /// Runs that did not settle whose band it reaches.
@@ -334,13 +406,21 @@ impl std::fmt::Display for FloorReach {
                 ),
             )
         };
+        let floor = if self.floors.0 < self.floors.1 {
+            format!(
+                "{:.3}–{:.3} µm (each run's own, from its drawn μ)",
+                self.floors.0 * 1e6,
+                self.floors.1 * 1e6
+            )
+        } else {
+            format!("{:.3} µm", self.floor * 1e6)
+        };
         write!(
             f,
-            "{} of the {} runs that did not settle {has} {} δ·A_ref ({bands}) at or below a whirl no balancer removes, {:.3} µm: {}",
+            "{} of the {} runs that did not settle {has} {} δ·A_ref ({bands}) at or below a whirl no balancer removes, {floor}: {}",
             self.runs,
             self.unsettled,
             whose_band(self.plane),
-            self.floor * 1e6,
             self.what,
         )
     }
@@ -348,45 +428,53 @@ impl std::fmt::Display for FloorReach {
 
 /// The floor that reaches the own band (δ·A_ref, per balancer plane on
 /// rotors with several) of at least half the runs that did not settle,
-/// each given by its A_ref per watched plane (or the rotor's alone).
+/// each given by its A_ref per watched plane (or the rotor's alone) and
+/// its own breakaway coefficient: a run's dead band is its drawn μ_s·l.
 pub fn floor_reach(
     plan: &StudyPlan,
     design: &Design,
-    unsettled_a_refs: &[Vec<f64>],
+    unsettled: &[UnsettledRun],
 ) -> Option<FloorReach> {
     let planes = plan.file.scene.rotor.as_rotor().planes();
-    let several = unsettled_a_refs.iter().any(|a| a.len() > 1);
-    let mut candidates: Vec<(String, f64, usize)> = Vec::new();
+    let several = unsettled.iter().any(|r| r.a_refs.len() > 1);
+    // (what, plane, the floor of each run).
+    let mut candidates: Vec<(String, usize, Vec<Option<f64>>)> = Vec::new();
     for p in 0..if several { planes } else { 1 } {
         if let Some((floor, what)) = plan.file.scene.effects.whirl_floor() {
-            candidates.push((what.to_string(), floor, p));
+            candidates.push((what.to_string(), p, vec![Some(floor); unsettled.len()]));
         }
-        if let Some(dead) = plane_dead_band(plan, design, p) {
+        if plane_dead_band(plan, design, p).is_some() {
             candidates.push((
                 "the dead band of rolling resistance μ_s·l, inside which the weights stop anywhere"
                     .into(),
-                dead,
                 p,
+                unsettled
+                    .iter()
+                    .map(|r| dead_band_at(plan, design, p, r.breakaway))
+                    .collect(),
             ));
         }
     }
     candidates
         .into_iter()
-        .filter_map(|(what, floor, p)| {
-            let reached: Vec<f64> = unsettled_a_refs
+        .filter_map(|(what, p, floors)| {
+            let (reached, floors): (Vec<f64>, Vec<f64>) = unsettled
                 .iter()
-                .filter_map(|a| a.get(p))
-                .map(|&a| settling_band(plan, a))
-                .filter(|&band| floor >= band)
-                .collect();
+                .zip(&floors)
+                .filter_map(|(r, &floor)| Some((settling_band(plan, *r.a_refs.get(p)?), floor?)))
+                .filter(|&(band, floor)| floor >= band)
+                .unzip();
             let lo = reached.iter().copied().reduce(f64::min)?;
             let hi = reached.iter().copied().reduce(f64::max)?;
+            let fl = floors.iter().copied().reduce(f64::min)?;
+            let fh = floors.iter().copied().reduce(f64::max)?;
             Some(FloorReach {
                 what,
-                floor,
+                floor: fh,
+                floors: (fl, fh),
                 plane: several.then_some(p),
                 runs: reached.len(),
-                unsettled: unsettled_a_refs.len(),
+                unsettled: unsettled.len(),
                 bands: (lo, hi),
             })
         })
@@ -434,7 +522,10 @@ pub fn first_cause(plan: &StudyPlan, design: &Design, facts: &DesignFacts) -> Ca
     for &(plane, a_ref) in &bands {
         let band = settling_band(plan, a_ref);
         let p = plane.unwrap_or(0);
-        if let Some(dead) = plane_dead_band(plan, design, p).filter(|&d| d >= band) {
+        // The runs' own dead bands, at their median drawn μ_s when uncertain.
+        if let Some(dead) =
+            dead_band_at(plan, design, p, facts.breakaway_median).filter(|&d| d >= band)
+        {
             return Cause::DeadBand {
                 dead,
                 track_radius: plane_track_radius(design, p),

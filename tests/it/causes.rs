@@ -108,6 +108,27 @@ fn the_grinder_fails_to_settle_because_of_its_race_not_its_rolling_resistance() 
     );
     let summary = read_parquet(&folder.join("summary.parquet")).unwrap();
     assert_eq!(strings(&summary, "cause_tested_key"), ["race_eccentricity"]);
+    // The report shows the counts.
+    let page = tmp.path().join("report.html");
+    let out = Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg("report")
+        .arg(&folder)
+        .arg("--out")
+        .arg(&page)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let html = std::fs::read_to_string(&page).unwrap();
+    let row =
+        format!("<tr><td>race eccentricity</td><td>{race_n}</td><td>{race}</td><td>0</td></tr>");
+    assert!(
+        html.contains("id=\"causes-table\"") && html.contains(&row),
+        "{html}"
+    );
 }
 
 /// The re-runs are the seed's, not the schedule's: one thread and two
@@ -240,4 +261,67 @@ fn each_counterfactual_removes_its_effect_and_only_it() {
             );
         }
     }
+}
+
+/// With rolling resistance's coefficient uncertain, each run's dead band is
+/// its own drawn μ_s·l: the runs that did not settle are classed against
+/// it (`unsettled_floor`), not against the nominal μ's.
+#[test]
+fn an_uncertain_friction_is_classed_per_run_by_its_drawn_dead_band() {
+    let tmp = tempfile::tempdir().unwrap();
+    let study = grinder(
+        tmp.path(),
+        "\n[summary]\ncounterfactual_runs = 0\n\n[uncertain]\n\"effects.rolling_resistance.coefficient\" = { distribution = \"log_uniform\", min = 1e-5, max = 2e-4 }\n",
+    );
+    // Only the dead band may reach the bands: the race is made true, and
+    // the balls stick where they stop (no creep).
+    let text = std::fs::read_to_string(&study)
+        .unwrap()
+        .replace("offset = 1e-6", "offset = 0.0")
+        .replace("slip_rate = 1e-3", "");
+    std::fs::write(&study, text).unwrap();
+    let out = run(&study, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let folder = tmp.path().join("bench_grinder");
+    let runs = read_parquet(&folder.join("runs.parquet")).unwrap();
+    let outcome = strings(&runs, "outcome");
+    let mu = runs
+        .column("scene.effects.rolling_resistance.coefficient")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .clone();
+    let a_refs = runs.column("plane_a_ref").unwrap().list().unwrap().clone();
+    // Track radius 31.5 mm, static ratio 1, δ = 0.05: count per plane.
+    let (track, delta, nominal) = (0.0315, 0.05, 5e-5);
+    let reached = |plane: usize, own: bool| {
+        (0..runs.height())
+            .filter(|&i| outcome[i] == "censored" || outcome[i] == "not_settled")
+            .filter(|&i| {
+                let a = a_refs.get_as_series(i).unwrap();
+                let a = a.f64().unwrap().get(plane).unwrap();
+                let mu = if own { mu.get(i).unwrap() } else { nominal };
+                mu * track >= delta * a
+            })
+            .count()
+    };
+    let own = reached(0, true).max(reached(1, true));
+    let unsettled = outcome
+        .iter()
+        .filter(|o| *o == "censored" || *o == "not_settled")
+        .count();
+    let summary = read_parquet(&folder.join("summary.parquet")).unwrap();
+    let floor = strings(&summary, "unsettled_floor").remove(0);
+    assert!(own > 0 && 2 * own >= unsettled, "own {own} of {unsettled}");
+    assert!(
+        floor.starts_with(&format!(
+            "{own} of the {unsettled} runs that did not settle"
+        )) && floor.contains("each run's own, from its drawn μ"),
+        "{floor} (own {own}, nominal {})",
+        reached(0, false)
+    );
 }

@@ -143,6 +143,7 @@ pub fn run(args: &ReportArgs) -> Result<(), UserError> {
         legend: lines(&parts.legend),
         findings,
         preformatted: parts.passage,
+        causes: autobal::report::causes_table(&args.dir, &summary)?,
         figures,
         provenance: vec![
             ("autobal".into(), value("build")),

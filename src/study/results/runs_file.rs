@@ -231,10 +231,17 @@ pub const PLANE_SUMMARY_COLUMNS: [&str; 3] =
 
 /// Columns the summary reads when a file has them: how contact was
 /// modelled and the pack's slip rate (files written before the columns
-/// have none), and each run's peak whirl (the start-up whirl columns; every
+/// have none), each run's peak whirl (the start-up whirl columns; every
 /// file has it, but a table built without it still summarises, with those
-/// columns empty).
-pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 3] = ["contact_model", "pack_slip_rate", "peak_r"];
+/// columns empty), and rolling resistance's drawn keys, which set each
+/// run's dead band.
+pub const OPTIONAL_SUMMARY_COLUMNS: [&str; 5] = [
+    "contact_model",
+    "pack_slip_rate",
+    "peak_r",
+    "scene.effects.rolling_resistance.coefficient",
+    "scene.effects.rolling_resistance.static_ratio",
+];
 
 /// The summary's projection of the file at `path`: [`SUMMARY_COLUMNS`], and
 /// [`PLANE_SUMMARY_COLUMNS`] and [`OPTIONAL_SUMMARY_COLUMNS`] where the file

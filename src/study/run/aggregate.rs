@@ -7,7 +7,9 @@
 //! run that was simulated to the end (settled or not), i.e. the distribution
 //! over the sampled unbalances; diverged and failed runs are counted.
 
-use crate::decide::diagnosis::{DesignFacts, dead_band, diagnose, floor_reach, settling_band};
+use crate::decide::diagnosis::{
+    DesignFacts, UnsettledRun, dead_band, diagnose, floor_reach, run_breakaways, settling_band,
+};
 use crate::decide::verdict::{
     BestVersusRest, LEVEL, SettlingClock, best_versus_rest, design_runs, measure_scale, pareto_set,
 };
@@ -319,7 +321,12 @@ impl SummaryColumns {
         let fraction = sorted_values(mine.column("unbalance_fraction")?.f64()?);
         let median_of = |v: &[f64]| quantile_sorted(v, 0.5, Interpolation::Linear);
         let plane_a_refs = crate::study::results::record::nullable_lists(mine, "plane_a_ref")?;
+        // Each run's own μ_s where rolling resistance is uncertain.
+        let breakaways = run_breakaways(plan, mine)?;
+        let mut drawn: Vec<f64> = breakaways.iter().flatten().flatten().copied().collect();
+        drawn.sort_by(f64::total_cmp);
         let facts = DesignFacts {
+            breakaway_median: median_of(&drawn),
             plane_a_ref_medians: plane_medians(plane_a_refs.as_deref()),
             a_ref_median: median_of(&a_ref).unwrap_or(f64::NAN),
             unbalance_fraction_median: median_of(&fraction).unwrap_or(f64::NAN),
@@ -342,9 +349,14 @@ impl SummaryColumns {
             _ => None,
         };
         rows.unsettled_floor.push(
-            unsettled_a_refs(mine, outcomes, plane_a_refs.as_deref())?
-                .and_then(|a| floor_reach(plan, design, &a))
-                .map(|r| r.to_string()),
+            unsettled_runs(
+                mine,
+                outcomes,
+                plane_a_refs.as_deref(),
+                breakaways.as_deref(),
+            )?
+            .and_then(|a| floor_reach(plan, design, &a))
+            .map(|r| r.to_string()),
         );
         rows.diagnosis_cause
             .push(diagnosis.as_ref().map(|d| d.cause.key().to_string()));
@@ -811,21 +823,29 @@ fn append_peak_whirl(summary: &mut DataFrame, runs: &DataFrame) -> PolarsResult<
     Ok(())
 }
 
-/// A_ref per watched plane (or the rotor's alone) of each run of `mine`
-/// that ended censored or not settled; `None` when every run settled or failed.
-fn unsettled_a_refs(
+/// A_ref per watched plane (or the rotor's alone) and the drawn μ_s
+/// (`breakaways`, where uncertain) of each run of `mine` that ended
+/// censored or not settled; `None` when every run settled or failed.
+fn unsettled_runs(
     mine: &DataFrame,
     outcomes: &[Option<Outcome>],
     plane_a_refs: Option<&[Vec<Option<f64>>]>,
-) -> PolarsResult<Option<Vec<Vec<f64>>>> {
+    breakaways: Option<&[Option<f64>]>,
+) -> PolarsResult<Option<Vec<UnsettledRun>>> {
     let a_ref = mine.column("a_ref")?.f64()?;
-    let rows: Vec<Vec<f64>> = outcomes
+    let rows: Vec<UnsettledRun> = outcomes
         .iter()
         .enumerate()
         .filter(|(_, o)| matches!(o, Some(Outcome::Censored | Outcome::NotSettled)))
-        .filter_map(|(i, _)| match plane_a_refs.and_then(|l| l.get(i)) {
-            Some(l) if l.len() > 1 => l.iter().copied().collect::<Option<Vec<f64>>>(),
-            _ => a_ref.get(i).map(|a| vec![a]),
+        .filter_map(|(i, _)| {
+            let a_refs = match plane_a_refs.and_then(|l| l.get(i)) {
+                Some(l) if l.len() > 1 => l.iter().copied().collect::<Option<Vec<f64>>>(),
+                _ => a_ref.get(i).map(|a| vec![a]),
+            }?;
+            Some(UnsettledRun {
+                a_refs,
+                breakaway: breakaways.and_then(|b| b[i]),
+            })
         })
         .collect();
     Ok((!rows.is_empty()).then_some(rows))
