@@ -3,6 +3,7 @@
 //! recommendation with its cautions, edges and Pareto set.
 
 use super::*;
+use crate::decide::decision::TestedCause;
 
 /// "#r (design id)".
 pub(super) fn who_id(decision: &StudyDecision, id: u32) -> String {
@@ -56,7 +57,7 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             residual_median.map_or("– (no run was simulated to its end)".into(), |r| format!(
                 "{r:.2}"
             )),
-            cause_text(decision, cause.as_deref())
+            cause_text(decision, *best, cause.as_deref())
         ),
 >>>>>>> 89de857 (Causes by counterfactual re-runs: #1's unsettled samples re-run with each effect removed in turn, the effect whose removal settles them named with counts (causes.parquet, summary.counterfactual_runs); bench grinder names the race eccentricity (13 of 13), not the dead band (rolling resistance 0 of 13))
         Crown::Alone => String::new(),
@@ -106,6 +107,11 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
     }
 }
 
+/// The tested cause when the experiment ran on design `id`.
+fn tested_on(decision: &StudyDecision, id: u32) -> Option<&TestedCause> {
+    decision.tested_cause.as_ref().filter(|t| t.design == id)
+}
+
 /// What introduces the floor checks beside a tested cause: they bound
 /// what could stop a run, the re-runs say what does.
 const FLOORS_SAY: &str = "the floor checks, which only bound what could stop a run, say: ";
@@ -113,8 +119,8 @@ const FLOORS_SAY: &str = "the floor checks, which only bound what could stop a r
 /// The cause after "cause: ": the tested one (#1's runs re-run without
 /// each effect) with the floor checks' diagnosis as context, else the
 /// diagnosis alone.
-fn cause_text(decision: &StudyDecision, diagnosis: Option<&str>) -> String {
-    match (&decision.tested_cause, diagnosis) {
+fn cause_text(decision: &StudyDecision, best: u32, diagnosis: Option<&str>) -> String {
+    match (tested_on(decision, best), diagnosis) {
         (Some(tested), Some(d)) => format!("{}; {FLOORS_SAY}{d}", tested.text),
         (Some(tested), None) => tested.text.clone(),
         (None, d) => d.unwrap_or("no cause found").to_string(),
@@ -244,7 +250,7 @@ pub(super) fn recommendation_line(decision: &StudyDecision) -> String {
         line += &format!(", with a caution: {}", short.join("; "));
         // The cause of the shortfall: the tested one, with a floor that
         // could explain it as context.
-        match (&decision.tested_cause, unsettled_floor) {
+        match (tested_on(decision, *design), unsettled_floor) {
             (Some(tested), floor) => {
                 line += &format!(" ({}", tested.text);
                 if let Some(floor) = floor {
