@@ -137,6 +137,37 @@ fn unsettled_samples(runs: &DataFrame, id: u32) -> PolarsResult<(usize, Vec<u32>
     Ok((all, unsettled))
 }
 
+/// Run the experiment and append its columns to `summary` (what `study
+/// run` and `study merge` both do after the summary).
+pub fn test_and_append(
+    plan: &StudyPlan,
+    runs: &DataFrame,
+    summary: &mut DataFrame,
+) -> PolarsResult<Option<CauseExperiment>> {
+    let found = experiment(plan, runs, summary)?;
+    append_columns(summary, found.as_ref().map(|c| &c.finding))?;
+    Ok(found)
+}
+
+/// Write `causes.parquet` at `path` from the experiment, or remove an
+/// earlier one (a resumed or re-merged study's) that no longer matches
+/// the summary.
+pub fn write_or_remove(
+    path: &std::path::Path,
+    found: Option<&CauseExperiment>,
+    provenance: &crate::study::results::io::Provenance,
+) -> Result<(), super::RunError> {
+    match found {
+        Some(c) => {
+            let mut table = crate::study::results::causes_file::to_dataframe(&c.rows)?;
+            crate::study::results::io::write_parquet(path, &mut table, provenance)?;
+        }
+        None if path.exists() => std::fs::remove_file(path)?,
+        None => {}
+    }
+    Ok(())
+}
+
 /// The summary's `cause_tested` (the finding in words) and
 /// `cause_tested_key` (its causes' keys) columns: on the experiment's
 /// design's row, null elsewhere and when no experiment ran.

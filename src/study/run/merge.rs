@@ -101,8 +101,16 @@ pub fn merge(
         write_parquet(&runs_path, &mut made, &provenance)?;
         departures = Some(race.departures());
     }
-    let mut summary = summarize_table(&plan, &read_summary_columns(&runs_path)?)?;
+    let table = read_summary_columns(&runs_path)?;
+    let mut summary = summarize_table(&plan, &table)?;
+    // The cause experiment, as the unsharded study runs it.
+    let found = crate::study::run::causes::test_and_append(&plan, &table, &mut summary)?;
     write_parquet(&dir.join("summary.parquet"), &mut summary, &provenance)?;
+    crate::study::run::causes::write_or_remove(
+        &dir.join(crate::study::results::causes_file::CAUSES_FILE),
+        found.as_ref(),
+        &provenance,
+    )?;
     crate::study::results::io::write_text(&dir.join("study.toml"), &plan.text)
         .map_err(RunError::Io)?;
     if let Some((plan_id, _)) = shard_plan.split_once('\n')

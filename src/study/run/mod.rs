@@ -612,33 +612,14 @@ impl RunContext<'_> {
         let summary = if self.options.shard.is_none() {
             let table = read_summary_columns(runs_path)?;
             let mut summary = self.install(|| summarize_table(self.plan, &table))?;
-            let found = self.install(|| causes::experiment(self.plan, &table, &summary))?;
-            causes::append_columns(&mut summary, found.as_ref().map(|c| &c.finding))?;
+            let found =
+                self.install(|| causes::test_and_append(self.plan, &table, &mut summary))?;
             write_parquet(&self.files.summary, &mut summary, provenance)?;
-            self.write_causes(found.as_ref(), provenance)?;
+            causes::write_or_remove(&self.files.causes, found.as_ref(), provenance)?;
             Some(summary)
         } else {
             None
         };
         Ok((written, summary))
-    }
-
-    /// Write causes.parquet from the experiment, or remove an earlier one
-    /// (a resumed study's) that no longer matches the summary.
-    fn write_causes(
-        &self,
-        found: Option<&causes::CauseExperiment>,
-        provenance: &Provenance,
-    ) -> Result<(), RunError> {
-        let path = &self.files.causes;
-        match found {
-            Some(c) => {
-                let mut table = crate::study::results::causes_file::to_dataframe(&c.rows)?;
-                write_parquet(path, &mut table, provenance)?;
-            }
-            None if path.exists() => std::fs::remove_file(path)?,
-            None => {}
-        }
-        Ok(())
     }
 }
