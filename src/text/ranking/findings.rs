@@ -24,7 +24,6 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             dead_band_over_a_ref,
             dead_band_over_band,
             ..
-<<<<<<< HEAD
         } => {
             let mut line = format!(
                 "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer){}; cause: {}",
@@ -37,7 +36,7 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
                     "; {:.1} % of its runs end worse than with no balancer",
                     100.0 * w
                 )),
-                cause.as_deref().unwrap_or("no cause found")
+                cause_text(decision, *best, cause.as_deref())
             );
             // A dead band beyond A_ref: no band a user would accept helps,
             // only less friction does, and by how much is a number.
@@ -49,17 +48,6 @@ pub(super) fn verdict_line(decision: &StudyDecision) -> String {
             }
             line + "\n"
         }
-=======
-        } => format!(
-            "verdict: no design balances this rotor, so none is called best: even {} settles into the band in only {:.1} % of its runs (a working balancer settles in at least half) and leaves a median residual/A_ref of {} (above 1 is worse than no balancer); cause: {}\n",
-            who_id(decision, *best),
-            100.0 * settled_fraction,
-            residual_median.map_or("– (no run was simulated to its end)".into(), |r| format!(
-                "{r:.2}"
-            )),
-            cause_text(decision, *best, cause.as_deref())
-        ),
->>>>>>> 89de857 (Causes by counterfactual re-runs: #1's unsettled samples re-run with each effect removed in turn, the effect whose removal settles them named with counts (causes.parquet, summary.counterfactual_runs); bench grinder names the race eccentricity (13 of 13), not the dead band (rolling resistance 0 of 13))
         Crown::Alone => String::new(),
         Crown::Best {
             best,
